@@ -1,0 +1,27 @@
+# Warnings on everywhere; Release optimises.  Targets opt in with fdem_target_options().
+option(FDEM_NATIVE "Tune for the build machine (-march=native)" OFF)
+set(CMAKE_CXX_FLAGS_RELEASE "-O3 -DNDEBUG")
+set(CMAKE_CXX_FLAGS_RELWITHDEBINFO "-O2 -g -DNDEBUG")
+
+function(fdem_target_options target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wno-unused-parameter)
+  if(FDEM_NATIVE)
+    target_compile_options(${target} PRIVATE -march=native)
+  endif()
+endfunction()
+
+# fdem_folder_library(NAME deps...) : a library from every .cpp in the current folder.
+function(fdem_folder_library name)
+  file(GLOB _sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  if(_sources)
+    add_library(fdem_${name} STATIC ${_sources})
+    target_include_directories(fdem_${name} PUBLIC ${PROJECT_SOURCE_DIR})
+    target_link_libraries(fdem_${name} PUBLIC ${ARGN})
+    fdem_target_options(fdem_${name})
+  else()
+    add_library(fdem_${name} INTERFACE)
+    target_include_directories(fdem_${name} INTERFACE ${PROJECT_SOURCE_DIR})
+    target_link_libraries(fdem_${name} INTERFACE ${ARGN})
+  endif()
+  add_library(fdem::${name} ALIAS fdem_${name})
+endfunction()
