@@ -20,8 +20,8 @@ class NumericalFailure : public std::runtime_error {
 
 // Always-on check for internal invariants (a failure here is a bug in fdem, not user error).
 [[noreturn]] void internal_error(const char* file, int line, const std::string& what);
-#define FDEM_VERIFY(cond, msg)                                  \
-  do {                                                          \
+#define FDEM_VERIFY(cond, msg)                                    \
+  do {                                                            \
     if (!(cond)) ::fdem::internal_error(__FILE__, __LINE__, msg); \
   } while (0)
 

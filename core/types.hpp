@@ -15,7 +15,9 @@ using GlobalId = std::int64_t;
 using LocalIndex = std::int32_t;
 
 // View of node i's xyz triple inside a flat array of 3*n doubles.
-inline Eigen::Map<Vec3> vec3_at(double* xyz, LocalIndex i) { return Eigen::Map<Vec3>(xyz + 3 * i); }
+inline Eigen::Map<Vec3> vec3_at(double* xyz, LocalIndex i) {
+  return Eigen::Map<Vec3>(xyz + 3 * i);
+}
 inline Eigen::Map<const Vec3> vec3_at(const double* xyz, LocalIndex i) {
   return Eigen::Map<const Vec3>(xyz + 3 * i);
 }

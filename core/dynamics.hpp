@@ -1,0 +1,54 @@
+// Element-loop stages of the step: internal forces, gathering corner forces to nodes in canonical
+// order, gravity, and the central-difference update with its energy bookkeeping.
+#pragma once
+
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace fdem {
+
+struct InternalForceSummary {
+  double strain_energy = 0.0;  // J, at the current positions
+  double damping_power = 0.0;  // W, viscous dissipation rate
+  double min_jacobian = 1.0;   // smallest det F over the tets
+  LocalIndex min_jacobian_tet = -1;
+};
+
+// Computes every tet's corner forces into corner_forces (12 doubles per tet, overwritten).
+InternalForceSummary compute_internal_forces(const Model& model,
+                                             std::vector<double>& corner_forces);
+
+// f[node] = Σ corner forces in ascending tet gid (overwrites f for every node in the map).
+void gather_corner_forces(const NodeCornerMap& map, const std::vector<double>& corner_forces,
+                          std::vector<double>& f);
+
+// Adds m·g to every node's force.
+void add_gravity(const Vec3& gravity, NodeArrays& nodes);
+
+// Gravity potential −Σ m g·(x − x0) (J), zero at t = 0.
+double gravity_potential(const Vec3& gravity, const NodeArrays& nodes);
+
+struct IntegrationSummary {
+  double kinetic_energy = 0.0;   // J, with the full-step velocity ½(v⁻ + v⁺)
+  double constraint_work = 0.0;  // J, work of prescribed-velocity reactions over [n−½, n+½]
+  double max_displacement_increment = 0.0;  // m, largest |Δx| of a node this step
+  bool finite = true;                       // false if any velocity became NaN or infinite
+};
+
+// Central difference: v⁺ = v⁻ + dt·f/m (prescribed components set), x += dt·v⁺, on owned nodes.
+IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes);
+
+// Mass-weighted position, velocity and rotation of each piece (for bodies.csv and tests).
+struct PieceMotion {
+  Vec3 centroid = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  Vec3 rotation = Vec3::Zero();  // rotation vector (axis × angle, rad) of the best-fit rotation
+};
+std::vector<PieceMotion> piece_motions(const Model& model);
+
+// Total linear and angular momentum (about the origin) of the owned nodes.
+Vec3 linear_momentum(const NodeArrays& nodes);
+Vec3 angular_momentum(const NodeArrays& nodes);
+
+}  // namespace fdem

@@ -1,0 +1,67 @@
+// Energy bookkeeping: E_kin + U + E_grav + U_contact + U_joint + D_friction + D_fracture +
+// D_damping − W_ext = E_0.  Work and dissipation terms grow by increments that cover [t_n − dt/2,
+// t_n + dt/2]; the value reported at t_n takes half of the latest increment so every term refers to
+// t_n.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+namespace fdem {
+
+struct EnergyTerms {
+  double kinetic = 0.0, strain = 0.0, gravity = 0.0, contact = 0.0, joint = 0.0;
+  double dissipated_fracture = 0.0, dissipated_friction = 0.0, dissipated_damping = 0.0;
+  double external_work = 0.0;
+
+  double total() const {
+    return kinetic + strain + gravity + contact + joint + dissipated_fracture +
+           dissipated_friction + dissipated_damping - external_work;
+  }
+  // The largest magnitude among the terms: the scale that the balance error is measured against.
+  double scale() const {
+    return std::max({std::abs(kinetic), std::abs(strain), std::abs(gravity), std::abs(contact),
+                     std::abs(joint), dissipated_fracture, dissipated_friction, dissipated_damping,
+                     std::abs(external_work)});
+  }
+};
+
+// A work-like quantity accumulated with increments over [n−½, n+½].
+struct HalfStepAccumulator {
+  double through_previous = 0.0;  // sum of increments of steps < n
+  // Adds step n's increment and returns the value at t_n.
+  double add(double increment) {
+    const double at_n = through_previous + 0.5 * increment;
+    through_previous += increment;
+    return at_n;
+  }
+};
+
+class EnergyLedger {
+ public:
+  // Records the state at t_n; the first call fixes E_0.
+  void record(const EnergyTerms& terms) {
+    current_ = terms;
+    if (!has_initial_) {
+      initial_total_ = terms.total();
+      has_initial_ = true;
+    }
+    peak_scale_ = std::max(peak_scale_, terms.scale());
+  }
+  const EnergyTerms& current() const { return current_; }
+  double initial_total() const { return initial_total_; }
+  // |E(t) − E_0| / (largest term seen so far); 0 while nothing has moved.
+  double balance_error() const {
+    return peak_scale_ > 0.0 ? std::abs(current_.total() - initial_total_) / peak_scale_ : 0.0;
+  }
+
+  HalfStepAccumulator damping, friction, fracture, external;
+
+ private:
+  EnergyTerms current_;
+  double initial_total_ = 0.0;
+  double peak_scale_ = 0.0;
+  bool has_initial_ = false;
+};
+
+}  // namespace fdem

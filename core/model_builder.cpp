@@ -1,0 +1,259 @@
+#include "core/model_builder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/tet_kernels.hpp"
+
+namespace fdem {
+
+namespace {
+
+struct UnionFind {
+  std::vector<LocalIndex> parent;
+  explicit UnionFind(LocalIndex n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  LocalIndex find(LocalIndex i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  }
+  void unite(LocalIndex a, LocalIndex b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+std::uint64_t spread_bits(std::uint64_t v) {  // 21 bits -> every third bit
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+
+MaterialProperties resolve_material(const MaterialSpec& spec) {
+  MaterialProperties m;
+  m.name = spec.name;
+  m.density = spec.density;
+  m.model = spec.elastic.model;
+  m.young = spec.elastic.young;
+  m.poisson = spec.elastic.poisson;
+  m.lame = LameParameters::from_young_poisson(spec.elastic.young, spec.elastic.poisson);
+  m.damping_ratio = spec.damping;
+  m.contact = spec.contact;
+  return m;
+}
+
+}  // namespace
+
+std::vector<std::int32_t> connected_pieces(const std::vector<LocalIndex>& tets, LocalIndex n_nodes,
+                                           std::int32_t* n_pieces) {
+  UnionFind uf(n_nodes);
+  const LocalIndex n_tets = static_cast<LocalIndex>(tets.size() / 4);
+  for (LocalIndex t = 0; t < n_tets; ++t)
+    for (int c = 1; c < 4; ++c) uf.unite(tets[4 * t], tets[4 * t + c]);
+  std::vector<std::int32_t> root_piece(n_nodes, -1), piece(n_tets);
+  std::int32_t count = 0;
+  for (LocalIndex t = 0; t < n_tets; ++t) {
+    const LocalIndex root = uf.find(tets[4 * t]);
+    if (root_piece[root] < 0) root_piece[root] = count++;
+    piece[t] = root_piece[root];
+  }
+  if (n_pieces) *n_pieces = count;
+  return piece;
+}
+
+std::uint64_t morton_key(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  std::uint64_t key = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double extent = hi[k] - lo[k];
+    double s = extent > 0.0 ? (p[k] - lo[k]) / extent : 0.0;
+    s = std::clamp(s, 0.0, 1.0);
+    key |= spread_bits(static_cast<std::uint64_t>(s * 2097151.0)) << k;
+  }
+  return key;
+}
+
+Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, ElementOrder order) {
+  FDEM_VERIFY(meshes.size() == scene.bodies.size(), "one mesh per body");
+  Model model;
+  model.gravity = scene.gravity;
+  for (const auto& spec : scene.materials) model.materials.push_back(resolve_material(spec));
+  for (const auto& body : scene.bodies) {
+    model.body_names.push_back(body.name);
+    model.body_fixed.push_back(body.fixed);
+  }
+
+  // Gather every tet of every body with its body, piece and source position.
+  struct TetRecord {
+    std::int32_t body;
+    LocalIndex local;  // index within its body mesh
+    std::int32_t piece;
+    std::uint64_t key;
+  };
+  std::vector<TetRecord> records;
+  std::vector<LocalIndex> node_offset(meshes.size() + 1, 0);
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (std::size_t b = 0; b < meshes.size(); ++b) {
+    const BodyMesh& mesh = meshes[b];
+    const LocalIndex n_nodes = static_cast<LocalIndex>(mesh.coords.size() / 3);
+    node_offset[b + 1] = node_offset[b] + n_nodes;
+    for (LocalIndex i = 0; i < n_nodes; ++i) {
+      lo = lo.cwiseMin(vec3_at(mesh.coords.data(), i));
+      hi = hi.cwiseMax(vec3_at(mesh.coords.data(), i));
+    }
+    std::int32_t n_pieces = 0;
+    const auto piece = connected_pieces(mesh.tets, n_nodes, &n_pieces);
+    const std::int32_t piece_base = static_cast<std::int32_t>(model.pieces.size());
+    for (std::int32_t p = 0; p < n_pieces; ++p)
+      model.pieces.push_back({static_cast<std::int32_t>(b), p});
+    const LocalIndex n_tets = static_cast<LocalIndex>(mesh.tets.size() / 4);
+    for (LocalIndex t = 0; t < n_tets; ++t) {
+      Vec3 X[4];
+      for (int c = 0; c < 4; ++c) X[c] = vec3_at(mesh.coords.data(), mesh.tets[4 * t + c]);
+      const double volume = tet_reference(X).volume;
+      const double scale = std::pow(std::max(smallest_altitude(X), 1e-300), 3.0);
+      if (!(volume > 1e-12 * scale) || !std::isfinite(volume)) {
+        std::ostringstream msg;
+        msg << "body '" << scene.bodies[b].name << "' (" << mesh.source << "): tetrahedron "
+            << (mesh.source_tags.empty() ? t + 1 : mesh.source_tags[t])
+            << (volume < 0 ? " is inverted (negative volume " : " is degenerate (volume ") << volume
+            << " m^3). Fix the mesh: nodes of a 4-node tetrahedron must be ordered so that "
+               "(x1-x0)x(x2-x0).(x3-x0) > 0, as Gmsh writes them.";
+        throw InputError(msg.str());
+      }
+      records.push_back({static_cast<std::int32_t>(b), t, piece_base + piece[t], 0});
+    }
+  }
+  if (records.empty()) throw InputError(scene.source_path + ": the scene has no tetrahedra");
+
+  // Element order: Morton keys of centroids give spatial locality in memory.
+  if (order == ElementOrder::space_filling_curve) {
+    for (auto& r : records) {
+      const BodyMesh& mesh = meshes[r.body];
+      Vec3 c = Vec3::Zero();
+      for (int k = 0; k < 4; ++k) c += vec3_at(mesh.coords.data(), mesh.tets[4 * r.local + k]);
+      r.key = morton_key(0.25 * c, lo, hi);
+    }
+    std::stable_sort(records.begin(), records.end(),
+                     [](const TetRecord& a, const TetRecord& b) { return a.key < b.key; });
+  }
+
+  // Nodes get their ids in order of first use by the ordered tets.
+  const LocalIndex n_all_nodes = node_offset.back();
+  std::vector<LocalIndex> new_node(n_all_nodes, -1);
+  LocalIndex n_nodes = 0;
+  for (const auto& r : records)
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex old = node_offset[r.body] + meshes[r.body].tets[4 * r.local + c];
+      if (new_node[old] < 0) new_node[old] = n_nodes++;
+    }
+
+  NodeArrays& nodes = model.nodes;
+  nodes.resize(n_nodes);
+  nodes.n_owned = n_nodes;
+  std::fill(nodes.v.begin(), nodes.v.end(), 0.0);
+  std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
+  std::fill(nodes.mass.begin(), nodes.mass.end(), 0.0);
+  std::fill(nodes.constrained.begin(), nodes.constrained.end(), 0);
+  std::fill(nodes.prescribed_velocity.begin(), nodes.prescribed_velocity.end(), 0.0);
+  for (std::size_t b = 0; b < meshes.size(); ++b) {
+    const LocalIndex n_body_nodes = node_offset[b + 1] - node_offset[b];
+    for (LocalIndex i = 0; i < n_body_nodes; ++i) {
+      const LocalIndex n = new_node[node_offset[b] + i];
+      if (n < 0) continue;  // node used by no tet
+      for (int k = 0; k < 3; ++k) nodes.x0[3 * n + k] = meshes[b].coords[3 * i + k];
+    }
+  }
+  nodes.x = nodes.x0;
+  for (LocalIndex n = 0; n < n_nodes; ++n) nodes.gid[n] = n;
+
+  TetArrays& tets = model.tets;
+  const LocalIndex n_tets = static_cast<LocalIndex>(records.size());
+  tets.resize(n_tets);
+  tets.n_owned = n_tets;
+  for (LocalIndex t = 0; t < n_tets; ++t) {
+    const TetRecord& r = records[t];
+    const BodySpec& body = scene.bodies[r.body];
+    const MaterialProperties& mat = model.materials[body.material];
+    tets.gid[t] = t;
+    tets.material[t] = body.material;
+    tets.piece[t] = r.piece;
+    Vec3 X[4];
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = new_node[node_offset[r.body] + meshes[r.body].tets[4 * r.local + c]];
+      tets.nodes[4 * t + c] = n;
+      X[c] = vec3_at(nodes.x0.data(), n);
+      nodes.piece[n] = r.piece;
+    }
+    const TetReference ref = tet_reference(X);
+    Eigen::Map<Mat3>(tets.dm_inv.data() + 9 * t) = ref.dm_inv;
+    tets.volume0[t] = ref.volume;
+    const double element_mass = mat.density * ref.volume;
+    for (int c = 0; c < 4; ++c) nodes.mass[tets.nodes[4 * t + c]] += 0.25 * element_mass;
+    // Viscosity that gives damping ratio ξ in the element's highest mode: η = 2ξμ/ω_max.
+    if (mat.damping_ratio > 0.0) {
+      const double k_max = tet_max_stiffness_eigenvalue(ref.dm_inv, ref.volume, mat.lame);
+      const double omega = std::sqrt(k_max / (0.25 * element_mass));
+      tets.viscosity[t] = 2.0 * mat.damping_ratio * mat.lame.mu / omega;
+    } else {
+      tets.viscosity[t] = 0.0;
+    }
+    PieceInfo& piece = model.pieces[r.piece];
+    piece.mass += element_mass;
+    piece.centroid0 += element_mass * 0.25 * (X[0] + X[1] + X[2] + X[3]);
+  }
+  for (auto& piece : model.pieces)
+    if (piece.mass > 0.0) piece.centroid0 /= piece.mass;
+
+  // Initial velocity: translation plus rotation about each piece's own centroid.
+  for (LocalIndex n = 0; n < n_nodes; ++n) {
+    const PieceInfo& piece = model.pieces[nodes.piece[n]];
+    const BodySpec& body = scene.bodies[piece.body];
+    const Vec3 r = vec3_at(nodes.x0.data(), n) - piece.centroid0;
+    vec3_at(nodes.v.data(), n) = body.velocity + body.angular_velocity.cross(r);
+  }
+
+  build_node_corner_map(tets, n_nodes, model.node_corners);
+  apply_constraints(scene, model);
+  return model;
+}
+
+void apply_constraints(const Scene& scene, Model& model) {
+  NodeArrays& nodes = model.nodes;
+  for (LocalIndex n = 0; n < nodes.size(); ++n) {
+    const std::int32_t body = model.pieces[nodes.piece[n]].body;
+    if (scene.bodies[body].fixed) {
+      nodes.constrained[n] = 7;
+      vec3_at(nodes.prescribed_velocity.data(), n).setZero();
+      vec3_at(nodes.v.data(), n).setZero();
+    }
+  }
+  for (const LoadSpec& load : scene.loads) {
+    for (LocalIndex n = 0; n < nodes.size(); ++n) {
+      bool applies = false;
+      if (load.region) {
+        const Vec3 X = vec3_at(nodes.x0.data(), n);
+        applies = (X.array() >= load.region->min.array()).all() &&
+                  (X.array() <= load.region->max.array()).all();
+      } else {
+        const std::int32_t body = model.pieces[nodes.piece[n]].body;
+        applies = std::find(load.bodies.begin(), load.bodies.end(), body) != load.bodies.end();
+      }
+      if (!applies) continue;
+      nodes.constrained[n] |= static_cast<std::uint8_t>(load.dof_mask);
+      for (int k = 0; k < 3; ++k)
+        if (load.dof_mask & (1u << k)) {
+          nodes.prescribed_velocity[3 * n + k] = load.velocity[k];
+          nodes.v[3 * n + k] = load.velocity[k];
+        }
+    }
+  }
+}
+
+}  // namespace fdem

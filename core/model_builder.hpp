@@ -1,0 +1,37 @@
+// Turns a validated Scene plus one tetrahedral mesh per body into the run-time Model:
+// connected pieces, space-filling-curve element order, global ids, lumped masses, reference
+// shapes, initial velocities and kinematic constraints.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/model.hpp"
+#include "core/scene.hpp"
+
+namespace fdem {
+
+// A body's mesh before it joins the model.
+struct BodyMesh {
+  std::vector<double> coords;             // 3 per node (m)
+  std::vector<LocalIndex> tets;           // 4 per tet, 0-based
+  std::vector<std::int64_t> source_tags;  // element tag in the source file (for messages), or empty
+  std::string source;                     // "box generator", a file name, ...
+};
+
+// Connected pieces of a tet mesh (tets sharing a node belong together): piece index per tet.
+std::vector<std::int32_t> connected_pieces(const std::vector<LocalIndex>& tets, LocalIndex n_nodes,
+                                           std::int32_t* n_pieces);
+
+// 63-bit Morton key of a point inside the box [lo, hi] (21 bits per axis).
+std::uint64_t morton_key(const Vec3& p, const Vec3& lo, const Vec3& hi);
+
+enum class ElementOrder { space_filling_curve, as_given };
+
+Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes,
+                  ElementOrder order = ElementOrder::space_filling_curve);
+
+// Applies fixed bodies and kinematic loads to the nodes' constraint masks.
+void apply_constraints(const Scene& scene, Model& model);
+
+}  // namespace fdem

@@ -1,0 +1,136 @@
+// Pure per-tetrahedron kernels: reference shape, deformation gradient, internal force, stability.
+// Constant-strain 4-node tetrahedron, total Lagrangian: F = Ds·Dm⁻¹ with Ds = [x1−x0, x2−x0,
+// x3−x0].
+#pragma once
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "core/materials.hpp"
+#include "core/types.hpp"
+
+namespace fdem {
+
+struct TetReference {
+  Mat3 dm_inv;    // inverse of the reference edge matrix Dm (1/m)
+  double volume;  // signed reference volume (m^3); ≤ 0 means inverted or degenerate
+};
+
+inline Mat3 edge_matrix(const Vec3 (&x)[4]) {
+  Mat3 d;
+  d.col(0) = x[1] - x[0];
+  d.col(1) = x[2] - x[0];
+  d.col(2) = x[3] - x[0];
+  return d;
+}
+
+inline TetReference tet_reference(const Vec3 (&X)[4]) {
+  const Mat3 dm = edge_matrix(X);
+  const double det = dm.determinant();
+  TetReference ref;
+  ref.volume = det / 6.0;
+  ref.dm_inv = det != 0.0 ? Mat3(dm.inverse()) : Mat3::Zero();
+  return ref;
+}
+
+// Gradients of the four linear shape functions in the reference configuration (1/m), as columns.
+inline Eigen::Matrix<double, 3, 4> shape_gradients(const Mat3& dm_inv) {
+  Eigen::Matrix<double, 3, 4> g;
+  g.rightCols<3>() = dm_inv.transpose();
+  g.col(0) = -g.col(1) - g.col(2) - g.col(3);
+  return g;
+}
+
+// Smallest altitude 3V/A_max of a tetrahedron (m): its characteristic size for stability and
+// penalties.
+inline double smallest_altitude(const Vec3 (&x)[4]) {
+  const double volume = std::abs(edge_matrix(x).determinant()) / 6.0;
+  double max_area = 0.0;
+  for (int skip = 0; skip < 4; ++skip) {
+    const Vec3& a = x[(skip + 1) % 4];
+    const Vec3& b = x[(skip + 2) % 4];
+    const Vec3& c = x[(skip + 3) % 4];
+    max_area = std::max(max_area, 0.5 * (b - a).cross(c - a).norm());
+  }
+  return max_area > 0.0 ? 3.0 * volume / max_area : 0.0;
+}
+
+struct TetForce {
+  Vec3 force[4];         // internal (elastic + viscous) force on each corner (N)
+  double strain_energy;  // W(F)·V0 (J)
+  double damping_power;  // viscous dissipation rate V0·P_v:Ḟ (W), ≥ 0
+  double jacobian;       // det F; ≤ 0 means the element inverted (forces not computed)
+};
+
+// Internal force of one tetrahedron.  x, v: current corner positions (m) and velocities (m/s);
+// viscosity η (Pa·s) adds the viscous Cauchy stress 2η·sym(ḞF⁻¹).
+template <class Material>
+inline TetForce tet_internal_force(const Vec3 (&x)[4], const Vec3 (&v)[4], const Mat3& dm_inv,
+                                   double volume0, const Material& material, double viscosity) {
+  TetForce out;
+  const Mat3 F = edge_matrix(x) * dm_inv;
+  out.jacobian = F.determinant();
+  if (!(out.jacobian > 0.0)) {  // also catches NaN
+    for (auto& f : out.force) f.setZero();
+    out.strain_energy = 0.0;
+    out.damping_power = 0.0;
+    return out;
+  }
+  Mat3 P = material.first_piola(F);
+  out.strain_energy = material.energy_density(F) * volume0;
+  out.damping_power = 0.0;
+  if (viscosity > 0.0) {
+    const Mat3 F_dot = edge_matrix(v) * dm_inv;
+    const Mat3 F_inv = F.inverse();
+    const Mat3 L = F_dot * F_inv;
+    const Mat3 sigma_v = viscosity * (L + L.transpose());
+    const Mat3 P_v = out.jacobian * sigma_v * F_inv.transpose();
+    P += P_v;
+    out.damping_power = volume0 * (P_v.cwiseProduct(F_dot)).sum();
+  }
+  const Mat3 H = -volume0 * P * dm_inv.transpose();
+  out.force[1] = H.col(0);
+  out.force[2] = H.col(1);
+  out.force[3] = H.col(2);
+  out.force[0] = -(out.force[1] + out.force[2] + out.force[3]);
+  return out;
+}
+
+// Largest eigenvalue (N/m) of the small-strain stiffness K = V·BᵀCB of an isotropic tet, from the
+// 6×6 matrix V·LᵀBBᵀL (C = LLᵀ) that has the same non-zero spectrum.
+inline double tet_max_stiffness_eigenvalue(const Mat3& dm_inv, double volume, LameParameters lame) {
+  const Eigen::Matrix<double, 3, 4> g = shape_gradients(dm_inv);
+  Eigen::Matrix<double, 6, 12> B =
+      Eigen::Matrix<double, 6, 12>::Zero();  // Voigt, engineering shear
+  for (int a = 0; a < 4; ++a) {
+    const double gx = g(0, a), gy = g(1, a), gz = g(2, a);
+    B(0, 3 * a + 0) = gx;
+    B(1, 3 * a + 1) = gy;
+    B(2, 3 * a + 2) = gz;
+    B(3, 3 * a + 1) = gz;
+    B(3, 3 * a + 2) = gy;
+    B(4, 3 * a + 0) = gz;
+    B(4, 3 * a + 2) = gx;
+    B(5, 3 * a + 0) = gy;
+    B(5, 3 * a + 1) = gx;
+  }
+  Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
+  C.topLeftCorner<3, 3>().setConstant(lame.lambda);
+  C.topLeftCorner<3, 3>().diagonal().setConstant(lame.lambda + 2.0 * lame.mu);
+  C.bottomRightCorner<3, 3>().diagonal().setConstant(lame.mu);
+  const Eigen::Matrix<double, 6, 6> L = Eigen::LLT<Eigen::Matrix<double, 6, 6>>(C).matrixL();
+  const Eigen::Matrix<double, 6, 6> A = std::abs(volume) * L.transpose() * B * B.transpose() * L;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(A, Eigen::EigenvaluesOnly);
+  return eig.eigenvalues().maxCoeff();
+}
+
+// Critical central-difference step (s) of one tet with lumped mass ρV/4 per node.  The element
+// eigenvalue theorem makes the smallest element value a safe bound for the assembled mesh.
+// damping_ratio ξ is the fraction of critical damping of the element's highest mode.
+inline double tet_critical_time_step(double max_stiffness_eigenvalue, double density, double volume,
+                                     double damping_ratio) {
+  const double omega = std::sqrt(max_stiffness_eigenvalue / (density * std::abs(volume) / 4.0));
+  return 2.0 / omega * (std::sqrt(1.0 + damping_ratio * damping_ratio) - damping_ratio);
+}
+
+}  // namespace fdem

@@ -1,0 +1,129 @@
+// The `fdem` command: run | check | --version (see docs/scene-format.md and README.md).
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "drivers/simulation.hpp"
+#include "io/scene_reader.hpp"
+
+namespace {
+
+const char* usage =
+    "usage:\n"
+    "  fdem run SCENE.yaml [-o OUTDIR] [--set key.path=value ...] [-q]\n"
+    "  fdem check SCENE.yaml [--set key.path=value ...]\n"
+    "  fdem --version\n";
+
+int check(const fdem::Scene& scene) {
+  auto sim = fdem::make_simulation(scene, {});
+  const fdem::Model& model = sim->model();
+  std::printf("scene '%s' (%s)\n", scene.name.c_str(), scene.source_path.c_str());
+  std::printf("  materials: %zu\n", scene.materials.size());
+  for (const auto& m : scene.materials)
+    std::printf(
+        "    %-16s density %g kg/m^3, E %g Pa, nu %g, %s%s\n", m.name.c_str(), m.density,
+        m.elastic.young, m.elastic.poisson,
+        m.elastic.model == fdem::ElasticModel::neo_hookean ? "neo-hookean" : "st-venant-kirchhoff",
+        m.damping > 0 ? (", damping ratio " + std::to_string(m.damping)).c_str() : "");
+  std::vector<int> pieces_per_body(scene.bodies.size(), 0);
+  for (const auto& p : model.pieces) ++pieces_per_body[p.body];
+  std::printf("  bodies: %zu\n", scene.bodies.size());
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+    std::printf("    %-16s %d discrete element(s), material %s%s\n", scene.bodies[b].name.c_str(),
+                pieces_per_body[b], scene.materials[scene.bodies[b].material].name.c_str(),
+                scene.bodies[b].fixed ? ", fixed" : "");
+  std::printf("  mesh: %d nodes, %d tetrahedra, %zu discrete elements\n", model.nodes.size(),
+              model.tets.size(), model.pieces.size());
+  std::printf("  time: end %g s, step %g s (%s; critical %g s), %ld steps\n", scene.time.end,
+              sim->time_step(), scene.time.auto_step ? "auto" : "fixed", sim->critical_time_step(),
+              static_cast<long>(scene.time.end / sim->time_step() + 0.999999));
+  std::printf("  stages:\n");
+  for (const auto& s : sim->plan().describe()) std::printf("    %s\n", s.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    std::fputs(usage, stderr);
+    return 2;
+  }
+  if (args[0] == "--version" || args[0] == "version") {
+    std::printf("fdem %s\n", FDEM_VERSION);
+    return 0;
+  }
+  if (args[0] == "--help" || args[0] == "-h") {
+    std::fputs(usage, stdout);
+    return 0;
+  }
+  const std::string command = args[0];
+  if (command != "run" && command != "check") {
+    std::fprintf(stderr, "fdem: unknown command '%s'\n%s", command.c_str(), usage);
+    return 2;
+  }
+  std::string scene_path;
+  fdem::RunOptions options;
+  std::vector<std::string> overrides;
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&](const char* flag) -> std::string {
+      if (i + 1 >= args.size()) {
+        std::fprintf(stderr, "fdem: %s needs a value\n%s", flag, usage);
+        std::exit(2);
+      }
+      return args[++i];
+    };
+    if (a == "-o" || a == "--output")
+      options.output_dir = value("-o");
+    else if (a == "--set")
+      overrides.push_back(value("--set"));
+    else if (a.rfind("--set=", 0) == 0)
+      overrides.push_back(a.substr(6));
+    else if (a == "-q" || a == "--quiet")
+      options.quiet = true;
+    else if (a == "--restart") {
+      std::fprintf(stderr,
+                   "fdem: --restart: checkpoint/restart is not part of this version of fdem\n");
+      return 2;
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "fdem: unknown option '%s'\n%s", a.c_str(), usage);
+      return 2;
+    } else if (scene_path.empty())
+      scene_path = a;
+    else {
+      std::fprintf(stderr, "fdem: unexpected argument '%s' (one scene per run)\n%s", a.c_str(),
+                   usage);
+      return 2;
+    }
+  }
+  if (scene_path.empty()) {
+    std::fprintf(stderr, "fdem: %s needs a scene file\n%s", command.c_str(), usage);
+    return 2;
+  }
+  try {
+    const fdem::Scene scene = fdem::read_scene(scene_path, overrides);
+    if (command == "check") return check(scene);
+    auto sim = fdem::make_simulation(scene, options);
+    const fdem::RunReport report = sim->run();
+    if (report.status != "completed") {
+      std::fprintf(stderr, "fdem: %s\nThe last good frame and summary.json are in %s.\n",
+                   report.reason.c_str(), options.output_dir.c_str());
+      return 3;
+    }
+    if (!options.quiet)
+      std::fprintf(stderr, "results in %s (open frames.pvd in ParaView)\n",
+                   options.output_dir.c_str());
+    return 0;
+  } catch (const fdem::InputError& e) {
+    std::fprintf(stderr, "fdem: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fdem: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,121 @@
+#include "drivers/run_files.hpp"
+
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+
+#include "core/dynamics.hpp"
+#include "drivers/simulation.hpp"
+
+namespace fdem {
+
+namespace {
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\')
+      out += '\\', out += c;
+    else if (c == '\n')
+      out += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20)
+      out += ' ';
+    else
+      out += c;
+  }
+  return out;
+}
+}  // namespace
+
+RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>& fields)
+    : directory_(directory),
+      fields_(fields),
+      frames_((std::filesystem::create_directories(directory), directory), "frames") {
+  energy_.open(std::filesystem::path(directory) / "energy.csv");
+  energy_ << "time,kinetic,strain,gravity,contact,joint,dissipated_fracture,dissipated_friction,"
+             "dissipated_damping,external_work,total,balance_error\n";
+  bodies_.open(std::filesystem::path(directory) / "bodies.csv");
+  bodies_ << "time,body,piece,mass,x,y,z,vx,vy,vz,rx,ry,rz\n";
+  energy_ << std::setprecision(12);
+  bodies_ << std::setprecision(12);
+  if (!energy_ || !bodies_)
+    throw std::runtime_error("cannot write into output directory " + directory);
+}
+
+void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balance_error) {
+  energy_ << time << ',' << e.kinetic << ',' << e.strain << ',' << e.gravity << ',' << e.contact
+          << ',' << e.joint << ',' << e.dissipated_fracture << ',' << e.dissipated_friction << ','
+          << e.dissipated_damping << ',' << e.external_work << ',' << e.total() << ','
+          << balance_error << '\n';
+  energy_.flush();
+}
+
+void RunFiles::write_bodies_rows(double time, const Model& model) {
+  const auto motion = piece_motions(model);
+  for (std::size_t p = 0; p < model.pieces.size(); ++p) {
+    const PieceInfo& piece = model.pieces[p];
+    const PieceMotion& m = motion[p];
+    bodies_ << time << ',' << model.body_names[piece.body] << ',' << piece.index_in_body << ','
+            << piece.mass << ',' << m.centroid.x() << ',' << m.centroid.y() << ',' << m.centroid.z()
+            << ',' << m.velocity.x() << ',' << m.velocity.y() << ',' << m.velocity.z() << ','
+            << m.rotation.x() << ',' << m.rotation.y() << ',' << m.rotation.z() << '\n';
+  }
+  bodies_.flush();
+}
+
+void RunFiles::write_frame(double time, const Model& model, const std::vector<FrameField>& extra) {
+  const std::string relative = frames_.next_frame_path() + ".vtu";
+  write_tet_frame((std::filesystem::path(directory_) / relative).string(), model, fields_, extra);
+  frames_.add_frame(time, relative);
+}
+
+std::string summary_json(const RunReport& r, const Model& model, const std::string& scene_name) {
+  std::ostringstream j;
+  j << std::setprecision(15);
+  j << "{\n";
+  j << "  \"scene\": \"" << json_escape(scene_name) << "\",\n";
+  j << "  \"status\": \"" << r.status << "\",\n";
+  if (!r.reason.empty()) j << "  \"reason\": \"" << json_escape(r.reason) << "\",\n";
+  j << "  \"ranks\": 1,\n";
+  j << "  \"steps\": " << r.steps << ",\n";
+  j << "  \"end_time\": " << r.time << ",\n";
+  j << "  \"time_step\": " << r.time_step << ",\n";
+  j << "  \"critical_time_step\": " << r.critical_time_step << ",\n";
+  j << "  \"wall_seconds\": " << r.wall_seconds << ",\n";
+  j << "  \"nodes\": " << model.nodes.size() << ",\n";
+  j << "  \"elements\": " << model.tets.size() << ",\n";
+  j << "  \"pieces\": " << model.pieces.size() << ",\n";
+  j << "  \"joints\": 0,\n";
+  j << "  \"broken_joints\": 0,\n";
+  j << "  \"stages\": {";
+  bool first = true;
+  for (const auto& s : r.stages) {
+    if (s.calls == 0) continue;
+    j << (first ? "\n" : ",\n") << "    \"" << s.name << "\": {\"seconds\": " << s.seconds
+      << ", \"calls\": " << s.calls << "}";
+    first = false;
+  }
+  j << "\n  },\n";
+  const double element_steps =
+      static_cast<double>(model.tets.size()) * static_cast<double>(r.steps);
+  j << "  \"throughput\": {\"element_steps_per_second\": "
+    << (r.wall_seconds > 0 ? element_steps / r.wall_seconds : 0.0) << "},\n";
+  const EnergyTerms& e = r.energy;
+  j << "  \"energy\": {\"kinetic\": " << e.kinetic << ", \"strain\": " << e.strain
+    << ", \"gravity\": " << e.gravity << ", \"contact\": " << e.contact
+    << ", \"joint\": " << e.joint << ", \"dissipated_fracture\": " << e.dissipated_fracture
+    << ", \"dissipated_friction\": " << e.dissipated_friction
+    << ", \"dissipated_damping\": " << e.dissipated_damping
+    << ", \"external_work\": " << e.external_work << ", \"balance_error\": " << r.balance_error
+    << "},\n";
+  j << "  \"state_hash\": \"" << r.state_hash << "\"\n";
+  j << "}\n";
+  return j.str();
+}
+
+void RunFiles::write_summary(const RunReport& report, const Model& model,
+                             const std::string& scene_name) {
+  write_file_atomically((std::filesystem::path(directory_) / "summary.json").string(),
+                        summary_json(report, model, scene_name));
+}
+
+}  // namespace fdem

@@ -1,0 +1,39 @@
+// The files of an output directory: energy.csv, bodies.csv, frames.pvd (+ frames/*.vtu) and
+// summary.json.  CSV rows are flushed as they are written so a failed run keeps its history.
+#pragma once
+
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/energy.hpp"
+#include "core/model.hpp"
+#include "io/vtk_output.hpp"
+
+namespace fdem {
+
+struct RunReport;
+struct StagePlan;
+
+class RunFiles {
+ public:
+  RunFiles(const std::string& directory, const std::vector<std::string>& fields);
+  void write_energy_row(double time, const EnergyTerms& e, double balance_error);
+  void write_bodies_rows(double time, const Model& model);
+  void write_frame(double time, const Model& model, const std::vector<FrameField>& extra = {});
+  void write_summary(const RunReport& report, const Model& model, const std::string& scene_name);
+  const std::string& directory() const { return directory_; }
+
+ private:
+  std::string directory_;
+  std::vector<std::string> fields_;
+  std::ofstream energy_, bodies_;
+  SeriesWriter frames_;
+};
+
+// JSON text of the run summary (also used by `fdem check --json` and tests).
+std::string summary_json(const RunReport& report, const Model& model,
+                         const std::string& scene_name);
+
+}  // namespace fdem

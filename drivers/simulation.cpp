@@ -1,0 +1,252 @@
+#include "drivers/simulation.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "core/dynamics.hpp"
+#include "core/error.hpp"
+#include "core/model_builder.hpp"
+#include "core/state_hash.hpp"
+#include "core/time_step.hpp"
+#include "drivers/mesh_generators.hpp"
+#include "drivers/run_files.hpp"
+
+namespace fdem {
+
+namespace {
+
+class Timed {
+ public:
+  explicit Timed(StageClock& clock) : clock_(clock), start_(std::chrono::steady_clock::now()) {}
+  ~Timed() {
+    clock_.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    ++clock_.calls;
+  }
+
+ private:
+  StageClock& clock_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// A run whose energy balance error exceeds this has blown up (well-resolved runs stay below 1 %).
+constexpr double runaway_balance_error = 0.2;
+
+}  // namespace
+
+std::vector<std::string> StagePlan::describe() const {
+  std::vector<std::string> s;
+  s.push_back("internal forces (tetrahedra)");
+  s.push_back(joints ? "joint forces + fracture" : "joint forces: skipped (no joints)");
+  s.push_back(contact ? "contact detection + contact forces"
+                      : "contact: skipped (no contact partners)");
+  s.push_back(std::string("external forces: ") + (gravity ? "gravity" : "none") +
+              (kinematic_loads ? " + prescribed velocities" : ""));
+  s.push_back("integrate (central difference)");
+  return s;
+}
+
+Simulation::Simulation(Scene scene, Model model, RunOptions options)
+    : scene_(std::move(scene)), model_(std::move(model)), options_(std::move(options)) {
+  const char* names[n_stages] = {"internal_forces",   "joint_forces",   "fracture",
+                                 "contact_detection", "contact_forces", "external_forces",
+                                 "integrate",         "halo_update",    "output"};
+  for (int s = 0; s < n_stages; ++s) clocks_[s].name = names[s];
+  plan_.gravity = scene_.gravity.squaredNorm() > 0.0;
+  plan_.kinematic_loads = !scene_.loads.empty();
+
+  const CriticalStep critical = fdem::critical_time_step(model_);
+  dt_critical_ = critical.dt;
+  dt_ = scene_.time.auto_step ? scene_.time.safety * critical.dt : scene_.time.step;
+  if (!std::isfinite(dt_) || dt_ <= 0.0)
+    throw InputError(scene_.source_path + ": could not determine a time step (critical step " +
+                     std::to_string(critical.dt) + " s)");
+}
+
+Simulation::~Simulation() = default;
+
+// ---------------------------------------------------------------------------------------------
+// One time step: the whole physics order in one place.
+// ---------------------------------------------------------------------------------------------
+void Simulation::step() {
+  NodeArrays& nodes = model_.nodes;
+  EnergyTerms energy;
+
+  // 1 internal forces: F = Ds·Dm⁻¹, stress, corner forces gathered per node in tet-gid order
+  InternalForceSummary forces;
+  {
+    Timed timed(clocks_[internal]);
+    forces = compute_internal_forces(model_, corner_forces_);
+    gather_corner_forces(model_.node_corners, corner_forces_, nodes.f);
+  }
+  energy.strain = forces.strain_energy;
+
+  // 2–3 joint forces and fracture, 4–5 contact detection and forces: run when the plan needs them
+  // (no stage of this kind is active in a scene without joints or contact partners).
+
+  // 6 external forces
+  if (plan_.gravity) {
+    Timed timed(clocks_[external]);
+    add_gravity(model_.gravity, nodes);
+    energy.gravity = gravity_potential(model_.gravity, nodes);
+  }
+
+  // 7 integrate: central difference with prescribed velocities
+  IntegrationSummary motion;
+  {
+    Timed timed(clocks_[integrate]);
+    motion = integrate_central_difference(dt_, nodes);
+  }
+
+  // 8 halo update: nothing to exchange on one rank.
+
+  // Energy balance at t_n
+  energy.kinetic = motion.kinetic_energy;
+  energy.dissipated_damping = ledger_.damping.add(forces.damping_power * dt_);
+  energy.external_work = ledger_.external.add(motion.constraint_work);
+  ledger_.record(energy);
+  check_state(forces, motion.finite);
+
+  time_ += dt_;
+  ++steps_;
+}
+
+void Simulation::check_state(const InternalForceSummary& forces, bool velocities_finite) const {
+  std::ostringstream advice;
+  const double ratio = dt_ / dt_critical_;
+  advice << " The time step is " << dt_ << " s = " << ratio << " x the critical step "
+         << dt_critical_ << " s";
+  if (!scene_.time.auto_step && ratio > 1.0)
+    advice << ": it is above the stability limit; use time.step: auto or a step below "
+           << dt_critical_ << " s.";
+  else
+    advice << ". Try a smaller time.safety (e.g. " << std::min(0.5, 0.5 * scene_.time.safety)
+           << "), check for very distorted elements, or slow down prescribed velocities.";
+  if (!(forces.min_jacobian > 0.0)) {
+    const LocalIndex t = forces.min_jacobian_tet;
+    const PieceInfo& piece = model_.pieces[model_.tets.piece[t]];
+    std::ostringstream msg;
+    msg << "numerical failure at step " << steps_ << " (t = " << time_ << " s): tetrahedron "
+        << model_.tets.gid[t] << " of body '" << model_.body_names[piece.body] << "' (piece "
+        << piece.index_in_body << ") "
+        << (std::isnan(forces.min_jacobian) ? "has NaN coordinates" : "inverted")
+        << " (det F = " << forces.min_jacobian << ")." << advice.str();
+    throw NumericalFailure(msg.str());
+  }
+  if (!velocities_finite) {
+    std::ostringstream msg;
+    msg << "numerical failure at step " << steps_ << " (t = " << time_
+        << " s): velocities became NaN or infinite." << advice.str();
+    throw NumericalFailure(msg.str());
+  }
+  if (steps_ > 10 && ledger_.balance_error() > runaway_balance_error) {
+    std::ostringstream msg;
+    msg << "numerical failure at step " << steps_ << " (t = " << time_
+        << " s): the run is unstable — the energy "
+        << "balance error reached " << ledger_.balance_error() * 100 << " % (total energy "
+        << ledger_.current().total() << " J, initially " << ledger_.initial_total() << " J)."
+        << advice.str();
+    throw NumericalFailure(msg.str());
+  }
+}
+
+RunReport Simulation::report() const {
+  RunReport r;
+  r.steps = steps_;
+  r.time = time_;
+  r.time_step = dt_;
+  r.critical_time_step = dt_critical_;
+  r.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+  r.energy = ledger_.current();
+  r.balance_error = ledger_.balance_error();
+  r.state_hash = hash_to_hex(state_hash(model_.nodes));
+  for (const auto& c : clocks_) r.stages.push_back(c);
+  return r;
+}
+
+void Simulation::write_outputs(bool force) {
+  if (!files_) return;
+  Timed timed(clocks_[output]);
+  // Energy rows refer to t_n = time_ − dt (the state the ledger recorded).
+  const double energy_time = steps_ > 0 ? time_ - dt_ : 0.0;
+  const double energy_every =
+      scene_.output.energy_every > 0 ? scene_.output.energy_every : scene_.output.every;
+  if (steps_ > 0 && (force || energy_time >= next_energy_time_ - 1e-12 * dt_)) {
+    files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());
+    if (energy_every > 0)
+      while (next_energy_time_ <= energy_time + 1e-12 * dt_) next_energy_time_ += energy_every;
+    else
+      next_energy_time_ = scene_.time.end;
+  }
+  if (force || time_ >= next_frame_time_ - 1e-12 * dt_) {
+    files_->write_frame(time_, model_);
+    files_->write_bodies_rows(time_, model_);
+    if (scene_.output.every > 0)
+      while (next_frame_time_ <= time_ + 1e-12 * dt_) next_frame_time_ += scene_.output.every;
+    else
+      next_frame_time_ = scene_.time.end;
+  }
+}
+
+RunReport Simulation::run() {
+  wall_start_ = std::chrono::steady_clock::now();
+  if (options_.write_output)
+    files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields);
+  const long total_steps = static_cast<long>(std::ceil(scene_.time.end / dt_ - 1e-9));
+  RunReport result;
+  auto last_progress = wall_start_;
+  try {
+    write_outputs(true);
+    while (steps_ < total_steps) {
+      step();
+      write_outputs(steps_ == total_steps);
+      const auto now = std::chrono::steady_clock::now();
+      if (!options_.quiet && (std::chrono::duration<double>(now - last_progress).count() > 0.5 ||
+                              steps_ == total_steps)) {
+        last_progress = now;
+        const double wall = std::chrono::duration<double>(now - wall_start_).count();
+        const double rate = steps_ / std::max(wall, 1e-9);
+        std::fprintf(
+            stderr,
+            "\rstep %ld/%ld  t = %.4g s  %5.1f %%  %.3g steps/s  ETA %.1f s  energy error %.2e   ",
+            steps_, total_steps, time_, 100.0 * steps_ / total_steps, rate,
+            (total_steps - steps_) / std::max(rate, 1e-9), ledger_.balance_error());
+        if (steps_ == total_steps) std::fprintf(stderr, "\n");
+      }
+    }
+    result = report();
+    result.status = "completed";
+  } catch (const NumericalFailure& failure) {
+    if (!options_.quiet) std::fprintf(stderr, "\n");
+    result = report();
+    result.status = "failed";
+    result.reason = failure.what();
+  }
+  if (files_) files_->write_summary(result, model_, scene_.name);
+  if (!options_.quiet) {
+    std::fprintf(stderr, "\n%-20s %12s %10s %8s\n", "stage", "seconds", "calls", "share");
+    double total = 0.0;
+    for (const auto& c : result.stages) total += c.seconds;
+    for (const auto& c : result.stages)
+      if (c.calls > 0)
+        std::fprintf(stderr, "%-20s %12.4f %10ld %7.1f%%\n", c.name.c_str(), c.seconds, c.calls,
+                     total > 0 ? 100.0 * c.seconds / total : 0.0);
+    std::fprintf(
+        stderr, "wall %.3f s, %ld steps, %.3g element-steps/s, energy balance error %.2e\n",
+        result.wall_seconds, result.steps,
+        result.wall_seconds > 0 ? double(model_.tets.size()) * result.steps / result.wall_seconds
+                                : 0.0,
+        result.balance_error);
+  }
+  return result;
+}
+
+std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options) {
+  Model model = build_model(scene, load_body_meshes(scene));
+  return std::make_unique<Simulation>(scene, std::move(model), std::move(options));
+}
+
+}  // namespace fdem

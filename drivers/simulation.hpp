@@ -1,0 +1,113 @@
+// The engine's step loop.  Simulation::step() spells out the stage order of one time step; run()
+// adds output, progress and the end-of-run report around it.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/energy.hpp"
+#include "core/model.hpp"
+#include "core/scene.hpp"
+
+namespace fdem {
+
+class SeriesWriter;
+class RunFiles;
+
+struct RunOptions {
+  std::string output_dir = "out";
+  bool quiet = false;        // no progress line, no stage table
+  bool write_output = true;  // VTK frames and CSV/JSON files
+};
+
+// Which stages the scene needs; the loop runs only these.
+struct StagePlan {
+  bool internal_forces = true;
+  bool joints = false;
+  bool contact = false;
+  bool gravity = false;
+  bool kinematic_loads = false;
+  std::vector<std::string> describe() const;
+};
+
+struct StageClock {
+  std::string name;
+  double seconds = 0.0;
+  long calls = 0;
+};
+
+struct RunReport {
+  std::string status = "running";  // completed | failed
+  std::string reason;              // message when failed
+  long steps = 0;
+  double time = 0.0;                // simulated time reached (s)
+  double time_step = 0.0;           // s
+  double critical_time_step = 0.0;  // s
+  double wall_seconds = 0.0;
+  EnergyTerms energy;
+  double balance_error = 0.0;
+  std::string state_hash;
+  std::vector<StageClock> stages;
+};
+
+class Simulation {
+ public:
+  Simulation(Scene scene, Model model, RunOptions options);
+  ~Simulation();
+
+  // Runs to scene.time.end (writing outputs); never throws NumericalFailure: a failure is
+  // reported in the returned status and in summary.json.
+  RunReport run();
+
+  // One time step (stages 1–8).  Throws NumericalFailure on blow-up.
+  void step();
+
+  const Model& model() const { return model_; }
+  Model& model() { return model_; }
+  const Scene& scene() const { return scene_; }
+  const StagePlan& plan() const { return plan_; }
+  const EnergyLedger& energy() const { return ledger_; }
+  double time() const { return time_; }
+  long steps_done() const { return steps_; }
+  double time_step() const { return dt_; }
+  double critical_time_step() const { return dt_critical_; }
+  void set_time_step(double dt) { dt_ = dt; }
+  RunReport report() const;
+
+ private:
+  enum Stage {
+    internal,
+    joints,
+    fracture,
+    detection,
+    contact,
+    external,
+    integrate,
+    halo,
+    output,
+    n_stages
+  };
+  void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
+  void write_outputs(bool force);
+
+  Scene scene_;
+  Model model_;
+  RunOptions options_;
+  StagePlan plan_;
+  EnergyLedger ledger_;
+  std::vector<double> corner_forces_;
+  double time_ = 0.0;
+  long steps_ = 0;
+  double dt_ = 0.0, dt_critical_ = 0.0;
+  StageClock clocks_[n_stages];
+  std::chrono::steady_clock::time_point wall_start_;
+  double next_frame_time_ = 0.0, next_energy_time_ = 0.0;
+  std::unique_ptr<RunFiles> files_;
+};
+
+// Builds a Simulation from a scene file (meshes loaded or generated).
+std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options);
+
+}  // namespace fdem
