@@ -253,8 +253,12 @@ class MshCursor {
   void check_count(std::int64_t count, std::size_t min_bytes, const std::string& what) {
     const std::size_t bytes_each = binary ? min_bytes : 2;  // ASCII: a digit and a separator
     if (count > 0 && static_cast<std::uint64_t>(count) > remaining() / bytes_each) {
-      fail_truncated(data_.size(), std::to_string(count) + " " + what + " (the header announces " +
-                                       std::to_string(count) + " but the file ends before)");
+      fail_at(data_.size(), "unexpected end of file: " + std::to_string(count) + " " + what +
+                                " are announced, which need at least " +
+                                std::to_string(static_cast<std::uint64_t>(count) * bytes_each) +
+                                " bytes, but only " + std::to_string(remaining()) +
+                                " remain; the file is truncated (incomplete copy or interrupted "
+                                "export?), re-export it from Gmsh.");
     }
   }
 

@@ -13,6 +13,8 @@
 
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 std::string data_file(const std::string& name) {
   return std::string(FDEM_TEST_DATA) + "/gmsh/" + name;
 }
@@ -173,6 +175,27 @@ TEST_CASE("cube from Gmsh: filtering by physical volume", "[io][gmsh]") {
   CHECK(right_by_number.coords == right.coords);
 }
 
+TEST_CASE("coarse Brazilian disc: geometry of the Gmsh mesh", "[io][gmsh]") {
+  const fdem::GmshMesh mesh = fdem::read_gmsh(data_file("brazilian_disc_coarse.msh"), "disc");
+  CHECK(mesh.num_nodes() == 863);
+  CHECK(mesh.num_tets() == 3552);
+  CHECK(mesh.physical_names == std::map<std::string, int>{{"disc", 1}});
+  const double radius = 0.025, thickness = 0.025;  // m; axis along z, centred at the origin
+  for (std::size_t i = 0; i < mesh.num_nodes(); ++i) {
+    const double x = mesh.coords[3 * i], y = mesh.coords[3 * i + 1], z = mesh.coords[3 * i + 2];
+    CHECK(std::hypot(x, y) <= radius * (1 + 1e-12));
+    CHECK(std::abs(z) <= thickness / 2 * (1 + 1e-12));
+  }
+  // Gmsh orders tet nodes with positive volume; the faceted cylinder lies inside the true one and
+  // misses less than 1 % of its volume pi R^2 t at this size (3-5 mm facets on R = 25 mm).
+  std::size_t inverted = 0;
+  for (std::size_t t = 0; t < mesh.num_tets(); ++t) inverted += tet_volume(mesh, t) <= 0 ? 1 : 0;
+  CHECK(inverted == 0);
+  const double cylinder = kPi * radius * radius * thickness;
+  CHECK(total_volume(mesh) < cylinder);
+  CHECK(total_volume(mesh) > 0.99 * cylinder);
+}
+
 TEST_CASE("errors: missing file, directory, not a Gmsh file", "[io][gmsh][errors]") {
   const std::string missing = data_file("no_such_mesh.msh");
   std::string message = error_of(missing);
@@ -212,10 +235,11 @@ TEST_CASE("errors: truncated files name the line or the byte offset", "[io][gmsh
   CHECK(contains(message, "unexpected end of file while reading a node coordinate"));
   CHECK(contains(message, "truncated"));
 
-  // The file is cut after 12000 bytes, in the middle of a triangle block of $Elements.
+  // The file is cut after 7600 bytes, just after the $Elements header that announces 278 elements.
   message = error_of(data_file("cube_truncated_binary.msh"));
   CHECK(contains(message, "cube_truncated_binary.msh"));
-  CHECK(contains(message, "byte offset"));
+  CHECK(contains(message, "byte offset 7600"));
+  CHECK(contains(message, "278 elements are announced"));
   CHECK(contains(message, "(in $Elements)"));
   CHECK(contains(message, "truncated"));
 }
