@@ -95,10 +95,10 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
       if (mask & (1u << k)) {
         v_new = nodes.prescribed_velocity[i];
         const double reaction = m * (v_new - v_old) / dt - nodes.f[i];
-        out.constraint_work += reaction * dt * 0.5 * (v_old + v_new);
+        out.constraint_work_before += 0.5 * reaction * dt * v_old;
+        out.constraint_work_after += 0.5 * reaction * dt * v_new;
       }
-      const double v_mid = 0.5 * (v_old + v_new);
-      kinetic2 += m * v_mid * v_mid;
+      kinetic2 += m * v_old * v_new;
       nodes.v[i] = v_new;
       const double dx = dt * v_new;
       nodes.x[i] += dx;

@@ -30,8 +30,9 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes);
 double gravity_potential(const Vec3& gravity, const NodeArrays& nodes);
 
 struct IntegrationSummary {
-  double kinetic_energy = 0.0;   // J, with the full-step velocity ½(v⁻ + v⁺)
-  double constraint_work = 0.0;  // J, work of prescribed-velocity reactions over [n−½, n+½]
+  double kinetic_energy = 0.0;  // J, ½m·v⁻·v⁺ (the energy central difference conserves)
+  double constraint_work_before = 0.0;  // J, reactions at prescribed components · (x_n − x_n−1)/2
+  double constraint_work_after = 0.0;       // J, reactions · (x_n+1 − x_n)/2
   double max_displacement_increment = 0.0;  // m, largest |Δx| of a node this step
   bool finite = true;                       // false if any velocity became NaN or infinite
 };

@@ -26,13 +26,22 @@ struct EnergyTerms {
   }
 };
 
-// A work-like quantity accumulated with increments over [n−½, n+½].
-struct HalfStepAccumulator {
-  double through_previous = 0.0;  // sum of increments of steps < n
-  // Adds step n's increment and returns the value at t_n.
-  double add(double increment) {
-    const double at_n = through_previous + 0.5 * increment;
-    through_previous += increment;
+// Work of a force by the trapezoid rule, W(t_n) = Σ_k ½(F_k + F_k+1)·(x_k+1 − x_k).  Step n
+// supplies F_n·(x_n − x_n−1)/2 ("before") and F_n·(x_n+1 − x_n)/2 ("after"); with the kinetic
+// energy taken as ½m·v_n−½·v_n+½ this makes the central-difference balance exact for constant and
+// linear forces.
+struct WorkAccumulator {
+  double through_previous = 0.0;  // Σ_{k<n} (before_k + after_k)
+  double first_before = 0.0;
+  bool started = false;
+  // Adds step n's halves and returns the work done up to t_n.
+  double add(double before, double after) {
+    if (!started) {
+      first_before = before;
+      started = true;
+    }
+    const double at_n = through_previous + before - first_before;
+    through_previous += before + after;
     return at_n;
   }
 };
@@ -55,7 +64,7 @@ class EnergyLedger {
     return peak_scale_ > 0.0 ? std::abs(current_.total() - initial_total_) / peak_scale_ : 0.0;
   }
 
-  HalfStepAccumulator damping, friction, fracture, external;
+  WorkAccumulator damping, friction, fracture, external;
 
  private:
   EnergyTerms current_;

@@ -96,14 +96,17 @@ inline TetForce tet_internal_force(const Vec3 (&x)[4], const Vec3 (&v)[4], const
   return out;
 }
 
-// Largest eigenvalue (N/m) of the small-strain stiffness K = V·BᵀCB of an isotropic tet, from the
-// 6×6 matrix V·LᵀBBᵀL (C = LLᵀ) that has the same non-zero spectrum.
-inline double tet_max_stiffness_eigenvalue(const Mat3& dm_inv, double volume, LameParameters lame) {
+// Largest eigenvalue of M⁻¹K for one tet: K = V·BᵀCB (isotropic small-strain stiffness), M the
+// diagonal matrix of the masses given to its corners (kg; 1 each → eigenvalue of K in N/m).  Uses
+// the 6×6 matrix V·LᵀB'B'ᵀL (C = LLᵀ, B' = B·M^-1/2) that has the same non-zero spectrum.
+inline double tet_max_eigenvalue(const Mat3& dm_inv, double volume, LameParameters lame,
+                                 const double (&corner_mass)[4]) {
   const Eigen::Matrix<double, 3, 4> g = shape_gradients(dm_inv);
   Eigen::Matrix<double, 6, 12> B =
       Eigen::Matrix<double, 6, 12>::Zero();  // Voigt, engineering shear
   for (int a = 0; a < 4; ++a) {
-    const double gx = g(0, a), gy = g(1, a), gz = g(2, a);
+    const double s = 1.0 / std::sqrt(corner_mass[a]);
+    const double gx = s * g(0, a), gy = s * g(1, a), gz = s * g(2, a);
     B(0, 3 * a + 0) = gx;
     B(1, 3 * a + 1) = gy;
     B(2, 3 * a + 2) = gz;
@@ -124,13 +127,22 @@ inline double tet_max_stiffness_eigenvalue(const Mat3& dm_inv, double volume, La
   return eig.eigenvalues().maxCoeff();
 }
 
-// Critical central-difference step (s) of one tet with lumped mass ρV/4 per node.  The element
-// eigenvalue theorem makes the smallest element value a safe bound for the assembled mesh.
-// damping_ratio ξ is the fraction of critical damping of the element's highest mode.
+inline double tet_max_stiffness_eigenvalue(const Mat3& dm_inv, double volume, LameParameters lame) {
+  const double unit[4] = {1.0, 1.0, 1.0, 1.0};
+  return tet_max_eigenvalue(dm_inv, volume, lame, unit);
+}
+
+// Critical central-difference step (s) for a highest angular frequency ω (rad/s) with damping
+// ratio ξ of that mode: Δt = (2/ω)(√(1+ξ²) − ξ).
+inline double critical_step_for_frequency(double omega, double damping_ratio) {
+  return 2.0 / omega * (std::sqrt(1.0 + damping_ratio * damping_ratio) - damping_ratio);
+}
+
+// Critical step of one tet alone with lumped mass ρV/4 per node.
 inline double tet_critical_time_step(double max_stiffness_eigenvalue, double density, double volume,
                                      double damping_ratio) {
-  const double omega = std::sqrt(max_stiffness_eigenvalue / (density * std::abs(volume) / 4.0));
-  return 2.0 / omega * (std::sqrt(1.0 + damping_ratio * damping_ratio) - damping_ratio);
+  return critical_step_for_frequency(
+      std::sqrt(max_stiffness_eigenvalue / (density * std::abs(volume) / 4.0)), damping_ratio);
 }
 
 }  // namespace fdem

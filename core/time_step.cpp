@@ -9,19 +9,37 @@ namespace fdem {
 CriticalStep critical_time_step(const Model& model) {
   const TetArrays& tets = model.tets;
   const NodeArrays& nodes = model.nodes;
-  CriticalStep out;
-  out.dt = std::numeric_limits<double>::infinity();
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
+  const LocalIndex n_tets = tets.size();
+
+  // Pass 1: each tet's stiffness weight (its largest K eigenvalue, N/m) and the weight per node.
+  std::vector<double> weight(n_tets, 0.0), node_weight(nodes.size(), 0.0);
+  std::vector<Mat3> dm_inv(n_tets);
+  std::vector<double> volume(n_tets, 0.0);
+  for (LocalIndex t = 0; t < n_tets; ++t) {
     Vec3 x[4];
     for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * t + c]);
     const TetReference current = tet_reference(x);
-    if (!(current.volume > 0.0)) {  // inverted: the caller reports it from the force stage
-      continue;
+    if (!(current.volume > 0.0)) continue;  // inverted: the force stage reports it
+    dm_inv[t] = current.dm_inv;
+    volume[t] = current.volume;
+    weight[t] = tet_max_stiffness_eigenvalue(current.dm_inv, current.volume,
+                                             model.materials[tets.material[t]].lame);
+    for (int c = 0; c < 4; ++c) node_weight[tets.nodes[4 * t + c]] += weight[t];
+  }
+
+  // Pass 2: λ_max(M_e⁻¹K_e) with the node masses split in proportion to the weights.
+  CriticalStep out;
+  out.dt = std::numeric_limits<double>::infinity();
+  for (LocalIndex t = 0; t < n_tets; ++t) {
+    if (weight[t] <= 0.0) continue;
+    double corner_mass[4];
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = tets.nodes[4 * t + c];
+      corner_mass[c] = nodes.mass[n] * weight[t] / node_weight[n];
     }
     const MaterialProperties& mat = model.materials[tets.material[t]];
-    const double k_max = tet_max_stiffness_eigenvalue(current.dm_inv, current.volume, mat.lame);
-    const double dt =
-        tet_critical_time_step(k_max, mat.density, tets.volume0[t], mat.damping_ratio);
+    const double omega = std::sqrt(tet_max_eigenvalue(dm_inv[t], volume[t], mat.lame, corner_mass));
+    const double dt = critical_step_for_frequency(omega, mat.damping_ratio);
     if (dt < out.dt) {
       out.dt = dt;
       out.limiting_tet = t;

@@ -104,8 +104,10 @@ void Simulation::step() {
 
   // Energy balance at t_n
   energy.kinetic = motion.kinetic_energy;
-  energy.dissipated_damping = ledger_.damping.add(forces.damping_power * dt_);
-  energy.external_work = ledger_.external.add(motion.constraint_work);
+  energy.dissipated_damping =
+      ledger_.damping.add(0.5 * forces.damping_power * dt_, 0.5 * forces.damping_power * dt_);
+  energy.external_work =
+      ledger_.external.add(motion.constraint_work_before, motion.constraint_work_after);
   ledger_.record(energy);
   check_state(forces, motion.finite);
 
@@ -139,6 +141,18 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
     std::ostringstream msg;
     msg << "numerical failure at step " << steps_ << " (t = " << time_
         << " s): velocities became NaN or infinite." << advice.str();
+    throw NumericalFailure(msg.str());
+  }
+  // Central difference conserves ½m·v⁻·v⁺ + U even past the stability limit, but that kinetic term
+  // turns negative when a mode oscillates beyond it (velocities flip sign every step).
+  const EnergyTerms& e = ledger_.current();
+  if (e.kinetic < -1e-3 * std::max(e.scale(), 1e-300)) {
+    std::ostringstream msg;
+    msg << "numerical failure at step " << steps_ << " (t = " << time_
+        << " s): the run is unstable — nodal "
+        << "velocities alternate in sign from step to step (a mode beyond the stability limit is "
+           "growing)."
+        << advice.str();
     throw NumericalFailure(msg.str());
   }
   if (steps_ > 10 && ledger_.balance_error() > runaway_balance_error) {
