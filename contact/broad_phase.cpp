@@ -40,17 +40,24 @@ void sort_pairs(std::vector<CandidatePair>& pairs, LocalIndex n,
                 std::vector<CandidatePair>& scratch, std::vector<std::size_t>& counts) {
   const std::size_t p = pairs.size();
   if (p < 2) return;
+  // One stable counting-sort pass by a into scratch (O(P + n)), then each bucket (the partners
+  // of one element: a few to a few hundred pairs, contiguous in memory) is sorted by b.
   scratch.resize(p);
   counts.assign(static_cast<std::size_t>(n) + 1, 0);
-  // Pass 1: stable counting sort by b into scratch.
-  for (const CandidatePair& q : pairs) ++counts[q.b + 1];
+  for (const CandidatePair& q : pairs) ++counts[q.a + 1];
   for (LocalIndex i = 0; i < n; ++i) counts[i + 1] += counts[i];
-  for (const CandidatePair& q : pairs) scratch[counts[q.b]++] = q;
-  // Pass 2: stable counting sort by a back into pairs.
-  std::fill(counts.begin(), counts.end(), 0);
-  for (const CandidatePair& q : scratch) ++counts[q.a + 1];
-  for (LocalIndex i = 0; i < n; ++i) counts[i + 1] += counts[i];
-  for (const CandidatePair& q : scratch) pairs[counts[q.a]++] = q;
+  for (const CandidatePair& q : pairs) scratch[counts[q.a]++] = q;
+  std::size_t begin = 0;
+  for (LocalIndex i = 0; i < n; ++i) {
+    const std::size_t end = counts[i];
+    if (end - begin > 1) {
+      std::sort(scratch.begin() + static_cast<std::ptrdiff_t>(begin),
+                scratch.begin() + static_cast<std::ptrdiff_t>(end),
+                [](CandidatePair x, CandidatePair y) { return x.b < y.b; });
+    }
+    begin = end;
+  }
+  pairs.swap(scratch);
 }
 
 void detect_brute_force(const double* lo, const double* hi, LocalIndex n, double buffer,
@@ -118,8 +125,7 @@ void SortSweepDetector::detect(const double* lo, const double* hi, LocalIndex n,
 
 std::size_t SortSweepDetector::workspace_bytes() const {
   return boxes_.capacity() * sizeof(double) + sorted_boxes_.capacity() * sizeof(double) +
-         order_.capacity() * sizeof(order_[0]) + scratch_.capacity() * sizeof(CandidatePair) +
-         counts_.capacity() * sizeof(std::size_t);
+         order_.capacity() * sizeof(order_[0]) + counts_.capacity() * sizeof(std::size_t);
 }
 
 void detect_sort_sweep(const double* lo, const double* hi, LocalIndex n, double buffer,

@@ -61,13 +61,15 @@ void inflate_boxes(const double* lo, const double* hi, LocalIndex n, double buff
                    std::vector<double>& boxes);
 
 // The one overlap predicate (closed boxes, 6 doubles each as produced by inflate_boxes).
+// Bitwise & on purpose: all six comparisons, one hard-to-predict branch fewer per test.
 inline bool boxes_overlap(const double* a, const double* b) {
-  return a[3] >= b[0] && b[3] >= a[0] && a[4] >= b[1] && b[4] >= a[1] && a[5] >= b[2] &&
-         b[5] >= a[2];
+  return (a[3] >= b[0]) & (b[3] >= a[0]) & (a[4] >= b[1]) & (b[4] >= a[1]) & (a[5] >= b[2]) &
+         (b[5] >= a[2]);
 }
 
-// Sorts pairs by (a, b) in O(P + n) with two counting-sort passes (n = number of elements).
-// scratch and counts are reused workspace.
+// Sorts pairs by (a, b) (n = number of elements): a counting sort by a, then a sort of each
+// element's partners by b; O(P + n) for bounded partners per element.  scratch and counts are
+// reused workspace (pairs and scratch may exchange their buffers).
 void sort_pairs(std::vector<CandidatePair>& pairs, LocalIndex n,
                 std::vector<CandidatePair>& scratch, std::vector<std::size_t>& counts);
 
@@ -84,7 +86,8 @@ class SortSweepDetector {
  public:
   void detect(const double* lo, const double* hi, LocalIndex n, double buffer,
               std::vector<CandidatePair>& out, PairFilter keep = {});
-  // Bytes held by the reusable workspace (capacity, excluding the output list).
+  // Bytes held by the reusable workspace (capacity), without the pair lists (output and its
+  // sort scratch, 8 bytes per pair each).
   std::size_t workspace_bytes() const;
   // Overlap-predicate evaluations in the last detect() call.
   std::size_t box_tests() const { return box_tests_; }

@@ -55,7 +55,7 @@ std::size_t NbsDetector::Level::bytes() const {
 std::size_t NbsDetector::workspace_bytes() const {
   std::size_t total = capacity_bytes(boxes_) + capacity_bytes(extent_) +
                       capacity_bytes(extent_scratch_) + capacity_bytes(remaining_) +
-                      capacity_bytes(large_) + capacity_bytes(scratch_) + capacity_bytes(counts_);
+                      capacity_bytes(large_) + capacity_bytes(counts_);
   for (const Level& level : levels_) total += level.bytes();
   return total;
 }
@@ -84,8 +84,12 @@ void NbsDetector::detect(const double* lo, const double* hi, LocalIndex n, doubl
   double max_abs_coordinate = 0.0;
   for (LocalIndex i = 0; i < n; ++i) {
     const double* box = &boxes_[6 * i];
-    extent_[i] = std::max({box[3] - box[0], box[4] - box[1], box[5] - box[2]});
-    for (int k = 0; k < 6; ++k) max_abs_coordinate = std::max(max_abs_coordinate, std::abs(box[k]));
+    const double ex = box[3] - box[0], ey = box[4] - box[1], ez = box[5] - box[2];
+    extent_[i] = std::max(ex, std::max(ey, ez));
+    // lo <= hi, so max(|lo|, |hi|) = max(-lo, hi) on each axis.
+    const double ax = std::max(-box[0], box[3]), ay = std::max(-box[1], box[4]),
+                 az = std::max(-box[2], box[5]);
+    max_abs_coordinate = std::max(max_abs_coordinate, std::max(ax, std::max(ay, az)));
   }
   // A box whose extent is below d - margin provably cannot reach past the neighbour cell, even
   // with the round-off of the cell index (relative 1e-6 of d, or 64 ulp of the coordinates).
@@ -106,16 +110,20 @@ void NbsDetector::detect(const double* lo, const double* hi, LocalIndex n, doubl
       cell_size = options_.cell_size;
       limit = cell_size - margin(cell_size);
     } else {
-      extent_scratch_.resize(m);
-      double max_extent = 0.0;
-      for (std::size_t k = 0; k < m; ++k) {
-        extent_scratch_[k] = extent_[remaining_[k]];
-        max_extent = std::max(max_extent, extent_scratch_[k]);
+      double min_extent = extent_[remaining_[0]], max_extent = min_extent;
+      for (LocalIndex g : remaining_) {
+        min_extent = std::min(min_extent, extent_[g]);
+        max_extent = std::max(max_extent, extent_[g]);
       }
-      auto middle = extent_scratch_.begin() + static_cast<std::ptrdiff_t>(m / 2);
-      std::nth_element(extent_scratch_.begin(), middle, extent_scratch_.end());
-      limit = options_.size_ratio * *middle;
-      if (limit >= max_extent || limit <= 0.0) limit = max_extent;
+      limit = max_extent;
+      if (max_extent > options_.size_ratio * min_extent) {  // else nothing can be large
+        extent_scratch_.resize(m);
+        for (std::size_t k = 0; k < m; ++k) extent_scratch_[k] = extent_[remaining_[k]];
+        auto middle = extent_scratch_.begin() + static_cast<std::ptrdiff_t>(m / 2);
+        std::nth_element(extent_scratch_.begin(), middle, extent_scratch_.end());
+        const double median_limit = options_.size_ratio * *middle;
+        if (median_limit > 0.0 && median_limit < max_extent) limit = median_limit;
+      }
       cell_size = limit + margin(limit);
     }
 
@@ -185,7 +193,8 @@ void NbsDetector::map_level(Level& level, double cell_size, NbsLevelStats& level
   for (std::size_t k = 0; k < m; ++k) {
     const double* box = &boxes_[6 * level.ids[k]];
     for (int a = 0; a < 3; ++a) {
-      const double t = std::floor((box[a] - level.origin[a]) * level.inverse_cell_size);
+      // box[a] >= origin, so truncation is floor (and avoids a libm call).
+      const double t = (box[a] - level.origin[a]) * level.inverse_cell_size;
       level.cell[3 * k + a] =
           static_cast<std::int32_t>(std::min<double>(t, level.n_cells[a] - 1)) + 1;
     }
@@ -215,17 +224,6 @@ void NbsDetector::sweep_level(Level& level, std::vector<CandidatePair>& out, Pai
   for (int r = 0; r < 5; ++r) head_cell[r] = level.head_cell[r].data();
   std::size_t tests = 0;
   std::int64_t occupied = 0;
-
-  // Tests local element k (box_k) against every element of the cell list starting at j.
-  auto test_list = [&](LocalIndex k, const double* box_k, LocalIndex j) {
-    for (; j != kEmpty; j = next_in_cell[j]) {
-      ++tests;
-      if (boxes_overlap(box_k, boxes + 6 * ids[j])) {
-        const LocalIndex a = std::min(ids[k], ids[j]), b = std::max(ids[k], ids[j]);
-        if (keep.keep(a, b)) out.push_back({a, b});
-      }
-    }
-  };
 
   // Stage 1: layers (z).
   level.used_layers.clear();
@@ -268,14 +266,29 @@ void NbsDetector::sweep_level(Level& level, std::vector<CandidatePair>& out, Pai
       }
       for (LocalIndex k = rows[0]; k != kEmpty; k = next_in_row[k]) {
         const std::int32_t x = cell[3 * k];
-        const double* box_k = boxes + 6 * ids[k];
-        test_list(k, box_k, next_in_cell[k]);      // later elements of its own cell
-        test_list(k, box_k, head_cell[0][x - 1]);  // same row, x-1
+        // The lists to test k against: later elements of its own cell, x-1 in its row, and
+        // x-1..x+1 in each non-empty half-stencil row (at most 14 lists).
+        LocalIndex lists[14];
+        int n_lists = 0;
+        lists[n_lists++] = next_in_cell[k];
+        lists[n_lists++] = head_cell[0][x - 1];
         for (int r = 1; r < 5; ++r) {
           if (rows[r] == kEmpty) continue;
-          test_list(k, box_k, head_cell[r][x - 1]);
-          test_list(k, box_k, head_cell[r][x]);
-          test_list(k, box_k, head_cell[r][x + 1]);
+          lists[n_lists++] = head_cell[r][x - 1];
+          lists[n_lists++] = head_cell[r][x];
+          lists[n_lists++] = head_cell[r][x + 1];
+        }
+        const LocalIndex id_k = ids[k];
+        const double* box_k = boxes + 6 * id_k;
+        for (int l = 0; l < n_lists; ++l) {
+          for (LocalIndex j = lists[l]; j != kEmpty; j = next_in_cell[j]) {
+            ++tests;
+            const LocalIndex id_j = ids[j];
+            if (boxes_overlap(box_k, boxes + 6 * id_j)) {
+              const LocalIndex a = std::min(id_k, id_j), b = std::max(id_k, id_j);
+              if (keep.keep(a, b)) out.push_back({a, b});
+            }
+          }
         }
       }
       for (int r = 0; r < 5; ++r) {  // reset the cell heads by walking the rows again

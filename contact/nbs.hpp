@@ -53,9 +53,11 @@ struct NbsStats {
   LocalIndex elements = 0;
   LocalIndex large_elements = 0;  // elements not mapped at the first level
   std::vector<NbsLevelStats> levels;
-  std::size_t box_tests = 0;        // overlap-predicate evaluations
-  std::size_t pairs = 0;            // candidate pairs returned
-  std::size_t workspace_bytes = 0;  // capacity of all reusable arrays (output list excluded)
+  std::size_t box_tests = 0;  // overlap-predicate evaluations
+  std::size_t pairs = 0;      // candidate pairs returned
+  // Capacity of the reusable arrays, without the pair lists (output and its sort scratch,
+  // 8 bytes per pair each).
+  std::size_t workspace_bytes = 0;
 };
 
 class NbsDetector {
