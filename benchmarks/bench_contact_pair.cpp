@@ -30,7 +30,8 @@ TetCorners random_tet(std::mt19937_64& rng, double size, const Vec3& center) {
   const Mat3 rot = q.toRotationMatrix();
   TetCorners t;
   for (int v = 0; v < 4; ++v)
-    t.x[v] = center + rot * (regular[v] * size / std::sqrt(8.0) + 0.2 * size * Vec3(u(rng), u(rng), u(rng)));
+    t.x[v] = center +
+             rot * (regular[v] * size / std::sqrt(8.0) + 0.2 * size * Vec3(u(rng), u(rng), u(rng)));
   return t;
 }
 
@@ -113,16 +114,20 @@ int main(int argc, char** argv) {
   };
   std::vector<Row> rows;
   rows.push_back({"rejected_pairs", rejected.size(), throughput(rejected, seconds, contact, sink)});
-  rows.push_back({"overlapping_pairs", overlapping.size(), throughput(overlapping, seconds, contact, sink)});
+  rows.push_back(
+      {"overlapping_pairs", overlapping.size(), throughput(overlapping, seconds, contact, sink)});
   rows.push_back({"mixed_cloud", mixed.size(), throughput(mixed, seconds, contact, sink)});
-  rows.push_back({"mixed_cloud_with_edge_axes", mixed.size(), throughput(mixed, seconds, contact_edge, sink)});
+  rows.push_back(
+      {"mixed_cloud_with_edge_axes", mixed.size(), throughput(mixed, seconds, contact_edge, sink)});
   rows.push_back({"rejection_only_mixed", mixed.size(), throughput(mixed, seconds, reject, sink)});
-  rows.push_back({"rejection_with_edge_axes_mixed", mixed.size(), throughput(mixed, seconds, reject_edge, sink)});
+  rows.push_back({"rejection_with_edge_axes_mixed", mixed.size(),
+                  throughput(mixed, seconds, reject_edge, sink)});
 
   std::printf("bench_contact_pair: potential contact kernel, penalty %.1e Pa\n", penalty);
-  std::printf("mixed cloud: %zu candidate pairs, %d overlapping, %d pass boxes+face planes, "
-              "%d of those separated by an edge axis\n",
-              mixed.size(), mixed_overlapping, mixed_face_pass, mixed_edge_reject);
+  std::printf(
+      "mixed cloud: %zu candidate pairs, %d overlapping, %d pass boxes+face planes, "
+      "%d of those separated by an edge axis\n",
+      mixed.size(), mixed_overlapping, mixed_face_pass, mixed_edge_reject);
   std::printf("%-32s %10s %16s %12s\n", "case", "pairs", "pairs/s", "ns/pair");
   std::ofstream csv(csv_path);
   csv << "case,pairs,pairs_per_second,ns_per_pair\n";

@@ -11,9 +11,9 @@ namespace {
 constexpr int kMaxVertices = 48;
 
 // Plane tags carried by every vertex (bit set = the vertex lies on that plane).
-constexpr unsigned kOuterFaceBit = 1u;     // the sub-tet's base = a face of its own tet
-constexpr unsigned kInternalBits = 0x1Eu;  // bits 1..4: sub-tet sides, through the centroid
-constexpr unsigned kOtherFaceShift = 8;    // bits 8..11: faces 0..3 of the other tet
+constexpr unsigned kOuterFaceBit = 1u;  // the sub-tet's base = a face of its own tet
+// bits 1..4: the sub-tet's sides (planes through the own centroid)
+constexpr unsigned kOtherFaceShift = 8;  // bits 8..11: faces 0..3 of the other tet
 constexpr unsigned kOtherFaceBits = 0xFu << kOtherFaceShift;
 
 struct PieceVertex {
@@ -113,18 +113,23 @@ bool clip_piece(Piece& piece, int k, unsigned plane_bit) {
 // physical volume = |edge_det| * that volume).
 struct SideIntegrals {
   double vol6[4] = {0, 0, 0, 0};  // per sub-tet i: 6 * volume in barycentric space
-  double moment[4][8] = {};       // per sub-tet i: sum vol6_tet * (sum of 3 face-vertex values)
+  double moment[4][8] = {};       // per sub-tet i: sum vol6_tet * (sum of its 4 vertex values)
   double surface[4][4] = {};  // [other face j][other node b]: ∫ 4 lambda_i^own lambda_b^other dS
                               // * 24 (physical area), over the pieces' faces on face j
 };
 
-// Accumulates one piece (sub-tet `own_sub` clipped): cone sums from the apex (the own centroid,
-// lam = 1/4), and the surface integrals on faces that lie on the other tet's faces.
+// Accumulates one piece (sub-tet `own_sub` clipped): cone sums over all faces from an apex at the
+// piece's first vertex (a point of the piece: no cancellation between remote cones, so slivers
+// of overlap keep full relative precision), and the surface integrals on the faces that lie on
+// the other tet's faces.
 // area_weight[j]: maps a barycentric-space doubled area vector to the doubled physical area
 // projected on face j's outward unit normal.
 void integrate_piece(const Piece& piece, int own_sub, const Vec3 (&area_weight)[4],
                      SideIntegrals& out) {
   bool used[kMaxVertices][3] = {};
+  const double* apex_values = piece.v[0].lam;  // apex: the first vertex of the piece
+  const Vec3 apex(apex_values[1], apex_values[2], apex_values[3]);
+  double piece_vol6 = 0.0;
   int face[kMaxVertices];
   for (int vs = 0; vs < piece.count; ++vs) {
     for (int es = 0; es < 3; ++es) {
@@ -146,23 +151,22 @@ void integrate_piece(const Piece& piece, int own_sub, const Vec3 (&area_weight)[
       } while (vc != vs && nf < kMaxVertices);
       if (nf < 3) continue;
       const bool on_other = (face_planes & kOtherFaceBits) != 0;
-      if (!on_other && (face_planes & kInternalBits)) continue;  // through the apex: no cone
       int other_face = -1;
       if (on_other) {
         const unsigned bits = (face_planes & kOtherFaceBits) >> kOtherFaceShift;
         other_face = (bits & 1u) ? 0 : (bits & 2u) ? 1 : (bits & 4u) ? 2 : 3;
       }
-      // Fan from the first vertex; apex at the own centroid (lam_1..3 = 1/4).
+      // Fan from the face's first vertex.
       const PieceVertex& p0 = piece.v[face[0]];
       const Vec3 x0(p0.lam[1], p0.lam[2], p0.lam[3]);
-      const Vec3 h0 = x0 - Vec3::Constant(0.25);
+      const Vec3 h0 = x0 - apex;
       for (int k = 1; k + 1 < nf; ++k) {
         const PieceVertex& p1 = piece.v[face[k]];
         const PieceVertex& p2 = piece.v[face[k + 1]];
         const Vec3 area2 = (Vec3(p1.lam[1], p1.lam[2], p1.lam[3]) - x0)
                                .cross(Vec3(p2.lam[1], p2.lam[2], p2.lam[3]) - x0);
         const double vol6 = h0.dot(area2);
-        out.vol6[own_sub] += vol6;
+        piece_vol6 += vol6;
         for (int c = 0; c < 8; ++c)
           out.moment[own_sub][c] += vol6 * (p0.lam[c] + p1.lam[c] + p2.lam[c]);
         if (other_face >= 0) {
@@ -181,6 +185,8 @@ void integrate_piece(const Piece& piece, int own_sub, const Vec3 (&area_weight)[
       }
     }
   }
+  out.vol6[own_sub] += piece_vol6;
+  for (int c = 0; c < 8; ++c) out.moment[own_sub][c] += piece_vol6 * apex_values[c];
 }
 
 // Integrates the four pieces (sub-tet i of `own`) ∩ other.
@@ -250,21 +256,14 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   integrate_side(frame, 0, side[0]);
   integrate_side(frame, 1, side[1]);
 
-  // Physical volume integrals: ∫_{piece i} lam_c dV = |det| (vol6 * lam_c(apex) + moment) / 24.
+  // Physical volume integrals: ∫_{piece i} lam_c dV = |det| * moment / 24 (moment includes the
+  // apex term vol6 * lam_c(apex)).
   double vol_integral[2][4][8];  // [side][sub-tet][carried value]
   double volume[2] = {0.0, 0.0};
   for (int s = 0; s < 2; ++s) {
     const double jac = std::abs(frame.map[s].edge_det);
-    const double(&other_at_corner)[4][4] = frame.lambda_other[s];
-    double apex[8];
-    for (int a = 0; a < 4; ++a) apex[a] = 0.25;
-    for (int b = 0; b < 4; ++b)
-      apex[4 + b] = 0.25 * (other_at_corner[0][b] + other_at_corner[1][b] + other_at_corner[2][b] +
-                            other_at_corner[3][b]);
     for (int i = 0; i < 4; ++i) {
-      for (int c = 0; c < 8; ++c)
-        vol_integral[s][i][c] =
-            jac * (side[s].vol6[i] * apex[c] + side[s].moment[i][c]) * (1.0 / 24.0);
+      for (int c = 0; c < 8; ++c) vol_integral[s][i][c] = jac * side[s].moment[i][c] * (1.0 / 24.0);
       volume[s] += jac * side[s].vol6[i] * (1.0 / 6.0);
     }
   }

@@ -16,9 +16,10 @@
 // pieces (sub-tet of t) ∩ c.  Each piece is a sub-tet clipped by the other tet's four face
 // planes with a vertex-graph convex clipper (every vertex classified once, every cut edge
 // computed once, so the pieces are closed and shared faces identical: robust for touching and
-// coplanar configurations).  Volume integrals of linear functions are exact cone sums from the
-// sub-tet apex (internal faces through the apex drop out); surface integrals of the quadratic
-// phi*lambda over the pieces' faces on the other tet's faces use the exact degree-2 triangle rule.
+// coplanar configurations).  Volume integrals of linear functions are exact cone sums from a
+// vertex of the piece; surface integrals of the quadratic phi*lambda over the pieces' faces on
+// the other tet's faces use the exact degree-2 triangle rule.  Everything is computed in the
+// piece's own barycentric coordinates (the sub-tets are fixed shapes there) and mapped once.
 #pragma once
 
 #include "contact/tet_overlap.hpp"
