@@ -55,16 +55,36 @@ std::string join(const std::vector<std::string>& items) {
 // Reads one YAML document with positions; every accessor knows its key path for messages.
 class Reader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
+  // overridden: (key path as the reader spells it, "--set" assignment) for each override, so
+  // errors in overridden values point at the override instead of a line of the file.
+  Reader(std::string file, std::vector<std::pair<std::string, std::string>> overridden)
+      : file_(std::move(file)), overridden_(std::move(overridden)) {}
 
   [[noreturn]] void fail(const YAML::Node& at, const std::string& path,
                          const std::string& what) const {
     std::ostringstream msg;
     msg << file_;
+    const std::string* assignment = nullptr;
+    for (const auto& [prefix, set] : overridden_)
+      if (path == prefix || path.rfind(prefix + ".", 0) == 0 || path.rfind(prefix + "[", 0) == 0)
+        assignment = &set;
     const YAML::Mark mark = at.IsDefined() ? at.Mark() : YAML::Mark::null_mark();
-    if (mark.line >= 0) msg << ":" << mark.line + 1 << ":" << mark.column + 1;
+    // A key that only an override created has no place in the file either.
+    if (!assignment && mark.line < 0 && !path.empty())
+      for (const auto& [prefix, set] : overridden_)
+        if (prefix.rfind(path + ".", 0) == 0 || prefix.rfind(path + "[", 0) == 0) assignment = &set;
+    if (assignment)
+      msg << ": --set " << *assignment;
+    else if (mark.line >= 0)
+      msg << ":" << mark.line + 1 << ":" << mark.column + 1;
     msg << ": " << (path.empty() ? std::string("(top level)") : path) << ": " << what;
     throw InputError(msg.str());
+  }
+
+  // The text of a mapping key (keys must be plain scalars).
+  std::string key_name(const YAML::Node& key, const std::string& path) const {
+    if (!key.IsScalar()) fail(key, path, "a key must be a plain name, not a list or a mapping");
+    return key.Scalar();
   }
 
   // Checks a mapping has only allowed keys and has every required key.
@@ -73,8 +93,13 @@ class Reader {
                   const std::vector<std::string>& required = {}) const {
     if (!node.IsMap())
       fail(node, path, "expected a mapping (key: value pairs) with keys " + join(allowed));
+    std::vector<std::string> seen;
     for (auto it = node.begin(); it != node.end(); ++it) {
-      const std::string key = it->first.as<std::string>();
+      const std::string key = key_name(it->first, path);
+      // YAML forbids repeated keys; yaml-cpp would silently use the first one.
+      if (std::find(seen.begin(), seen.end(), key) != seen.end())
+        fail(it->first, child(path, key), "key '" + key + "' is given twice in this mapping");
+      seen.push_back(key);
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
         const std::string near = nearest_name(key, allowed);
         fail(it->first, child(path, key),
@@ -170,7 +195,21 @@ class Reader {
 
  private:
   std::string file_;
+  std::vector<std::pair<std::string, std::string>> overridden_;
 };
+
+// "bodies.0.velocity" → "bodies[0].velocity" (the reader's spelling of key paths).
+std::string reader_path(const std::string& override_path) {
+  std::string out;
+  std::stringstream ss(override_path);
+  for (std::string key; std::getline(ss, key, '.');) {
+    if (!key.empty() && std::all_of(key.begin(), key.end(), ::isdigit))
+      out += "[" + key + "]";
+    else
+      out += (out.empty() ? "" : ".") + key;
+  }
+  return out;
+}
 
 void apply_override(YAML::Node& root, const std::string& assignment, const std::string& file) {
   const auto eq = assignment.find('=');
@@ -192,6 +231,11 @@ void apply_override(YAML::Node& root, const std::string& assignment, const std::
     if (index && !node.IsSequence())
       throw InputError("--set " + assignment + ": '" + key + "' indexes a list, but " + file +
                        " has no list there");
+    if (!index && node.IsDefined() && !node.IsNull() && !node.IsMap())
+      throw InputError("--set " + assignment + ": '" + (i > 0 ? keys[i - 1] : file) +
+                       "' is not a mapping, so it has no key '" + key + "'");
+    if (index && key.size() > 9)
+      throw InputError("--set " + assignment + ": index " + key + " is past the end of the list");
     if (i + 1 == keys.size()) {
       if (index) {
         if (std::stoul(key) >= node.size())
@@ -356,8 +400,12 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ":" +
                      std::to_string(e.mark.column + 1) + ": not valid YAML: " + e.msg);
   }
-  for (const auto& o : overrides) apply_override(root, o, path);
-  const Reader r(path);
+  std::vector<std::pair<std::string, std::string>> overridden;
+  for (const auto& o : overrides) {
+    apply_override(root, o, path);
+    overridden.emplace_back(reader_path(o.substr(0, o.find('='))), o);
+  }
+  const Reader r(path, overridden);
   const std::string scene_dir = std::filesystem::path(path).parent_path().string();
 
   Scene scene;
@@ -389,7 +437,9 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     r.fail(materials, "materials", "expected a mapping of material names to their properties");
   std::vector<std::string> material_names;
   for (auto it = materials.begin(); it != materials.end(); ++it) {
-    const std::string name = it->first.as<std::string>();
+    const std::string name = r.key_name(it->first, "materials");
+    if (std::find(material_names.begin(), material_names.end(), name) != material_names.end())
+      r.fail(it->first, "materials." + name, "material '" + name + "' is defined twice");
     scene.materials.push_back(read_material(r, name, it->second, "materials." + name));
     material_names.push_back(name);
   }
@@ -407,7 +457,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     BodySpec body;
     body.name = b["name"] ? r.string(b["name"], bp + ".name") : "body" + std::to_string(i);
     if (std::find(body_names.begin(), body_names.end(), body.name) != body_names.end())
-      r.fail(b["name"], bp + ".name",
+      r.fail(b["name"] ? b["name"] : b, bp + ".name",
              "body name '" + body.name + "' is used twice; names must be unique");
     body.mesh = read_mesh(r, b["mesh"], bp + ".mesh", scene_dir);
     const std::string mat = r.string(b["material"], bp + ".material");
@@ -444,6 +494,9 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
       const auto pair = read_body_list(r, interfaces[i]["between"], ip + ".between", body_names);
       if (pair.size() != 2)
         r.fail(interfaces[i]["between"], ip + ".between", "expected exactly two body names");
+      if (pair[0] == pair[1])
+        r.fail(interfaces[i]["between"], ip + ".between",
+               "an interface joins two different bodies; both are '" + body_names[pair[0]] + "'");
       InterfaceSpec spec;
       spec.body_a = pair[0];
       spec.body_b = pair[1];
