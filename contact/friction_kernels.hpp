@@ -42,9 +42,9 @@ struct FrictionHistory {
 };
 
 struct FrictionResult {
-  Vec3 force_contactor[4];  // N
-  Vec3 force_target[4];     // N
-  Vec3 tangential_force;    // resultant on the contactor (N)
+  Vec3 force_contactor[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};  // N
+  Vec3 force_target[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};     // N
+  Vec3 tangential_force = Vec3::Zero();  // resultant on the contactor (N)
   bool slipping = false;
   double slip_dissipation = 0.0;  // J dissipated by slip during this step
   double spring_energy = 0.0;     // J stored in the spring after the step: |F_t|^2 / (2k)

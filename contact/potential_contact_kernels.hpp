@@ -28,15 +28,17 @@
 namespace fdem {
 
 struct ContactPairResult {
-  bool overlapping = false;     // false: every output below is zero
-  double energy = 0.0;          // U (J)
-  Vec3 force_contactor[4];      // N, on the contactor's nodes
-  Vec3 force_target[4];         // N, on the target's nodes
-  double overlap_volume = 0.0;  // m^3
-  Vec3 normal;                  // unit direction of the resultant force on the contactor
-                                // (zero when that resultant vanishes, e.g. coincident tets)
-  Vec3 centroid;                // overlap centroid (m): where friction acts
-  double normal_force = 0.0;    // |resultant force on the contactor| (N)
+  bool overlapping = false;  // false: every output below is zero
+  double energy = 0.0;       // U (J)
+  Vec3 force_contactor[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(),
+                             Vec3::Zero()};  // N, on the contactor's nodes
+  Vec3 force_target[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(),
+                          Vec3::Zero()};  // N, on the target's nodes
+  double overlap_volume = 0.0;            // m^3
+  Vec3 normal = Vec3::Zero();             // unit direction of the resultant force on the contactor
+                               // (zero when that resultant vanishes, e.g. coincident tets)
+  Vec3 centroid = Vec3::Zero();                         // overlap centroid (m): where friction acts
+  double normal_force = 0.0;                            // |resultant force on the contactor| (N)
   double centroid_weights_contactor[4] = {0, 0, 0, 0};  // barycentric coords of centroid in c
   double centroid_weights_target[4] = {0, 0, 0, 0};     // barycentric coords of centroid in t
 };
