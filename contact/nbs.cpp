@@ -314,35 +314,46 @@ void NbsDetector::test_large_against_level(Level& level, const std::vector<Local
                                            std::vector<CandidatePair>& out, PairFilter keep) {
   const LocalIndex m = static_cast<LocalIndex>(level.ids.size());
   const std::int32_t* cell = level.cell.data();
-  const std::int64_t nx = level.n_cells[0] + 2, ny = level.n_cells[1] + 2;
+  const std::int64_t nx = level.n_cells[0] + 2, ny = level.n_cells[1] + 2,
+                     nz = level.n_cells[2] + 2;
   auto key_of = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
     return (z * ny + y) * nx + x;
   };
   auto key = [&](LocalIndex k) { return key_of(cell[3 * k], cell[3 * k + 1], cell[3 * k + 2]); };
 
-  // Local elements sorted by cell (z, y, x): three stable counting-sort passes, O(m + cells).
+  // Local elements sorted by cell (z, y, x) with stable counting-sort passes: by x, then by
+  // row (z, y) when a table with one entry per row stays within O(m) memory (the usual case:
+  // about m^(2/3) rows), else by y and then z.  O(m + cells along the axes or rows).
+  const std::int64_t n_rows = ny * nz;
+  const bool row_table = n_rows <= 4 * static_cast<std::int64_t>(m) + 4096;
   level.by_cell.resize(m);
   std::vector<LocalIndex>& order = level.by_cell;
   std::vector<LocalIndex>& pass = level.by_cell_scratch;
   pass.resize(m);
   std::iota(pass.begin(), pass.end(), 0);
-  for (int a = 0; a < 3; ++a) {
-    level.counts.assign(static_cast<std::size_t>(level.n_cells[a]) + 3, 0);
-    for (LocalIndex k : pass) ++level.counts[cell[3 * k + a] + 1];
+  auto counting_pass = [&](std::size_t n_keys, auto&& key_of_element) {
+    level.counts.assign(n_keys + 1, 0);
+    for (LocalIndex k : pass) ++level.counts[key_of_element(k) + 1];
     for (std::size_t c = 1; c < level.counts.size(); ++c) level.counts[c] += level.counts[c - 1];
-    for (LocalIndex k : pass) order[level.counts[cell[3 * k + a]]++] = k;
-    pass.swap(order);
+    for (LocalIndex k : pass) order[level.counts[key_of_element(k)]++] = k;
+    pass.swap(order);  // the sorted order is now in `pass`
+  };
+  counting_pass(static_cast<std::size_t>(nx), [&](LocalIndex k) { return cell[3 * k]; });
+  if (row_table) {
+    // After this pass counts[r] is the end of row r = the start of row r + 1.
+    counting_pass(static_cast<std::size_t>(n_rows),
+                  [&](LocalIndex k) { return cell[3 * k + 2] * ny + cell[3 * k + 1]; });
+  } else {
+    counting_pass(static_cast<std::size_t>(ny), [&](LocalIndex k) { return cell[3 * k + 1]; });
+    counting_pass(static_cast<std::size_t>(nz), [&](LocalIndex k) { return cell[3 * k + 2]; });
   }
-  order.swap(pass);  // after three passes the sorted order is in `order`
+  order.swap(pass);
+  const LocalIndex* sorted = order.data();
 
   auto cell_of = [&](double v, int a) {
     double t = std::floor((v - level.origin[a]) * level.inverse_cell_size);
     t = std::max(-1.0, std::min<double>(t, level.n_cells[a]));
     return static_cast<std::int32_t>(t) + 1;
-  };
-  auto lower_bound = [&](std::int64_t target) {
-    return std::partition_point(order.begin(), order.end(),
-                                [&](LocalIndex k) { return key(k) < target; });
   };
 
   const double log_m = std::log2(static_cast<double>(m) + 1.0);
@@ -365,22 +376,52 @@ void NbsDetector::test_large_against_level(Level& level, const std::vector<Local
         if (keep.keep(a, b)) out.push_back({a, b});
       }
     };
+    // Scans positions [begin, end) of one row (sorted by x) for cells first[0]..last[0].
+    auto scan_row = [&](std::size_t begin, std::size_t end) {
+      if (end - begin > 16) {
+        begin = static_cast<std::size_t>(
+            std::partition_point(sorted + begin, sorted + end,
+                                 [&](LocalIndex k) { return cell[3 * k] < first[0]; }) -
+            sorted);
+      }
+      for (std::size_t p = begin; p < end; ++p) {
+        const std::int32_t x = cell[3 * sorted[p]];
+        if (x > last[0]) break;
+        if (x >= first[0]) test(sorted[p]);
+      }
+    };
+    if (row_table) {
+      for (std::int32_t z = first[2]; z <= last[2]; ++z) {
+        for (std::int32_t y = first[1]; y <= last[1]; ++y) {
+          const std::int64_t r = z * ny + y;
+          scan_row(r > 0 ? level.counts[r - 1] : 0, level.counts[r]);
+        }
+      }
+      continue;
+    }
+    auto lower_bound = [&](std::int64_t target) {
+      return static_cast<std::size_t>(
+          std::partition_point(sorted, sorted + m, [&](LocalIndex k) { return key(k) < target; }) -
+          sorted);
+    };
     const double rows = static_cast<double>(last[1] - first[1] + 1) * (last[2] - first[2] + 1);
     if (rows * log_m > m) {
       // Box covers more rows than the level has elements: one scan of the covered key range.
       const std::int64_t end_key = key_of(last[0], last[1], last[2]);
-      for (auto it = lower_bound(key_of(first[0], first[1], first[2]));
-           it != order.end() && key(*it) <= end_key; ++it) {
-        const std::int32_t* c = &cell[3 * *it];
-        if (c[0] >= first[0] && c[0] <= last[0] && c[1] >= first[1] && c[1] <= last[1]) test(*it);
+      for (std::size_t p = lower_bound(key_of(first[0], first[1], first[2]));
+           p < static_cast<std::size_t>(m) && key(sorted[p]) <= end_key; ++p) {
+        const std::int32_t* c = &cell[3 * sorted[p]];
+        if (c[0] >= first[0] && c[0] <= last[0] && c[1] >= first[1] && c[1] <= last[1]) {
+          test(sorted[p]);
+        }
       }
     } else {
       for (std::int32_t z = first[2]; z <= last[2]; ++z) {
         for (std::int32_t y = first[1]; y <= last[1]; ++y) {
           const std::int64_t end_key = key_of(last[0], y, z);
-          for (auto it = lower_bound(key_of(first[0], y, z));
-               it != order.end() && key(*it) <= end_key; ++it) {
-            test(*it);
+          for (std::size_t p = lower_bound(key_of(first[0], y, z));
+               p < static_cast<std::size_t>(m) && key(sorted[p]) <= end_key; ++p) {
+            test(sorted[p]);
           }
         }
       }

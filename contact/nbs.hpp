@@ -83,7 +83,7 @@ class NbsDetector {
     std::vector<LocalIndex> used_layers, used_rows;
     std::vector<LocalIndex> by_cell;  // local elements sorted by (z, y, x), for large elements
     std::vector<LocalIndex> by_cell_scratch;
-    std::vector<LocalIndex> counts;
+    std::vector<LocalIndex> counts;  // counting sort; then the row table (end of each row)
     std::array<double, 3> origin{};
     double inverse_cell_size = 0.0;
     std::array<std::int32_t, 3> n_cells{};
