@@ -218,6 +218,41 @@ TEST_CASE("NBS edge case: a single huge element among small ones", "[contact][nb
   CHECK(nbs.stats().box_tests < 60 * static_cast<std::size_t>(n));
 }
 
+TEST_CASE("NBS edge case: huge elements in a sparse domain with a dense cluster",
+          "[contact][nbs]") {
+  // 1500 small tets in a dense 15 m cluster and 1500 spread over a 2 km cube: about 2000 cells
+  // per axis, so the large-element pass cannot use a per-row table and falls back to binary
+  // search (the cluster box) and to one range scan (the box covering everything).
+  std::mt19937_64 rng(31);
+  auto cluster = random_tets(1500, {0, 0, 0}, {15, 15, 15}, 0.5, 1.0, rng);
+  auto spread = random_tets(1500, {0, 0, 0}, {2000, 2000, 2000}, 0.5, 1.0, rng);
+  std::vector<double> lo = cluster.lo, hi = cluster.hi;
+  lo.insert(lo.end(), spread.lo.begin(), spread.lo.end());
+  hi.insert(hi.end(), spread.hi.begin(), spread.hi.end());
+  const double big[3][6] = {{-1, -1, -1, 2001, 2001, 2001},    // everything
+                            {2, 2, 2, 12, 12, 12},             // inside the cluster
+                            {500, 500, 500, 900, 700, 1500}};  // part of the spread elements
+  for (const auto& b : big) {
+    lo.insert(lo.end(), b, b + 3);
+    hi.insert(hi.end(), b + 3, b + 6);
+  }
+  const LocalIndex n = 3003;
+  NbsDetector nbs;
+  SortSweepDetector sweep;
+  ThreeWay r = run_all(nbs, sweep, lo, hi, n, 0.01);
+  CHECK(nbs.stats().large_elements == 3);
+  REQUIRE(!nbs.stats().levels.empty());
+  const auto& cells = nbs.stats().levels[0].cells_per_axis;
+  CHECK(static_cast<double>(cells[1] + 2) * (cells[2] + 2) > 4.0 * 3000 + 4096);
+  LocalIndex with_everything = 0, with_cluster_box = 0;
+  for (const CandidatePair& p : r.nbs) {
+    with_everything += (p.a == 3000 || p.b == 3000);
+    with_cluster_box += (p.a == 3001 || p.b == 3001);
+  }
+  CHECK(with_everything == 3002);
+  CHECK(with_cluster_box > 100);
+}
+
 TEST_CASE("NBS memory is linear in N and independent of the domain size", "[contact][nbs]") {
   std::mt19937_64 rng(5);
   const LocalIndex n = 3000;
