@@ -68,6 +68,22 @@ void RunFiles::write_frame(double time, const Model& model, const std::vector<Fr
   frames_.add_frame(time, relative);
 }
 
+void RunFiles::write_contacts(double time, const std::vector<ContactRecord>& records) {
+  if (!contacts_) contacts_ = std::make_unique<SeriesWriter>(directory_, "contacts");
+  std::vector<double> points, normal, tangential;
+  for (const ContactRecord& r : records)
+    for (int k = 0; k < 3; ++k) {
+      points.push_back(r.point[k]);
+      normal.push_back(r.normal_force[k]);
+      tangential.push_back(r.tangential_force[k]);
+    }
+  const std::string relative = contacts_->next_frame_path() + ".vtp";
+  write_point_frame(
+      (std::filesystem::path(directory_) / relative).string(), points,
+      {{"normal_force", 3, false, normal}, {"tangential_force", 3, false, tangential}});
+  contacts_->add_frame(time, relative);
+}
+
 std::string summary_json(const RunReport& r, const Model& model, const std::string& scene_name) {
   std::ostringstream j;
   j << std::setprecision(15);

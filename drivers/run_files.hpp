@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "contact/contact_stage.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
 #include "io/vtk_output.hpp"
@@ -22,6 +23,8 @@ class RunFiles {
   void write_energy_row(double time, const EnergyTerms& e, double balance_error);
   void write_bodies_rows(double time, const Model& model);
   void write_frame(double time, const Model& model, const std::vector<FrameField>& extra = {});
+  // Contact points with their normal and tangential forces, as the "contacts" series.
+  void write_contacts(double time, const std::vector<ContactRecord>& records);
   void write_summary(const RunReport& report, const Model& model, const std::string& scene_name);
   const std::string& directory() const { return directory_; }
 
@@ -30,6 +33,7 @@ class RunFiles {
   std::vector<std::string> fields_;
   std::ofstream energy_, bodies_;
   SeriesWriter frames_;
+  std::unique_ptr<SeriesWriter> contacts_;
 };
 
 // JSON text of the run summary (also used by `fdem check --json` and tests).

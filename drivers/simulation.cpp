@@ -5,6 +5,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "contact/contact_stage.hpp"
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
 #include "core/model_builder.hpp"
@@ -57,9 +58,17 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options)
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0;
   plan_.kinematic_loads = !scene_.loads.empty();
 
+  plan_.contact = ContactStage::needed(model_);
   const CriticalStep critical = fdem::critical_time_step(model_);
   dt_critical_ = critical.dt;
-  dt_ = scene_.time.auto_step ? scene_.time.safety * critical.dt : scene_.time.step;
+  if (plan_.contact) {
+    contact_ = std::make_unique<ContactStage>(model_, ContactSettings{scene_.contact_buffer});
+    // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
+    const double dt_contact = contact_->critical_time_step(model_);
+    dt_critical_ =
+        1.0 / std::sqrt(1.0 / (dt_critical_ * dt_critical_) + 1.0 / (dt_contact * dt_contact));
+  }
+  dt_ = scene_.time.auto_step ? scene_.time.safety * dt_critical_ : scene_.time.step;
   if (!std::isfinite(dt_) || dt_ <= 0.0)
     throw InputError(scene_.source_path + ": could not determine a time step (critical step " +
                      std::to_string(critical.dt) + " s)");
@@ -83,8 +92,22 @@ void Simulation::step() {
   }
   energy.strain = forces.strain_energy;
 
-  // 2–3 joint forces and fracture, 4–5 contact detection and forces: run when the plan needs them
-  // (no stage of this kind is active in a scene without joints or contact partners).
+  // 2–3 joint forces and fracture: run when the plan needs them (no joints yet in this version).
+
+  // 4 contact detection: only when a node has moved more than buffer/2 since the last one
+  if (plan_.contact) {
+    Timed timed(clocks_[detection]);
+    contact_->detect_if_needed(model_);
+  }
+
+  // 5 contact forces: potential tet–tet contact over the candidate pairs
+  if (plan_.contact) {
+    Timed timed(clocks_[contact]);
+    const ContactForceSummary c = contact_->add_forces(model_, dt_);
+    energy.contact = c.energy + c.friction_spring_energy;
+    energy.dissipated_friction =
+        ledger_.friction.add(c.friction_work_before, c.friction_work_after);
+  }
 
   // 6 external forces
   if (plan_.gravity) {
@@ -197,6 +220,7 @@ void Simulation::write_outputs(bool force) {
   }
   if (force || time_ >= next_frame_time_ - 1e-12 * dt_) {
     files_->write_frame(time_, model_);
+    if (contact_) files_->write_contacts(time_, contact_->records());
     files_->write_bodies_rows(time_, model_);
     if (scene_.output.every > 0)
       while (next_frame_time_ <= time_ + 1e-12 * dt_) next_frame_time_ += scene_.output.every;

@@ -15,6 +15,7 @@ namespace fdem {
 
 class SeriesWriter;
 class RunFiles;
+class ContactStage;
 
 struct RunOptions {
   std::string output_dir = "out";
@@ -74,6 +75,7 @@ class Simulation {
   double time_step() const { return dt_; }
   double critical_time_step() const { return dt_critical_; }
   void set_time_step(double dt) { dt_ = dt; }
+  const ContactStage* contact_stage() const { return contact_.get(); }
   RunReport report() const;
 
  private:
@@ -105,6 +107,7 @@ class Simulation {
   std::chrono::steady_clock::time_point wall_start_;
   double next_frame_time_ = 0.0, next_energy_time_ = 0.0;
   std::unique_ptr<RunFiles> files_;
+  std::unique_ptr<ContactStage> contact_;
 };
 
 // Builds a Simulation from a scene file (meshes loaded or generated).

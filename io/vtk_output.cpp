@@ -1,12 +1,15 @@
 #include "io/vtk_output.hpp"
 
+#include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
+#include <vtkPolyData.h>
 #include <vtkUnstructuredGrid.h>
+#include <vtkXMLPolyDataWriter.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include <algorithm>
@@ -165,6 +168,36 @@ void write_tet_frame(const std::string& path, const Model& model,
   vtkNew<vtkXMLUnstructuredGridWriter> writer;
   writer->SetFileName(tmp.c_str());
   writer->SetInputData(grid);
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  if (writer->Write() != 1) throw std::runtime_error("VTK could not write " + tmp);
+  std::filesystem::rename(tmp, path);
+}
+
+void write_point_frame(const std::string& path, const std::vector<double>& points,
+                       const std::vector<FrameField>& point_fields) {
+  const vtkIdType n = static_cast<vtkIdType>(points.size() / 3);
+  vtkNew<vtkPolyData> poly;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(n);
+  vtkNew<vtkCellArray> verts;
+  for (vtkIdType i = 0; i < n; ++i) {
+    pts->SetPoint(i, &points[3 * i]);
+    verts->InsertNextCell(1, &i);
+  }
+  poly->SetPoints(pts);
+  poly->SetVerts(verts);
+  for (const FrameField& f : point_fields) {
+    FDEM_VERIFY(static_cast<vtkIdType>(f.values.size()) == n * f.components, "point field size");
+    auto a = make_array(f.name, f.components, n);
+    for (vtkIdType i = 0; i < n * f.components; ++i) a->SetValue(i, f.values[i]);
+    poly->GetPointData()->AddArray(a);
+  }
+  const std::string tmp = path + ".tmp";
+  vtkNew<vtkXMLPolyDataWriter> writer;
+  writer->SetFileName(tmp.c_str());
+  writer->SetInputData(poly);
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
   if (writer->Write() != 1) throw std::runtime_error("VTK could not write " + tmp);

@@ -36,6 +36,11 @@ class SeriesWriter {
 void write_tet_frame(const std::string& path, const Model& model,
                      const std::vector<std::string>& fields, const std::vector<FrameField>& extra);
 
+// Writes points (3 doubles each) with per-point arrays as a .vtp (VTK poly data, one vertex per
+// point).
+void write_point_frame(const std::string& path, const std::vector<double>& points,
+                       const std::vector<FrameField>& point_fields);
+
 // Atomically replaces `path` with `content`.
 void write_file_atomically(const std::string& path, const std::string& content);
 
