@@ -1,5 +1,6 @@
 // The `fdem` command: run | check | --version (see docs/scene-format.md and README.md).
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -122,6 +123,9 @@ int main(int argc, char** argv) {
   } catch (const fdem::InputError& e) {
     std::fprintf(stderr, "fdem: error: %s\n", e.what());
     return 2;
+  } catch (const fdem::NumericalFailure& e) {
+    std::fprintf(stderr, "fdem: %s\n", e.what());
+    return 3;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fdem: error: %s\n", e.what());
     return 1;

@@ -1,10 +1,12 @@
 #include "drivers/run_files.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
 
 #include "core/dynamics.hpp"
+#include "core/error.hpp"
 #include "drivers/simulation.hpp"
 
 namespace fdem {
@@ -24,12 +26,30 @@ std::string json_escape(const std::string& s) {
   }
   return out;
 }
+
+// The -o directory is the user's choice, so failing to create it is an input error (exit 2).
+const std::string& create_output_directory(const std::string& directory) {
+  std::error_code error;
+  std::filesystem::create_directories(directory, error);
+  if (error)
+    throw InputError("cannot create the output directory '" + directory +
+                     "' (-o): " + error.message());
+  return directory;
+}
+
+// JSON has no NaN or infinity: a run that blew up reports those values as null.
+struct JsonNumber {
+  double value;
+};
+std::ostream& operator<<(std::ostream& out, JsonNumber n) {
+  return std::isfinite(n.value) ? out << n.value : out << "null";
+}
 }  // namespace
 
 RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>& fields)
     : directory_(directory),
       fields_(fields),
-      frames_((std::filesystem::create_directories(directory), directory), "frames") {
+      frames_(create_output_directory(directory), "frames") {
   energy_.open(std::filesystem::path(directory) / "energy.csv");
   energy_ << "time,kinetic,strain,gravity,contact,joint,dissipated_fracture,dissipated_friction,"
              "dissipated_damping,external_work,total,balance_error\n";
@@ -38,7 +58,7 @@ RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>&
   energy_ << std::setprecision(12);
   bodies_ << std::setprecision(12);
   if (!energy_ || !bodies_)
-    throw std::runtime_error("cannot write into output directory " + directory);
+    throw InputError("cannot write into the output directory '" + directory + "' (-o)");
 }
 
 void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balance_error) {
@@ -93,10 +113,10 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
   if (!r.reason.empty()) j << "  \"reason\": \"" << json_escape(r.reason) << "\",\n";
   j << "  \"ranks\": 1,\n";
   j << "  \"steps\": " << r.steps << ",\n";
-  j << "  \"end_time\": " << r.time << ",\n";
-  j << "  \"time_step\": " << r.time_step << ",\n";
-  j << "  \"critical_time_step\": " << r.critical_time_step << ",\n";
-  j << "  \"wall_seconds\": " << r.wall_seconds << ",\n";
+  j << "  \"end_time\": " << JsonNumber{r.time} << ",\n";
+  j << "  \"time_step\": " << JsonNumber{r.time_step} << ",\n";
+  j << "  \"critical_time_step\": " << JsonNumber{r.critical_time_step} << ",\n";
+  j << "  \"wall_seconds\": " << JsonNumber{r.wall_seconds} << ",\n";
   j << "  \"nodes\": " << model.nodes.size() << ",\n";
   j << "  \"elements\": " << model.tets.size() << ",\n";
   j << "  \"pieces\": " << model.pieces.size() << ",\n";
@@ -106,23 +126,24 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
   bool first = true;
   for (const auto& s : r.stages) {
     if (s.calls == 0) continue;
-    j << (first ? "\n" : ",\n") << "    \"" << s.name << "\": {\"seconds\": " << s.seconds
-      << ", \"calls\": " << s.calls << "}";
+    j << (first ? "\n" : ",\n") << "    \"" << s.name
+      << "\": {\"seconds\": " << JsonNumber{s.seconds} << ", \"calls\": " << s.calls << "}";
     first = false;
   }
   j << "\n  },\n";
   const double element_steps =
       static_cast<double>(model.tets.size()) * static_cast<double>(r.steps);
   j << "  \"throughput\": {\"element_steps_per_second\": "
-    << (r.wall_seconds > 0 ? element_steps / r.wall_seconds : 0.0) << "},\n";
+    << JsonNumber{r.wall_seconds > 0 ? element_steps / r.wall_seconds : 0.0} << "},\n";
   const EnergyTerms& e = r.energy;
-  j << "  \"energy\": {\"kinetic\": " << e.kinetic << ", \"strain\": " << e.strain
-    << ", \"gravity\": " << e.gravity << ", \"contact\": " << e.contact
-    << ", \"joint\": " << e.joint << ", \"dissipated_fracture\": " << e.dissipated_fracture
-    << ", \"dissipated_friction\": " << e.dissipated_friction
-    << ", \"dissipated_damping\": " << e.dissipated_damping
-    << ", \"external_work\": " << e.external_work << ", \"balance_error\": " << r.balance_error
-    << "},\n";
+  j << "  \"energy\": {\"kinetic\": " << JsonNumber{e.kinetic}
+    << ", \"strain\": " << JsonNumber{e.strain} << ", \"gravity\": " << JsonNumber{e.gravity}
+    << ", \"contact\": " << JsonNumber{e.contact} << ", \"joint\": " << JsonNumber{e.joint}
+    << ", \"dissipated_fracture\": " << JsonNumber{e.dissipated_fracture}
+    << ", \"dissipated_friction\": " << JsonNumber{e.dissipated_friction}
+    << ", \"dissipated_damping\": " << JsonNumber{e.dissipated_damping}
+    << ", \"external_work\": " << JsonNumber{e.external_work}
+    << ", \"balance_error\": " << JsonNumber{r.balance_error} << "},\n";
   j << "  \"state_hash\": \"" << r.state_hash << "\"\n";
   j << "}\n";
   return j.str();

@@ -480,7 +480,7 @@ TEST_CASE("malformed YAML is reported with its line", "[io]") {
   }
 }
 
-TEST_CASE("--set overrides replace values before validation", "[io]") {
+TEST_CASE("overrides from --set replace values before validation", "[io]") {
   const std::string text = join_lines(minimal_lines());
   SECTION("a scalar") {
     const fdem::Scene s = fdem::parse_scene(text, "scene.yaml", {"time.end=0.5"});
