@@ -521,6 +521,10 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
         RegionSpec reg;
         reg.min = r.vec3(region["box"]["min"], lp + ".region.box.min");
         reg.max = r.vec3(region["box"]["max"], lp + ".region.box.max");
+        for (int k = 0; k < 3; ++k)
+          if (reg.max[k] < reg.min[k])
+            r.fail(region["box"]["max"], lp + ".region.box.max",
+                   "each component of max must be at least min's (the box would hold no node)");
         load.region = reg;
       } else {
         r.fail(l, lp, "a load needs 'bodies' or 'region' to say where it acts");

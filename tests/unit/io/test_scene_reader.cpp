@@ -458,6 +458,12 @@ TEST_CASE("load velocities with null components prescribe only the given ones", 
     const std::string msg = input_error(minimal_plus("loads:\n  - {velocity: [0, 0, 0]}\n"));
     CHECK_THAT(msg, StartsWith("scene.yaml:11:5: loads[0]: a load needs 'bodies' or 'region'"));
   }
+  SECTION("an inverted region box") {
+    const std::string msg = input_error(minimal_plus(
+        "loads:\n  - {region: {box: {min: [0, 0, 1], max: [1, 1, 0]}}, velocity: [0, 0, 0]}\n"));
+    CHECK_THAT(msg, StartsWith("scene.yaml:11:42: loads[0].region.box.max: each component of max "
+                               "must be at least min's"));
+  }
   SECTION("a velocity with two components") {
     const std::string msg =
         input_error(minimal_plus("loads:\n  - {bodies: [block], velocity: [0, 0]}\n"));
