@@ -14,13 +14,13 @@
 // no loop over cells, so time and memory are linear in N, whatever the domain size or packing
 // density.
 //
-// Size disparity: d is 2x the median extent (NbsOptions::size_ratio) when the largest element
-// exceeds that, otherwise the largest extent.  Elements larger than d are "large": they are
-// tested against the level's elements whose cells their box covers (cells found by binary
-// search in a cell-sorted copy of the level), and then form the next level, which repeats the
-// same procedure among themselves.  Each level holds at least half of the remaining elements, so
-// there are at most log2(N) levels; with similar sizes there is one.  See
-// docs/contact-detection.md.
+// Size disparity: if the largest extent exceeds size_ratio (2) x the smallest, d is 2x the
+// median extent (when that is below the largest), otherwise the largest extent.  Elements larger
+// than d are "large": they are tested against the level's elements whose cells their box covers
+// (found through a row table or binary search in a cell-sorted copy of the level), and then form
+// the next level, which repeats the same procedure among themselves.  Each level holds at least
+// half of the remaining elements, so there are at most log2(N) levels; with similar sizes there
+// is one.  See docs/contact-detection.md.
 #pragma once
 
 #include <array>
