@@ -9,20 +9,28 @@ namespace fdem {
 
 namespace {
 
+// The per-tet kernel is too large for the compiler's inlining heuristics; inlining it into the
+// element loop anyway (GCC, Clang) saves the call and the TetForce copy: ~5-10 % on the stage.
+#if defined(__GNUC__)
+#define FDEM_INLINE_CALLEES __attribute__((flatten))
+#else
+#define FDEM_INLINE_CALLEES
+#endif
+
 template <class Material>
-inline void tet_force_into(const Model& model, LocalIndex t, const Material& material,
-                           double* corner, InternalForceSummary& sum) {
+FDEM_INLINE_CALLEES inline void tet_force_into(const Model& model, LocalIndex t,
+                                               const Material& material, double* corner,
+                                               InternalForceSummary& sum) {
   const TetArrays& tets = model.tets;
   const NodeArrays& nodes = model.nodes;
+  const double viscosity = tets.viscosity[t];
   Vec3 x[4], v[4];
-  for (int c = 0; c < 4; ++c) {
-    const LocalIndex n = tets.nodes[4 * t + c];
-    x[c] = vec3_at(nodes.x.data(), n);
-    v[c] = vec3_at(nodes.v.data(), n);
-  }
+  for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * t + c]);
+  // The kernel reads velocities only for viscous damping: skip that gather when undamped.
+  if (viscosity > 0.0)
+    for (int c = 0; c < 4; ++c) v[c] = vec3_at(nodes.v.data(), tets.nodes[4 * t + c]);
   const Eigen::Map<const Mat3> dm_inv(tets.dm_inv.data() + 9 * t);
-  const TetForce out =
-      tet_internal_force(x, v, dm_inv, tets.volume0[t], material, tets.viscosity[t]);
+  const TetForce out = tet_internal_force(x, v, dm_inv, tets.volume0[t], material, viscosity);
   for (int c = 0; c < 4; ++c) vec3_at(corner, c) = out.force[c];
   sum.strain_energy += out.strain_energy;
   sum.damping_power += out.damping_power;
