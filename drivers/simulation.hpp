@@ -93,6 +93,7 @@ class Simulation {
   };
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
   void write_outputs(bool force);
+  void start_half_step(NodeArrays& nodes) const;
 
   Scene scene_;
   Model model_;
