@@ -243,7 +243,7 @@ void integrate_side(const TetPairFrame& frame, int own, SideIntegrals& out) {
   }
 }
 
-ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
+ContactPairResult zero_result() {
   ContactPairResult r;
   for (int v = 0; v < 4; ++v) {
     r.force_contactor[v].setZero();
@@ -251,6 +251,11 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   }
   r.normal.setZero();
   r.centroid.setZero();
+  return r;
+}
+
+ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
+  ContactPairResult r = zero_result();
 
   SideIntegrals side[2];
   integrate_side(frame, 0, side[0]);
@@ -308,17 +313,6 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
       r.force_contactor[0] + r.force_contactor[1] + r.force_contactor[2] + r.force_contactor[3];
   r.normal_force = resultant.norm();
   if (r.normal_force > 0.0) r.normal = resultant / r.normal_force;
-  return r;
-}
-
-ContactPairResult zero_result() {
-  ContactPairResult r;
-  for (int v = 0; v < 4; ++v) {
-    r.force_contactor[v].setZero();
-    r.force_target[v].setZero();
-  }
-  r.normal.setZero();
-  r.centroid.setZero();
   return r;
 }
 
