@@ -6,6 +6,7 @@
 
 #include "contact/detection.hpp"
 #include "contact/potential_contact_kernels.hpp"
+#include "core/error.hpp"
 #include "core/tet_kernels.hpp"
 
 namespace fdem {
@@ -39,7 +40,11 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
 bool ContactStage::needed(const Model& model) {
   int free_pieces = 0;
   for (const PieceInfo& p : model.pieces) free_pieces += model.body_fixed[p.body] ? 0 : 1;
-  return model.pieces.size() >= 2 && free_pieces >= 1;
+  // A jointed body is one piece of many contact groups: its tets meet once joints break.
+  const bool grouped = model.tets.contact_group.size() > 0 &&
+                       *std::max_element(model.tets.contact_group.begin(),
+                                         model.tets.contact_group.end()) >= 1;
+  return (model.pieces.size() >= 2 || grouped) && free_pieces >= 1;
 }
 
 double ContactStage::critical_time_step(const Model& model) const {
@@ -84,13 +89,46 @@ bool ContactStage::detect_if_needed(const Model& model) {
   const TetArrays& tets = model.tets;
   const auto keep = [&](LocalIndex a, LocalIndex b) {
     const std::int32_t pa = tets.piece[a], pb = tets.piece[b];
-    return pa != pb && !(piece_fixed_[pa] && piece_fixed_[pb]);
+    if (tets.group_of(a) == tets.group_of(b) || (piece_fixed_[pa] && piece_fixed_[pb]))
+      return false;
+    if (bonds_.empty()) return true;
+    const LocalIndex* bonded = bonds_.data() + 4 * static_cast<std::size_t>(a);
+    return bonded[0] != b && bonded[1] != b && bonded[2] != b && bonded[3] != b;
   };
   detector_.detect(lo_.data(), hi_.data(), tets.size(), buffer_, pairs_, keep);
   x_at_detection_ = nodes.x;
   detected_ = true;
   ++detections_;
   return true;
+}
+
+void ContactStage::set_bonds(LocalIndex n_tets,
+                             const std::vector<std::pair<LocalIndex, LocalIndex>>& pairs) {
+  bonds_.assign(4 * static_cast<std::size_t>(n_tets), -1);
+  for (const auto& [a, b] : pairs) {
+    const LocalIndex tets[2] = {a, b};
+    for (int side = 0; side < 2; ++side) {
+      const LocalIndex t = tets[side], other = tets[1 - side];
+      FDEM_VERIFY(t >= 0 && t < n_tets, "bonded tet index");
+      LocalIndex* slot = bonds_.data() + 4 * static_cast<std::size_t>(t);
+      int k = 0;
+      while (k < 4 && slot[k] >= 0) ++k;
+      FDEM_VERIFY(k < 4, "a tet has at most four bonded faces");
+      slot[k] = other;
+    }
+  }
+  detected_ = false;
+}
+
+void ContactStage::release_bond(LocalIndex a, LocalIndex b) {
+  for (int side = 0; side < 2; ++side) {
+    const LocalIndex t = side == 0 ? a : b, other = side == 0 ? b : a;
+    if (bonds_.empty()) return;
+    for (int k = 0; k < 4; ++k)
+      if (bonds_[4 * static_cast<std::size_t>(t) + k] == other)
+        bonds_[4 * static_cast<std::size_t>(t) + k] = -1;
+  }
+  detected_ = false;
 }
 
 namespace {

@@ -48,6 +48,13 @@ class ContactStage {
   // Adds contact forces to model.nodes.f (pairs in ascending (gid, gid) order).
   ContactForceSummary add_forces(Model& model, double dt);
 
+  // Tets bonded by an intact cohesive joint never pair (the joint carries their load).  Pairs
+  // are model tet indices, at most 4 bonds per tet (one per face).
+  void set_bonds(LocalIndex n_tets, const std::vector<std::pair<LocalIndex, LocalIndex>>& pairs);
+  // A joint broke: its two tets become contact partners.  The next detect_if_needed() re-runs
+  // detection (the pair is already inside the buffer, so the buffer rule would not notice).
+  void release_bond(LocalIndex a, LocalIndex b);
+
   // Penalty (Pa) of each material as resolved (auto → 10 × Young's modulus).
   const std::vector<double>& material_penalty() const { return penalty_; }
   // Stable step (s) of the contact springs alone: a face pressed a depth d into a tet of altitude H
@@ -72,6 +79,7 @@ class ContactStage {
   // Friction history per pair, keyed by the two tets' global ids; kept across re-detection.
   std::unordered_map<std::uint64_t, FrictionHistory> friction_;
   std::vector<double> friction_coefficient_;
+  std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
   long detections_ = 0;
   bool detected_ = false;
 };

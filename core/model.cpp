@@ -27,6 +27,45 @@ void TetArrays::resize(LocalIndex n) {
   viscosity.resize(n);
 }
 
+void JointArrays::resize(LocalIndex n) {
+  gid.resize(n);
+  nodes.resize(6 * n);
+  tets.resize(2 * n);
+  area0.resize(n);
+  law.resize(n);
+  broken.resize(n, 0);
+  mode.resize(n, 0);
+  failure_time.resize(n, -1.0);
+  damage.resize(n, 0.0);
+}
+
+std::int32_t count_fragments(const Model& model) {
+  // Without joints the pieces at t = 0 are the connected components, and they stay so.
+  if (model.joints.size() == 0) return static_cast<std::int32_t>(model.pieces.size());
+  // Union-find over nodes: a tet links its four nodes; an intact joint links its two tets.
+  const LocalIndex n_nodes = model.nodes.size();
+  std::vector<LocalIndex> parent(n_nodes);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](LocalIndex i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  const auto unite = [&](LocalIndex a, LocalIndex b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  const TetArrays& tets = model.tets;
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    for (int c = 1; c < 4; ++c) unite(tets.nodes[4 * t], tets.nodes[4 * t + c]);
+  const JointArrays& joints = model.joints;
+  for (LocalIndex j = 0; j < joints.size(); ++j)
+    if (!joints.broken[j]) unite(joints.nodes[6 * j], joints.nodes[6 * j + 3]);
+  std::vector<char> is_root(n_nodes, 0);
+  for (LocalIndex t = 0; t < tets.size(); ++t) is_root[find(tets.nodes[4 * t])] = 1;
+  return static_cast<std::int32_t>(std::count(is_root.begin(), is_root.end(), 1));
+}
+
 void build_node_corner_map(const TetArrays& tets, LocalIndex n_nodes, NodeCornerMap& map) {
   const LocalIndex n_tets = tets.size();
   map.offsets.assign(n_nodes + 1, 0);

@@ -38,6 +38,43 @@ struct TetArrays {
   std::vector<std::int32_t> material;
   std::vector<std::int32_t> piece;
   std::vector<double> viscosity;  // Pa·s (0: undamped)
+  // Contact group: tets of one group never contact each other.  A body without joints is one
+  // group per piece; in a body with `joints: all` every tet is its own group (its neighbours are
+  // held by joints, and become contact partners when those break).  Empty: the piece is the group
+  // (models assembled by hand).  Not touched by resize().
+  std::vector<std::int32_t> contact_group;
+
+  LocalIndex size() const { return static_cast<LocalIndex>(gid.size()); }
+  void resize(LocalIndex n);
+  std::int32_t group_of(LocalIndex t) const {
+    return contact_group.empty() ? piece[t] : contact_group[t];
+  }
+};
+
+// What the builder resolved for one cohesive law (fracture/ turns it into a CohesiveLaw).
+struct JointLawSpec {
+  FractureSpec fracture;            // strengths, energies, softening (scene `fracture:` block)
+  double normal_penalty = 0.0;      // p_n (Pa): joint normal stiffness p_n/h (Pa/m)
+  double tangential_penalty = 0.0;  // p_t (Pa)
+  double element_size = 0.0;        // h (m)
+  std::string origin;               // "material 'rock'" or "interface 'a'-'b'", for messages
+};
+
+// Cohesive joints (docs/fracture-model.md): 6-node elements bonding face (a0, a1, a2) of tet A to
+// the coincident face (b0, b1, b2) of tet B; (a1 − a0) × (a2 − a0) points from A into B at t = 0.
+// Stored in ascending (gid of A, gid of B) with gid(A) < gid(B); the joint gid is that rank.
+// The cohesive history of each integration point lives in the fracture stage; the arrays below
+// hold what the rest of the engine reads (output, contact hand-over, fragments).
+struct JointArrays {
+  std::vector<GlobalId> gid;
+  std::vector<LocalIndex> nodes;     // 6 per joint: a0 a1 a2 b0 b1 b2
+  std::vector<LocalIndex> tets;      // 2 per joint: A, B
+  std::vector<double> area0;         // reference face area (m^2)
+  std::vector<std::int32_t> law;     // index into Model::joint_laws
+  std::vector<std::uint8_t> broken;  // 1 once all three points reached D = 1
+  std::vector<std::uint8_t> mode;    // FailureMode code (fracture/joint_kernels.hpp), 0 intact
+  std::vector<double> failure_time;  // s; −1 while intact
+  std::vector<double> damage;        // mean D of the three points (output)
 
   LocalIndex size() const { return static_cast<LocalIndex>(gid.size()); }
   void resize(LocalIndex n);
@@ -78,9 +115,15 @@ struct Model {
   std::vector<bool> body_fixed;
   NodeCornerMap node_corners;
   Vec3 gravity = Vec3::Zero();
+  JointArrays joints;
+  std::vector<JointLawSpec> joint_laws;
 };
 
 // Builds node_corners from tets (call after any change of the tet arrays).
 void build_node_corner_map(const TetArrays& tets, LocalIndex n_nodes, NodeCornerMap& map);
+
+// Discrete elements now: connected components of tets linked by a shared node or an intact
+// joint.  At t = 0 with intact joints this equals the number of pieces.
+std::int32_t count_fragments(const Model& model);
 
 }  // namespace fdem

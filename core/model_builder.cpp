@@ -1,7 +1,9 @@
 #include "core/model_builder.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <sstream>
 
@@ -47,6 +49,275 @@ MaterialProperties resolve_material(const MaterialSpec& spec) {
   m.damping_ratio = spec.damping;
   m.contact = spec.contact;
   return m;
+}
+
+// Joint penalty p_n = p_t = joint_penalty_factor × Young's modulus.  A joint acts like a layer of
+// modulus p and thickness h in series with the tets (Munjiza 2004, p. 79), so an intact jointed
+// mesh is softer than the continuum by about E/p: 50 E keeps the free–free axial frequency of a
+// jointed bar within 1 % of the continuous mesh (tests/verification/test_fracture.cpp), where
+// 10 E loses ~3 %.  The price is a ~√5 smaller stable step than 10 E would give.
+constexpr double joint_penalty_factor = 50.0;
+// Laws are shared by joints whose element size h falls in the same bin of this ratio (h is
+// rounded to the bin's centre, at most 1 % off), so a graded mesh needs few law objects.
+constexpr double element_size_bin_ratio = 1.02;
+
+// A triangular face of a tet in a body mesh: sorted mesh node ids, the tet, its fourth corner.
+struct MeshFace {
+  std::array<LocalIndex, 3> key;
+  LocalIndex tet;
+  std::int8_t opposite;
+};
+
+// All faces of a body mesh sorted by their node triple: interior faces appear twice in a row.
+std::vector<MeshFace> sorted_faces(const BodyMesh& mesh) {
+  const LocalIndex n_tets = static_cast<LocalIndex>(mesh.tets.size() / 4);
+  std::vector<MeshFace> faces;
+  faces.reserve(4 * static_cast<std::size_t>(n_tets));
+  for (LocalIndex t = 0; t < n_tets; ++t)
+    for (int skip = 0; skip < 4; ++skip) {
+      MeshFace f{{0, 0, 0}, t, static_cast<std::int8_t>(skip)};
+      int k = 0;
+      for (int c = 0; c < 4; ++c)
+        if (c != skip) f.key[k++] = mesh.tets[4 * t + c];
+      std::sort(f.key.begin(), f.key.end());
+      faces.push_back(f);
+    }
+  std::sort(faces.begin(), faces.end(), [](const MeshFace& a, const MeshFace& b) {
+    return a.key != b.key ? a.key < b.key : a.tet < b.tet;
+  });
+  return faces;
+}
+
+// A joint before ordering: tets A, B (model indices) and the model nodes of each face, b_i
+// coincident with a_i.
+struct JointDraft {
+  LocalIndex tet_a, tet_b;
+  LocalIndex a[3], b[3];
+  std::int32_t group;  // law group: material index, or n_materials + interface index
+};
+
+// Places the cohesive joints of `joints: all` bodies (every interior face) and of `interfaces:`
+// (boundary faces of body A coinciding with boundary faces of body B at t = 0), resolves their
+// laws, and stores them in model.joints in canonical order.
+void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
+                  const std::vector<std::vector<LocalIndex>>& model_tet, const Vec3& extent,
+                  Model& model) {
+  const std::int32_t n_materials = static_cast<std::int32_t>(scene.materials.size());
+  bool any = !scene.interfaces.empty();
+  for (const BodySpec& body : scene.bodies) any = any || body.joints == JointPlacement::all;
+  if (!any) return;
+
+  const TetArrays& tets = model.tets;
+  const NodeArrays& nodes = model.nodes;
+  // Model node of body b's mesh tet `local` at mesh node m.
+  const auto node_at = [&](std::size_t b, LocalIndex local, LocalIndex m) {
+    const LocalIndex t = model_tet[b][local];
+    for (int c = 0; c < 4; ++c)
+      if (meshes[b].tets[4 * local + c] == m) return tets.nodes[4 * t + c];
+    FDEM_VERIFY(false, "mesh node belongs to the tet");
+    return LocalIndex{-1};
+  };
+  std::vector<JointDraft> drafts;
+  // Joint between mesh tets (ba, la) and (bb, lb) over the face with mesh nodes ma (in body ba)
+  // coincident with mb (in body bb).
+  const auto add = [&](std::size_t ba, LocalIndex la, const LocalIndex(&ma)[3], std::size_t bb,
+                       LocalIndex lb, const LocalIndex(&mb)[3], std::int32_t group) {
+    JointDraft d;
+    d.tet_a = model_tet[ba][la];
+    d.tet_b = model_tet[bb][lb];
+    d.group = group;
+    for (int i = 0; i < 3; ++i) {
+      d.a[i] = node_at(ba, la, ma[i]);
+      d.b[i] = node_at(bb, lb, mb[i]);
+    }
+    if (tets.gid[d.tet_a] > tets.gid[d.tet_b]) {  // canonical: A has the smaller gid
+      std::swap(d.tet_a, d.tet_b);
+      for (int i = 0; i < 3; ++i) std::swap(d.a[i], d.b[i]);
+    }
+    // Orientation: (a1 − a0) × (a2 − a0) points out of A, away from A's fourth corner.
+    LocalIndex opposite = -1;
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = tets.nodes[4 * d.tet_a + c];
+      if (n != d.a[0] && n != d.a[1] && n != d.a[2]) opposite = n;
+    }
+    const Vec3 x0 = vec3_at(nodes.x0.data(), d.a[0]);
+    const Vec3 normal =
+        (vec3_at(nodes.x0.data(), d.a[1]) - x0).cross(vec3_at(nodes.x0.data(), d.a[2]) - x0);
+    if (normal.dot(vec3_at(nodes.x0.data(), opposite) - x0) > 0.0) {
+      std::swap(d.a[1], d.a[2]);
+      std::swap(d.b[1], d.b[2]);
+    }
+    drafts.push_back(d);
+  };
+
+  std::vector<std::vector<MeshFace>> faces(meshes.size());
+  for (std::size_t b = 0; b < meshes.size(); ++b) {
+    const bool jointed = scene.bodies[b].joints == JointPlacement::all;
+    bool in_interface = false;
+    for (const InterfaceSpec& i : scene.interfaces)
+      in_interface =
+          in_interface || i.body_a == static_cast<int>(b) || i.body_b == static_cast<int>(b);
+    if (!jointed && !in_interface) continue;
+    faces[b] = sorted_faces(meshes[b]);
+    const auto& f = faces[b];
+    for (std::size_t i = 0; i + 2 < f.size(); ++i)
+      if (f[i].key == f[i + 2].key) {
+        std::ostringstream msg;
+        msg << "body '" << scene.bodies[b].name << "' (" << meshes[b].source
+            << "): a triangle is shared by more than two tetrahedra (mesh nodes " << f[i].key[0] + 1
+            << ", " << f[i].key[1] + 1 << ", " << f[i].key[2] + 1
+            << "); joints need a conforming, manifold tetrahedral mesh";
+        throw InputError(msg.str());
+      }
+    if (!jointed) continue;
+    for (std::size_t i = 0; i + 1 < f.size(); ++i)
+      if (f[i].key == f[i + 1].key) {
+        const LocalIndex m[3] = {f[i].key[0], f[i].key[1], f[i].key[2]};
+        add(b, f[i].tet, m, b, f[i + 1].tet, m, scene.bodies[b].material);
+        ++i;
+      }
+  }
+
+  // Interfaces: match boundary nodes by position (tolerance 1e-9 of the model size), then faces.
+  const double tol = 1e-9 * std::max(extent.norm(), 1e-300);
+  for (std::size_t k = 0; k < scene.interfaces.size(); ++k) {
+    const InterfaceSpec& spec = scene.interfaces[k];
+    const std::size_t ba = spec.body_a, bb = spec.body_b;
+    const auto boundary = [&](std::size_t b) {
+      std::vector<MeshFace> out;
+      const auto& f = faces[b];
+      for (std::size_t i = 0; i < f.size(); ++i) {
+        const bool paired =
+            (i + 1 < f.size() && f[i + 1].key == f[i].key) || (i > 0 && f[i - 1].key == f[i].key);
+        if (!paired) out.push_back(f[i]);
+      }
+      return out;
+    };
+    const std::vector<MeshFace> faces_a = boundary(ba), faces_b = boundary(bb);
+    // Hash grid of B's boundary nodes with cells of size tol: a match lies in a neighbour cell.
+    const auto cell_of = [&](const Vec3& x) {
+      return std::array<std::int64_t, 3>{static_cast<std::int64_t>(std::floor(x[0] / tol)),
+                                         static_cast<std::int64_t>(std::floor(x[1] / tol)),
+                                         static_cast<std::int64_t>(std::floor(x[2] / tol))};
+    };
+    const double* xb = meshes[bb].coords.data();
+    const double* xa = meshes[ba].coords.data();
+    std::map<std::array<std::int64_t, 3>, std::vector<LocalIndex>> grid;
+    for (const MeshFace& f : faces_b)
+      for (LocalIndex m : f.key) {
+        auto& cell = grid[cell_of(vec3_at(xb, m))];
+        if (std::find(cell.begin(), cell.end(), m) == cell.end()) cell.push_back(m);
+      }
+    std::map<LocalIndex, LocalIndex> match;  // A's mesh node → B's coincident mesh node (or −1)
+    const auto partner = [&](LocalIndex m) {
+      const auto it = match.find(m);
+      if (it != match.end()) return it->second;
+      const Vec3 x = vec3_at(xa, m);
+      const auto c = cell_of(x);
+      LocalIndex found = -1;
+      for (int dx = -1; dx <= 1 && found < 0; ++dx)
+        for (int dy = -1; dy <= 1 && found < 0; ++dy)
+          for (int dz = -1; dz <= 1 && found < 0; ++dz) {
+            const auto g = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
+            if (g == grid.end()) continue;
+            for (LocalIndex n : g->second)
+              if ((vec3_at(xb, n) - x).norm() <= tol) found = n;
+          }
+      return match[m] = found;
+    };
+    std::map<std::array<LocalIndex, 3>, const MeshFace*> by_key;
+    for (const MeshFace& f : faces_b) by_key[f.key] = &f;
+    const std::size_t before = drafts.size();
+    for (const MeshFace& fa : faces_a) {
+      LocalIndex mb[3];
+      bool all = true;
+      for (int i = 0; i < 3; ++i) all = all && (mb[i] = partner(fa.key[i])) >= 0;
+      if (!all) continue;
+      std::array<LocalIndex, 3> key = {mb[0], mb[1], mb[2]};
+      std::sort(key.begin(), key.end());
+      const auto it = by_key.find(key);
+      if (it == by_key.end()) continue;  // three coincident nodes that are not one face of B
+      const LocalIndex ma[3] = {fa.key[0], fa.key[1], fa.key[2]};
+      add(ba, fa.tet, ma, bb, it->second->tet, mb, n_materials + static_cast<std::int32_t>(k));
+    }
+    if (drafts.size() == before) {
+      std::ostringstream msg;
+      msg << scene.source_path << ": interfaces[" << k << "] between '" << scene.bodies[ba].name
+          << "' and '" << scene.bodies[bb].name
+          << "': no boundary triangle of one body coincides with a boundary triangle of the other "
+             "at t = 0 (node tolerance "
+          << tol
+          << " m). Interface joints need conforming meshes: the two bodies must touch with "
+             "identical triangles (same three node positions), as box meshes sharing a face or "
+             "a Gmsh mesh with shared surfaces give.";
+      throw InputError(msg.str());
+    }
+  }
+
+  // Laws: one per (group, element-size bin).  h = mean of the two tets' altitudes onto the joint
+  // face, the thickness of the elements the joint layer sits between.
+  const auto material_of = [&](std::size_t b) { return scene.bodies[b].material; };
+  std::map<std::pair<std::int32_t, long>, std::int32_t> law_index;
+  std::vector<std::int32_t> joint_law(drafts.size());
+  std::vector<double> joint_area(drafts.size());
+  for (std::size_t j = 0; j < drafts.size(); ++j) {
+    const JointDraft& d = drafts[j];
+    const Vec3 a0 = vec3_at(nodes.x0.data(), d.a[0]);
+    const double area =
+        0.5 *
+        (vec3_at(nodes.x0.data(), d.a[1]) - a0).cross(vec3_at(nodes.x0.data(), d.a[2]) - a0).norm();
+    joint_area[j] = area;
+    const double h =
+        0.5 * (3.0 * tets.volume0[d.tet_a] / area + 3.0 * tets.volume0[d.tet_b] / area);
+    const long bin = std::lround(std::log(h) / std::log(element_size_bin_ratio));
+    const auto key = std::make_pair(d.group, bin);
+    auto it = law_index.find(key);
+    if (it == law_index.end()) {
+      JointLawSpec law;
+      double young;
+      if (d.group < n_materials) {
+        const MaterialSpec& m = scene.materials[d.group];
+        FDEM_VERIFY(m.fracture.has_value(), "joints: all needs a fracture block (reader checks)");
+        law.fracture = *m.fracture;
+        law.origin = "material '" + m.name + "'";
+        young = m.elastic.young;
+      } else {
+        const InterfaceSpec& spec = scene.interfaces[d.group - n_materials];
+        law.fracture = spec.fracture;
+        law.origin = "interface '" + scene.bodies[spec.body_a].name + "'-'" +
+                     scene.bodies[spec.body_b].name + "'";
+        young = std::min(scene.materials[material_of(spec.body_a)].elastic.young,
+                         scene.materials[material_of(spec.body_b)].elastic.young);
+      }
+      law.normal_penalty = law.tangential_penalty = joint_penalty_factor * young;
+      law.element_size = std::pow(element_size_bin_ratio, static_cast<double>(bin));
+      it = law_index.emplace(key, static_cast<std::int32_t>(model.joint_laws.size())).first;
+      model.joint_laws.push_back(law);
+    }
+    joint_law[j] = it->second;
+  }
+
+  // Canonical order: ascending (gid A, gid B).
+  std::vector<std::size_t> order(drafts.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
+    const GlobalId pa = tets.gid[drafts[p].tet_a], qa = tets.gid[drafts[q].tet_a];
+    return pa != qa ? pa < qa : tets.gid[drafts[p].tet_b] < tets.gid[drafts[q].tet_b];
+  });
+  JointArrays& joints = model.joints;
+  joints.resize(static_cast<LocalIndex>(drafts.size()));
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    const JointDraft& d = drafts[order[j]];
+    joints.gid[j] = static_cast<GlobalId>(j);
+    for (int i = 0; i < 3; ++i) {
+      joints.nodes[6 * j + i] = d.a[i];
+      joints.nodes[6 * j + 3 + i] = d.b[i];
+    }
+    joints.tets[2 * j] = d.tet_a;
+    joints.tets[2 * j + 1] = d.tet_b;
+    joints.area0[j] = joint_area[order[j]];
+    joints.law[j] = joint_law[order[j]];
+  }
 }
 
 }  // namespace
@@ -144,15 +415,34 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
                      [](const TetRecord& a, const TetRecord& b) { return a.key < b.key; });
   }
 
-  // Nodes get their ids in order of first use by the ordered tets.
+  // Nodes get their ids in order of first use by the ordered tets.  In a body with
+  // `joints: all` every tet owns its four nodes (the joints hold the copies together).
   const LocalIndex n_all_nodes = node_offset.back();
   std::vector<LocalIndex> new_node(n_all_nodes, -1);
+  std::vector<LocalIndex> node_source;  // old (body-offset) node of each model node
+  std::vector<LocalIndex> tet_node(4 * records.size());
   LocalIndex n_nodes = 0;
-  for (const auto& r : records)
+  for (std::size_t t = 0; t < records.size(); ++t) {
+    const auto& r = records[t];
+    const bool split = scene.bodies[r.body].joints == JointPlacement::all;
     for (int c = 0; c < 4; ++c) {
       const LocalIndex old = node_offset[r.body] + meshes[r.body].tets[4 * r.local + c];
-      if (new_node[old] < 0) new_node[old] = n_nodes++;
+      if (split) {
+        tet_node[4 * t + c] = n_nodes++;
+        node_source.push_back(old);
+        continue;
+      }
+      if (new_node[old] < 0) {
+        new_node[old] = n_nodes++;
+        node_source.push_back(old);
+      }
+      tet_node[4 * t + c] = new_node[old];
     }
+  }
+  std::vector<std::int32_t> node_body(n_all_nodes);
+  for (std::size_t b = 0; b < meshes.size(); ++b)
+    for (LocalIndex i = node_offset[b]; i < node_offset[b + 1]; ++i)
+      node_body[i] = static_cast<std::int32_t>(b);
 
   NodeArrays& nodes = model.nodes;
   nodes.resize(n_nodes);
@@ -162,13 +452,11 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
   std::fill(nodes.mass.begin(), nodes.mass.end(), 0.0);
   std::fill(nodes.constrained.begin(), nodes.constrained.end(), 0);
   std::fill(nodes.prescribed_velocity.begin(), nodes.prescribed_velocity.end(), 0.0);
-  for (std::size_t b = 0; b < meshes.size(); ++b) {
-    const LocalIndex n_body_nodes = node_offset[b + 1] - node_offset[b];
-    for (LocalIndex i = 0; i < n_body_nodes; ++i) {
-      const LocalIndex n = new_node[node_offset[b] + i];
-      if (n < 0) continue;  // node used by no tet
-      for (int k = 0; k < 3; ++k) nodes.x0[3 * n + k] = meshes[b].coords[3 * i + k];
-    }
+  for (LocalIndex n = 0; n < n_nodes; ++n) {
+    const LocalIndex old = node_source[n];
+    const std::int32_t b = node_body[old];
+    for (int k = 0; k < 3; ++k)
+      nodes.x0[3 * n + k] = meshes[b].coords[3 * (old - node_offset[b]) + k];
   }
   nodes.x = nodes.x0;
   for (LocalIndex n = 0; n < n_nodes; ++n) nodes.gid[n] = n;
@@ -186,7 +474,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     tets.piece[t] = r.piece;
     Vec3 X[4];
     for (int c = 0; c < 4; ++c) {
-      const LocalIndex n = new_node[node_offset[r.body] + meshes[r.body].tets[4 * r.local + c]];
+      const LocalIndex n = tet_node[4 * t + c];
       tets.nodes[4 * t + c] = n;
       X[c] = vec3_at(nodes.x0.data(), n);
       nodes.piece[n] = r.piece;
@@ -210,6 +498,19 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
   }
   for (auto& piece : model.pieces)
     if (piece.mass > 0.0) piece.centroid0 /= piece.mass;
+
+  // Contact groups: a piece, or a single tet of a jointed body.
+  tets.contact_group.resize(n_tets);
+  std::int32_t next_group = static_cast<std::int32_t>(model.pieces.size());
+  for (LocalIndex t = 0; t < n_tets; ++t)
+    tets.contact_group[t] = scene.bodies[records[t].body].joints == JointPlacement::all
+                                ? next_group++
+                                : records[t].piece;
+
+  std::vector<std::vector<LocalIndex>> model_tet(meshes.size());
+  for (std::size_t b = 0; b < meshes.size(); ++b) model_tet[b].resize(meshes[b].tets.size() / 4);
+  for (LocalIndex t = 0; t < n_tets; ++t) model_tet[records[t].body][records[t].local] = t;
+  place_joints(scene, meshes, model_tet, hi - lo, model);
 
   // Initial velocity: translation plus rotation about each piece's own centroid.
   for (LocalIndex n = 0; n < n_nodes; ++n) {

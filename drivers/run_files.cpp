@@ -1,5 +1,6 @@
 #include "drivers/run_files.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -8,6 +9,7 @@
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
 #include "drivers/simulation.hpp"
+#include "fracture/joint_kernels.hpp"
 
 namespace fdem {
 
@@ -82,10 +84,55 @@ void RunFiles::write_bodies_rows(double time, const Model& model) {
   bodies_.flush();
 }
 
+std::vector<double> tet_damage(const Model& model) {
+  std::vector<double> damage(model.tets.size(), 0.0);
+  const JointArrays& joints = model.joints;
+  for (LocalIndex j = 0; j < joints.size(); ++j) {
+    const double d = joints.broken[j] ? 1.0 : joints.damage[j];
+    for (int side = 0; side < 2; ++side) {
+      double& slot = damage[joints.tets[2 * j + side]];
+      slot = std::max(slot, d);
+    }
+  }
+  return damage;
+}
+
 void RunFiles::write_frame(double time, const Model& model, const std::vector<FrameField>& extra) {
   const std::string relative = frames_.next_frame_path() + ".vtu";
-  write_tet_frame((std::filesystem::path(directory_) / relative).string(), model, fields_, extra);
+  std::vector<FrameField> fields = extra;
+  if (std::find(fields_.begin(), fields_.end(), "damage") != fields_.end())
+    fields.push_back({"damage", 1, true, tet_damage(model)});
+  write_tet_frame((std::filesystem::path(directory_) / relative).string(), model, fields_, fields);
   frames_.add_frame(time, relative);
+  if (model.joints.size() > 0) write_cracks(time, model);
+}
+
+void RunFiles::write_cracks(double time, const Model& model) {
+  if (!cracks_) cracks_ = std::make_unique<SeriesWriter>(directory_, "cracks");
+  const JointArrays& joints = model.joints;
+  const double* x = model.nodes.x.data();
+  std::vector<double> points;
+  std::vector<std::int64_t> triangles;
+  std::vector<double> mode, failure_time, opening;
+  for (LocalIndex j = 0; j < joints.size(); ++j) {
+    if (!joints.broken[j]) continue;
+    const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
+    double gap = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      triangles.push_back(static_cast<std::int64_t>(points.size() / 3));
+      for (int k = 0; k < 3; ++k) points.push_back(x[3 * id[i] + k]);
+      gap += (vec3_at(x, id[3 + i]) - vec3_at(x, id[i])).norm() / 3.0;
+    }
+    mode.push_back(joints.mode[j]);
+    failure_time.push_back(joints.failure_time[j]);
+    opening.push_back(gap);
+  }
+  const std::string relative = cracks_->next_frame_path() + ".vtp";
+  write_triangle_frame((std::filesystem::path(directory_) / relative).string(), points, triangles,
+                       {{"mode", 1, true, mode},
+                        {"failure_time", 1, true, failure_time},
+                        {"opening", 1, true, opening}});
+  cracks_->add_frame(time, relative);
 }
 
 void RunFiles::write_contacts(double time, const std::vector<ContactRecord>& records) {
@@ -120,8 +167,19 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
   j << "  \"nodes\": " << model.nodes.size() << ",\n";
   j << "  \"elements\": " << model.tets.size() << ",\n";
   j << "  \"pieces\": " << model.pieces.size() << ",\n";
-  j << "  \"joints\": 0,\n";
-  j << "  \"broken_joints\": 0,\n";
+  const JointArrays& joints = model.joints;
+  long broken = 0, by_mode[3] = {0, 0, 0};  // tension, shear, mixed
+  for (LocalIndex i = 0; i < joints.size(); ++i) {
+    if (!joints.broken[i]) continue;
+    ++broken;
+    const auto mode = static_cast<FailureMode>(joints.mode[i]);
+    ++by_mode[mode == FailureMode::tension ? 0 : mode == FailureMode::shear ? 1 : 2];
+  }
+  j << "  \"joints\": " << joints.size() << ",\n";
+  j << "  \"broken_joints\": " << broken << ",\n";
+  j << "  \"broken_by_mode\": {\"tension\": " << by_mode[0] << ", \"shear\": " << by_mode[1]
+    << ", \"mixed\": " << by_mode[2] << "},\n";
+  j << "  \"fragments\": " << count_fragments(model) << ",\n";
   j << "  \"stages\": {";
   bool first = true;
   for (const auto& s : r.stages) {

@@ -22,7 +22,12 @@ class RunFiles {
   RunFiles(const std::string& directory, const std::vector<std::string>& fields);
   void write_energy_row(double time, const EnergyTerms& e, double balance_error);
   void write_bodies_rows(double time, const Model& model);
+  // A frame of the tets; with `damage` in the fields, the per-tet damage; in a model with joints
+  // also a frame of the "cracks" series (broken joint faces).
   void write_frame(double time, const Model& model, const std::vector<FrameField>& extra = {});
+  // Broken joint faces as triangles (face A's current position) with mode (FailureMode code),
+  // failure_time (s) and opening (mean gap |b_i − a_i|, m), as the "cracks" series.
+  void write_cracks(double time, const Model& model);
   // Contact points with their normal and tangential forces, as the "contacts" series.
   void write_contacts(double time, const std::vector<ContactRecord>& records);
   void write_summary(const RunReport& report, const Model& model, const std::string& scene_name);
@@ -33,8 +38,11 @@ class RunFiles {
   std::vector<std::string> fields_;
   std::ofstream energy_, bodies_;
   SeriesWriter frames_;
-  std::unique_ptr<SeriesWriter> contacts_;
+  std::unique_ptr<SeriesWriter> contacts_, cracks_;
 };
+
+// Per-tet damage: the largest damage of the tet's joints (0 for a tet without joints).
+std::vector<double> tet_damage(const Model& model);
 
 // JSON text of the run summary (also used by `fdem check --json` and tests).
 std::string summary_json(const RunReport& report, const Model& model,

@@ -13,6 +13,7 @@
 #include "core/time_step.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/run_files.hpp"
+#include "fracture/joint_stage.hpp"
 
 namespace fdem {
 
@@ -68,6 +69,20 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options)
     dt_critical_ =
         1.0 / std::sqrt(1.0 / (dt_critical_ * dt_critical_) + 1.0 / (dt_contact * dt_contact));
   }
+  plan_.joints = JointStage::needed(model_);
+  if (plan_.joints) {
+    joints_ = std::make_unique<JointStage>(model_);
+    const double dt_joint = joints_->critical_time_step(model_);  // joint springs add ω² too
+    dt_critical_ =
+        1.0 / std::sqrt(1.0 / (dt_critical_ * dt_critical_) + 1.0 / (dt_joint * dt_joint));
+    if (contact_) {  // tets bonded by an intact joint never pair in contact
+      std::vector<std::pair<LocalIndex, LocalIndex>> bonds;
+      for (LocalIndex j = 0; j < model_.joints.size(); ++j)
+        if (!model_.joints.broken[j])
+          bonds.emplace_back(model_.joints.tets[2 * j], model_.joints.tets[2 * j + 1]);
+      contact_->set_bonds(model_.tets.size(), bonds);
+    }
+  }
   dt_ = scene_.time.auto_step ? scene_.time.safety * dt_critical_ : scene_.time.step;
   if (!std::isfinite(dt_) || dt_ <= 0.0)
     throw InputError(scene_.source_path + ": could not determine a time step (critical step " +
@@ -92,7 +107,24 @@ void Simulation::step() {
   }
   energy.strain = forces.strain_energy;
 
-  // 2–3 joint forces and fracture: run when the plan needs them (no joints yet in this version).
+  // 2 joint forces: cohesive joints in ascending joint gid
+  if (plan_.joints) {
+    JointStepSummary j;
+    {
+      Timed timed(clocks_[joints]);
+      j = joints_->add_forces(model_, time_);
+    }
+    energy.joint = j.stored_energy;
+    // The joints' dissipation covers x_{n-1} -> x_n, so all of it is "before" work at t_n.
+    energy.dissipated_fracture = ledger_.fracture.add(j.fracture_dissipated, 0.0);
+    energy.dissipated_friction = joint_friction_.add(j.friction_dissipated, 0.0);
+    // 3 fracture: the tets of newly broken joints become contact partners
+    if (j.newly_broken > 0 && contact_) {
+      Timed timed(clocks_[fracture]);
+      for (LocalIndex b : joints_->newly_broken())
+        contact_->release_bond(model_.joints.tets[2 * b], model_.joints.tets[2 * b + 1]);
+    }
+  }
 
   // 4 contact detection: only when a node has moved more than buffer/2 since the last one
   if (plan_.contact) {
@@ -105,7 +137,7 @@ void Simulation::step() {
     Timed timed(clocks_[contact]);
     const ContactForceSummary c = contact_->add_forces(model_, dt_);
     energy.contact = c.energy + c.friction_spring_energy;
-    energy.dissipated_friction =
+    energy.dissipated_friction +=
         ledger_.friction.add(c.friction_work_before, c.friction_work_after);
   }
 

@@ -16,6 +16,7 @@ namespace fdem {
 class SeriesWriter;
 class RunFiles;
 class ContactStage;
+class JointStage;
 
 struct RunOptions {
   std::string output_dir = "out";
@@ -76,6 +77,7 @@ class Simulation {
   double critical_time_step() const { return dt_critical_; }
   void set_time_step(double dt) { dt_ = dt; }
   const ContactStage* contact_stage() const { return contact_.get(); }
+  const JointStage* joint_stage() const { return joints_.get(); }
   RunReport report() const;
 
  private:
@@ -109,6 +111,8 @@ class Simulation {
   double next_frame_time_ = 0.0, next_energy_time_ = 0.0;
   std::unique_ptr<RunFiles> files_;
   std::unique_ptr<ContactStage> contact_;
+  std::unique_ptr<JointStage> joints_;
+  WorkAccumulator joint_friction_;  // Coulomb slip inside joints (part of dissipated_friction)
 };
 
 // Builds a Simulation from a scene file (meshes loaded or generated).

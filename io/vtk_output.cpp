@@ -204,4 +204,38 @@ void write_point_frame(const std::string& path, const std::vector<double>& point
   std::filesystem::rename(tmp, path);
 }
 
+void write_triangle_frame(const std::string& path, const std::vector<double>& points,
+                          const std::vector<std::int64_t>& triangles,
+                          const std::vector<FrameField>& cell_fields) {
+  const vtkIdType n_points = static_cast<vtkIdType>(points.size() / 3);
+  const vtkIdType n_cells = static_cast<vtkIdType>(triangles.size() / 3);
+  vtkNew<vtkPolyData> poly;
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(n_points);
+  for (vtkIdType i = 0; i < n_points; ++i) pts->SetPoint(i, &points[3 * i]);
+  vtkNew<vtkCellArray> polys;
+  for (vtkIdType t = 0; t < n_cells; ++t) {
+    const vtkIdType ids[3] = {triangles[3 * t], triangles[3 * t + 1], triangles[3 * t + 2]};
+    polys->InsertNextCell(3, ids);
+  }
+  poly->SetPoints(pts);
+  poly->SetPolys(polys);
+  for (const FrameField& f : cell_fields) {
+    FDEM_VERIFY(static_cast<vtkIdType>(f.values.size()) == n_cells * f.components,
+                "triangle field size");
+    auto a = make_array(f.name, f.components, n_cells);
+    for (vtkIdType i = 0; i < n_cells * f.components; ++i) a->SetValue(i, f.values[i]);
+    poly->GetCellData()->AddArray(a);
+  }
+  const std::string tmp = path + ".tmp";
+  vtkNew<vtkXMLPolyDataWriter> writer;
+  writer->SetFileName(tmp.c_str());
+  writer->SetInputData(poly);
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  if (writer->Write() != 1) throw std::runtime_error("VTK could not write " + tmp);
+  std::filesystem::rename(tmp, path);
+}
+
 }  // namespace fdem

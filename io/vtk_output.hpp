@@ -2,6 +2,7 @@
 // Each file is written under a temporary name and renamed, so a crash never leaves a torn frame.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,12 @@ void write_tet_frame(const std::string& path, const Model& model,
 // point).
 void write_point_frame(const std::string& path, const std::vector<double>& points,
                        const std::vector<FrameField>& point_fields);
+
+// Writes triangles (3 point indices each into `points`, 3 doubles per point) with per-triangle
+// arrays as a .vtp (VTK poly data).
+void write_triangle_frame(const std::string& path, const std::vector<double>& points,
+                          const std::vector<std::int64_t>& triangles,
+                          const std::vector<FrameField>& cell_fields);
 
 // Atomically replaces `path` with `content`.
 void write_file_atomically(const std::string& path, const std::string& content);

@@ -1,0 +1,102 @@
+#include "fracture/joint_stage.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "core/error.hpp"
+
+namespace fdem {
+
+namespace {
+
+CohesiveParameters parameters_of(const JointLawSpec& spec) {
+  CohesiveParameters p;
+  p.tensile_strength = spec.fracture.tensile_strength;
+  p.cohesion = spec.fracture.cohesion;
+  p.friction_angle_deg = spec.fracture.friction_angle_deg;
+  p.energy_I = spec.fracture.energy_I;
+  p.energy_II = spec.fracture.energy_II;
+  p.normal_penalty = spec.normal_penalty;
+  p.tangential_penalty = spec.tangential_penalty;
+  p.element_size = spec.element_size;
+  p.softening_a = spec.fracture.softening_a;
+  p.softening_b = spec.fracture.softening_b;
+  p.softening_c = spec.fracture.softening_c;
+  return p;
+}
+
+}  // namespace
+
+JointStage::JointStage(const Model& model) {
+  laws_.reserve(model.joint_laws.size());
+  for (const JointLawSpec& spec : model.joint_laws) {
+    try {
+      laws_.emplace_back(parameters_of(spec));
+    } catch (const InputError& e) {
+      throw InputError(spec.origin +
+                       " (joints with element size h = " + std::to_string(spec.element_size) +
+                       " m, penalty " + std::to_string(spec.normal_penalty) + " Pa): " + e.what());
+    }
+  }
+  history_.resize(model.joints.size());
+  const JointArrays& joints = model.joints;
+  for (LocalIndex j = 0; j < joints.size(); ++j) {
+    FDEM_VERIFY(joints.law[j] >= 0 && joints.law[j] < static_cast<int>(laws_.size()),
+                "joint law index");
+    if (joints.broken[j]) {
+      history_[j].broken = true;
+      history_[j].mode = static_cast<FailureMode>(joints.mode[j]);
+      history_[j].failure_time = joints.failure_time[j];
+      ++broken_;
+    }
+  }
+}
+
+JointStepSummary JointStage::add_forces(Model& model, double time) {
+  JointStepSummary out;
+  newly_broken_.clear();
+  JointArrays& joints = model.joints;
+  NodeArrays& nodes = model.nodes;
+  const LocalIndex n = joints.size();
+  for (LocalIndex j = 0; j < n; ++j) {
+    if (joints.broken[j]) continue;
+    const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
+    Vec3 x[6];
+    for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[i]);
+    JointHistory& h = history_[j];
+    const JointForce f = joint_force(x, joints.area0[j], laws_[joints.law[j]], h);
+    for (int i = 0; i < 6; ++i) vec3_at(nodes.f.data(), id[i]) += f.force[i];
+    out.stored_energy += f.stored_energy;
+    out.fracture_dissipated += f.fracture_energy;
+    out.friction_dissipated += f.friction_energy;
+    joints.damage[j] = h.damage();
+    if (f.newly_broken) {
+      h.failure_time = time;
+      joints.broken[j] = 1;
+      joints.mode[j] = static_cast<std::uint8_t>(h.mode);
+      joints.failure_time[j] = time;
+      newly_broken_.push_back(j);
+    }
+  }
+  broken_ += static_cast<LocalIndex>(newly_broken_.size());
+  out.newly_broken = static_cast<LocalIndex>(newly_broken_.size());
+  out.broken = broken_;
+  return out;
+}
+
+double JointStage::critical_time_step(const Model& model) const {
+  const JointArrays& joints = model.joints;
+  std::vector<double> stiffness(model.nodes.size(), 0.0);  // Σ 2k·A0/3 per node (N/m)
+  for (LocalIndex j = 0; j < joints.size(); ++j) {
+    const CohesiveLaw& law = laws_[joints.law[j]];
+    const double k =
+        2.0 * std::max(law.normal_stiffness(), law.tangential_stiffness()) * joints.area0[j] / 3.0;
+    for (int i = 0; i < 6; ++i) stiffness[joints.nodes[6 * j + i]] += k;
+  }
+  double omega2 = 0.0;
+  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
+    if (stiffness[n] > 0.0) omega2 = std::max(omega2, stiffness[n] / model.nodes.mass[n]);
+  return omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace fdem

@@ -1,0 +1,57 @@
+// Stages 2–3 of the step: forces of the cohesive joints (fracture/joint_kernels.hpp) added to the
+// nodes in ascending joint gid, and the fracture bookkeeping — newly broken joints get their
+// failure time and mode, and the caller hands their two tets over to contact.
+//
+// The cohesive history of every integration point lives here (one JointHistory per joint); the
+// model's JointArrays mirror what other parts read: broken flag, mode, failure time, damage.
+#pragma once
+
+#include <vector>
+
+#include "core/model.hpp"
+#include "fracture/joint_kernels.hpp"
+
+namespace fdem {
+
+struct JointStepSummary {
+  double stored_energy = 0.0;        // J held by the intact joints at the current positions
+  double fracture_dissipated = 0.0;  // J dissipated by bond degradation in this update
+  double friction_dissipated = 0.0;  // J dissipated by Coulomb slip inside joints in this update
+  LocalIndex newly_broken = 0;       // joints that broke in this update
+  LocalIndex broken = 0;             // broken joints in total
+};
+
+class JointStage {
+ public:
+  // Builds one CohesiveLaw per model.joint_laws entry; throws InputError (naming the material or
+  // interface) when a parameter set is invalid.
+  explicit JointStage(const Model& model);
+
+  static bool needed(const Model& model) { return model.joints.size() > 0; }
+
+  // Advances every intact joint to the current positions, adds its forces to model.nodes.f in
+  // ascending joint gid, and marks joints that break with `time` (s) and their failure mode.
+  // The dissipation terms cover the motion since the previous call, so for the trapezoid
+  // accumulators of core/energy.hpp they are all "before" work (see docs/fracture-model.md).
+  JointStepSummary add_forces(Model& model, double time);
+
+  // Joints (indices) that broke in the last add_forces call.
+  const std::vector<LocalIndex>& newly_broken() const { return newly_broken_; }
+
+  // Stable step (s) of the joint springs alone.  Each intact point couples a_i and b_i with a
+  // stiffness of at most max(k_n, k_t)·A0/3 (the frame terms vanish at zero gap when p_t = p_n);
+  // Gershgorin on M⁻¹K bounds ω² by max over nodes of Σ 2·k·A0/3 / m.  Combine with the other
+  // bounds by adding ω².
+  double critical_time_step(const Model& model) const;
+
+  const std::vector<CohesiveLaw>& laws() const { return laws_; }
+  const std::vector<JointHistory>& history() const { return history_; }
+
+ private:
+  std::vector<CohesiveLaw> laws_;
+  std::vector<JointHistory> history_;
+  std::vector<LocalIndex> newly_broken_;
+  LocalIndex broken_ = 0;
+};
+
+}  // namespace fdem
