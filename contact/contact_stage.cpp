@@ -21,6 +21,7 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   for (const MaterialProperties& m : model.materials) {
     penalty_.push_back(m.contact.auto_penalty ? auto_penalty_factor * m.young : m.contact.penalty);
     friction_coefficient_.push_back(m.contact.friction);
+    damping_ratio_.push_back(m.contact.damping);
   }
   piece_fixed_.resize(model.pieces.size());
   for (std::size_t p = 0; p < model.pieces.size(); ++p)
@@ -41,9 +42,9 @@ bool ContactStage::needed(const Model& model) {
   int free_pieces = 0;
   for (const PieceInfo& p : model.pieces) free_pieces += model.body_fixed[p.body] ? 0 : 1;
   // A jointed body is one piece of many contact groups: its tets meet once joints break.
-  const bool grouped = model.tets.contact_group.size() > 0 &&
-                       *std::max_element(model.tets.contact_group.begin(),
-                                         model.tets.contact_group.end()) >= 1;
+  const bool grouped =
+      model.tets.contact_group.size() > 0 &&
+      *std::max_element(model.tets.contact_group.begin(), model.tets.contact_group.end()) >= 1;
   return (model.pieces.size() >= 2 || grouped) && free_pieces >= 1;
 }
 
@@ -56,7 +57,8 @@ double ContactStage::critical_time_step(const Model& model) const {
     const double h = smallest_altitude(x);
     const double omega2 =
         96.0 * penalty_[tets.material[t]] / (model.materials[tets.material[t]].density * h * h);
-    dt = std::min(dt, 2.0 / std::sqrt(omega2));
+    const double xi = damping_ratio_[tets.material[t]];
+    dt = std::min(dt, 2.0 / std::sqrt(omega2) * (std::sqrt(1.0 + xi * xi) - xi));
   }
   return dt;
 }
@@ -173,17 +175,40 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += r.force_contactor[c];
       vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += r.force_target[c];
     }
+    Vec3 va[4], vb[4];
+    const double xi = std::max(damping_ratio_[ma], damping_ratio_[mb]);
+    if (mu > 0.0 || xi > 0.0)
+      for (int c = 0; c < 4; ++c) {
+        va[c] = vec3_at(nodes.v.data(), tets.nodes[4 * pair.a + c]);
+        vb[c] = vec3_at(nodes.v.data(), tets.nodes[4 * pair.b + c]);
+      }
+    if (xi > 0.0 && r.energy > 0.0 && r.normal_force > 0.0) {
+      // Normal dashpot c = 2ξ√(k m): k = F²/(2U) is the pair's secant stiffness (exact for U ∝ d²),
+      // m the reduced mass of the two tets (a fixed partner has infinite mass).  The dashpot never
+      // pulls harder than the elastic push, so it cannot make the contact sticky.
+      const double k = r.normal_force * r.normal_force / (2.0 * r.energy);
+      const double m_a = model.materials[ma].density * std::abs(tets.volume0[pair.a]);
+      const double m_b = model.materials[mb].density * std::abs(tets.volume0[pair.b]);
+      const bool a_fixed = piece_fixed_[tets.piece[pair.a]],
+                 b_fixed = piece_fixed_[tets.piece[pair.b]];
+      const double m = a_fixed ? m_b : b_fixed ? m_a : m_a * m_b / (m_a + m_b);
+      const double v_n = relative_velocity_at_centroid(r, va, vb).dot(r.normal);
+      const double f_n = std::max(-2.0 * xi * std::sqrt(k * m) * v_n,
+                                  -r.normal_force);  // on the contactor, along n
+      for (int c = 0; c < 4; ++c) {
+        vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) +=
+            r.centroid_weights_contactor[c] * f_n * r.normal;
+        vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) -=
+            r.centroid_weights_target[c] * f_n * r.normal;
+      }
+      out.damping_dissipated += -f_n * v_n * dt;
+    }
     Vec3 tangential = Vec3::Zero();
     if (mu > 0.0) {
       // Stick spring k_t = p·s (N/m) with s the pair's size: as stiff as the normal contact.
       const double size =
           std::cbrt(std::abs(tets.volume0[pair.a]) + std::abs(tets.volume0[pair.b]));
       const FrictionLaw law{mu, penalty * size};
-      Vec3 va[4], vb[4];
-      for (int c = 0; c < 4; ++c) {
-        va[c] = vec3_at(nodes.v.data(), tets.nodes[4 * pair.a + c]);
-        vb[c] = vec3_at(nodes.v.data(), tets.nodes[4 * pair.b + c]);
-      }
       FrictionHistory& history = friction_[key];
       const FrictionResult f =
           coulomb_friction(law, r, relative_velocity_at_centroid(r, va, vb), dt, history);

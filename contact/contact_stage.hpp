@@ -24,6 +24,7 @@ struct ContactForceSummary {
   double friction_work_before = 0.0, friction_work_after = 0.0;  // trapezoid halves (J)
   double friction_dissipated = 0.0;     // slip work + released stick-spring energy this step (J)
   double friction_spring_energy = 0.0;  // J stored in stick springs (part of the contact energy)
+  double damping_dissipated = 0.0;      // J dissipated by normal contact dashpots this step
   LocalIndex candidate_pairs = 0;
   LocalIndex active_pairs = 0;  // overlapping pairs
 };
@@ -78,7 +79,7 @@ class ContactStage {
   std::vector<ContactRecord> records_;
   // Friction history per pair, keyed by the two tets' global ids; kept across re-detection.
   std::unordered_map<std::uint64_t, FrictionHistory> friction_;
-  std::vector<double> friction_coefficient_;
+  std::vector<double> friction_coefficient_, damping_ratio_;
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
   long detections_ = 0;
   bool detected_ = false;

@@ -81,14 +81,6 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes) {
     for (int k = 0; k < 3; ++k) nodes.f[3 * n + k] += nodes.mass[n] * gravity[k];
 }
 
-double gravity_potential(const Vec3& gravity, const NodeArrays& nodes) {
-  double e = 0.0;
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n)
-    for (int k = 0; k < 3; ++k)
-      e -= nodes.mass[n] * gravity[k] * (nodes.x[3 * n + k] - nodes.x0[3 * n + k]);
-  return e;
-}
-
 IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
   IntegrationSummary out;
   double kinetic2 = 0.0, max_dx2 = 0.0;
@@ -107,6 +99,8 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
         out.constraint_work_after += 0.5 * reaction * dt * v_new;
       }
       kinetic2 += m * v_old * v_new;
+      out.momentum_before[k] += m * v_old;
+      out.momentum_after[k] += m * v_new;
       nodes.v[i] = v_new;
       const double dx = dt * v_new;
       nodes.x[i] += dx;

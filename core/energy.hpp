@@ -64,7 +64,7 @@ class EnergyLedger {
     return peak_scale_ > 0.0 ? std::abs(current_.total() - initial_total_) / peak_scale_ : 0.0;
   }
 
-  WorkAccumulator damping, friction, fracture, external;
+  WorkAccumulator damping, friction, fracture, external, gravity;
 
  private:
   EnergyTerms current_;

@@ -28,6 +28,7 @@ struct ContactSpec {
   bool auto_penalty = true;
   double penalty = 0.0;   // Pa, when not automatic
   double friction = 0.0;  // Coulomb coefficient μ
+  double damping = 0.0;   // normal viscous damping ratio of a contact pair (fraction of critical)
 };
 
 struct FractureSpec {

@@ -126,6 +126,8 @@ void Simulation::step() {
     }
   }
 
+  double contact_damping = 0.0;  // J dissipated by contact dashpots this step
+
   // 4 contact detection: only when a node has moved more than buffer/2 since the last one
   if (plan_.contact) {
     Timed timed(clocks_[detection]);
@@ -136,6 +138,7 @@ void Simulation::step() {
   if (plan_.contact) {
     Timed timed(clocks_[contact]);
     const ContactForceSummary c = contact_->add_forces(model_, dt_);
+    contact_damping = c.damping_dissipated;
     energy.contact = c.energy + c.friction_spring_energy;
     energy.dissipated_friction +=
         ledger_.friction.add(c.friction_work_before, c.friction_work_after);
@@ -145,7 +148,6 @@ void Simulation::step() {
   if (plan_.gravity) {
     Timed timed(clocks_[external]);
     add_gravity(model_.gravity, nodes);
-    energy.gravity = gravity_potential(model_.gravity, nodes);
   }
 
   // 7 integrate: central difference with prescribed velocities
@@ -161,8 +163,13 @@ void Simulation::step() {
 
   // Energy balance at t_n
   energy.kinetic = motion.kinetic_energy;
-  energy.dissipated_damping =
-      ledger_.damping.add(0.5 * forces.damping_power * dt_, 0.5 * forces.damping_power * dt_);
+  // Gravity potential = − its trapezoid work, ½dt·g·(Σm·v⁻ + Σm·v⁺) per step: exact for a constant
+  // g (−Σ m g·(x − x0)) and right when g changes in time (tilting tables).
+  if (plan_.gravity)
+    energy.gravity = -ledger_.gravity.add(0.5 * dt_ * model_.gravity.dot(motion.momentum_before),
+                                          0.5 * dt_ * model_.gravity.dot(motion.momentum_after));
+  const double damping_step = forces.damping_power * dt_ + contact_damping;
+  energy.dissipated_damping = ledger_.damping.add(0.5 * damping_step, 0.5 * damping_step);
   energy.external_work =
       ledger_.external.add(motion.constraint_work_before, motion.constraint_work_after);
   ledger_.record(energy);

@@ -317,7 +317,7 @@ MaterialSpec read_material(const Reader& r, const std::string& name, const YAML:
   }
   if (const YAML::Node c = node["contact"]) {
     const std::string cp = path + ".contact";
-    r.check_keys(c, cp, {"penalty", "friction"});
+    r.check_keys(c, cp, {"penalty", "friction", "damping"});
     if (c["penalty"] && !r.is_auto(c["penalty"])) {
       m.contact.auto_penalty = false;
       m.contact.penalty =
@@ -325,6 +325,13 @@ MaterialSpec read_material(const Reader& r, const std::string& name, const YAML:
     }
     if (c["friction"])
       m.contact.friction = r.non_negative(c["friction"], cp + ".friction", "friction coefficient");
+    if (c["damping"]) {
+      m.contact.damping = r.non_negative(c["damping"], cp + ".damping", "contact damping ratio");
+      if (m.contact.damping > 1.0)
+        r.fail(c["damping"], cp + ".damping",
+               Reader::format(m.contact.damping) +
+                   " is too large: the contact damping ratio must be <= 1 (critical)");
+    }
   }
   if (node["fracture"]) m.fracture = read_fracture(r, node["fracture"], path + ".fracture");
   return m;
