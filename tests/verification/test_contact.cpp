@@ -242,3 +242,69 @@ TEST_CASE("block on an incline slides with a = g(sinψ − cosψ·tanφ) (REFERE
   CHECK(std::abs(creep) < 0.05 * slide_off);
   CHECK(std::abs(firm) < 1e-6);
 }
+
+TEST_CASE("stacked blocks: shortening = σ(H/E + interface compliance), error ∝ E/p (REFERENCES 8)",
+          "[verification][contact]") {
+  // Three 0.1 m cubes (ν = 0) stacked on a fixed base, the top face pushed down slowly.  For the
+  // potential φ = 4 min λ a face pressed a depth d into a tet whose opposite node is H away stores
+  // U = 2pA d²(1/H_c + 1/H_t), so an interface between cells of height a closes d = σa/(8p): this
+  // is the "n·h/p" term of REFERENCES 8 for this contact law (h = a/8).
+  const double a = 0.1, E = 1e9, rho = 1000;
+  for (double penalty_ratio : {10.0, 100.0}) {
+    const double p = penalty_ratio * E;
+    Scene scene = basic_scene(0.03);
+    scene.materials.push_back(elastic_material(rho, E, 0.0, ElasticModel::st_venant_kirchhoff));
+    scene.materials[0].contact.auto_penalty = false;
+    scene.materials[0].contact.penalty = p;
+    scene.materials[0].damping = 0.3;
+    scene.materials[0].contact.damping = 0.3;
+    scene.time.safety = 0.5;
+    scene.bodies.push_back(box_body("base", Vec3(-0.1, -0.1, -a), Vec3(0.2, 0.2, 0), 3, 3, 1));
+    scene.bodies[0].fixed = true;
+    for (int i = 0; i < 3; ++i)
+      scene.bodies.push_back(box_body("block" + std::to_string(i), Vec3(0, 0, i * a),
+                                      Vec3(a, a, (i + 1) * a), 1, 1, 1));
+    LoadSpec push;  // top face moves down at 5 mm/s, sideways free
+    push.region = RegionSpec{Vec3(-1, -1, 3 * a - 1e-9), Vec3(1, 1, 3 * a + 1e-9)};
+    push.velocity = Vec3(0, 0, -0.005);
+    push.dof_mask = 4;
+    scene.loads.push_back(push);
+    auto sim = quiet_simulation(scene);
+    while (sim->time() < scene.time.end) sim->step();
+    // Stress from the contact forces on the top interface (between block1 and block2), and the
+    // shortening of the three blocks + 3 interfaces (block0 on the base is an interface too).
+    double force = 0;
+    for (const ContactRecord& r : sim->contact_stage()->records())
+      if (std::abs(r.point.z() - 2 * a) < 0.25 * a) force += std::abs(r.normal_force.z());
+    const double sigma = force / (a * a);
+    const double shortening = 0.005 * sim->time();
+    const double predicted = sigma * (3 * a / E + 3 * a / (8 * p));
+    INFO("p = " << penalty_ratio << " E: σ = " << sigma << " Pa, shortening " << shortening
+                << " m, predicted " << predicted << " m (interfaces " << 3 * sigma * a / (8 * p)
+                << " m)");
+    CHECK(shortening == Approx(predicted).epsilon(0.03));
+  }
+}
+
+TEST_CASE("oblique impact in gross slip: tangential restitution 1 − μ(1+e)/tanθ (REFERENCES 7)",
+          "[verification][contact]") {
+  // A block lands face-first on a fixed base at 45° (tanθ = 1 ≥ 3.5μ(1+e) for μ = 0.1).
+  const double mu = 0.1;
+  Scene scene = basic_scene(0.02);
+  scene.materials.push_back(elastic_material(2000, 1e8, 0.2));
+  scene.materials[0].contact.friction = mu;
+  scene.time.safety = 0.5;
+  scene.bodies.push_back(box_body("base", Vec3(-0.5, -0.5, -0.1), Vec3(0.5, 0.5, 0), 5, 5, 1));
+  scene.bodies[0].fixed = true;
+  scene.bodies.push_back(
+      box_body("block", Vec3(-0.1, -0.1, 0.001), Vec3(0.1, 0.1, 0.201), 2, 2, 2));
+  scene.bodies[1].velocity = Vec3(1, 0, -1);
+  auto sim = quiet_simulation(scene);
+  while (sim->time() < scene.time.end) sim->step();
+  REQUIRE(sim->energy().current().contact == 0.0);  // bounced off
+  const Vec3 v = piece_motions(sim->model())[1].velocity;
+  const double e = v.z() / 1.0, e_t = v.x() / 1.0;
+  const double predicted = 1 - mu * (1 + e) / 1.0;
+  INFO("normal restitution " << e << ", tangential " << e_t << ", predicted " << predicted);
+  CHECK(e_t == Approx(predicted).epsilon(0.03));
+}
