@@ -81,6 +81,36 @@ void ContactStage::compute_boxes(const Model& model) {
     }
 }
 
+namespace {
+
+// True if a face plane of one tet has every node of the other more than `distance` beyond it —
+// then the two tets are more than `distance` apart.
+bool tets_farther_than(const Model& model, LocalIndex a, LocalIndex b, double distance) {
+  Vec3 x[2][4];
+  for (int c = 0; c < 4; ++c) {
+    x[0][c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * a + c]);
+    x[1][c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * b + c]);
+  }
+  for (int side = 0; side < 2; ++side) {
+    const Vec3(&p)[4] = x[side];
+    const Vec3(&q)[4] = x[1 - side];
+    for (int k = 0; k < 4; ++k) {  // face opposite node k
+      const Vec3& o = p[(k + 1) % 4];
+      Vec3 n = (p[(k + 2) % 4] - o).cross(p[(k + 3) % 4] - o);
+      const double length = n.norm();
+      if (!(length > 0.0)) continue;
+      n /= length;
+      if (n.dot(p[k] - o) > 0.0) n = -n;  // outward
+      double nearest = n.dot(q[0] - o);
+      for (int c = 1; c < 4; ++c) nearest = std::min(nearest, n.dot(q[c] - o));
+      if (nearest > distance) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 bool ContactStage::detect_if_needed(const Model& model) {
   const NodeArrays& nodes = model.nodes;
   if (detected_ &&
@@ -98,6 +128,14 @@ bool ContactStage::detect_if_needed(const Model& model) {
     return bonded[0] != b && bonded[1] != b && bonded[2] != b && bonded[3] != b;
   };
   detector_.detect(lo_.data(), hi_.data(), tets.size(), buffer_, pairs_, keep);
+  // Narrow the list once per cycle: every point of a tet stays within buffer/2 of where it was at
+  // detection (a convex combination of node moves ≤ buffer/2), so a pair whose tets are now more
+  // than `buffer` apart cannot touch before the next detection.
+  pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                              [&](const CandidatePair& p) {
+                                return tets_farther_than(model, p.a, p.b, buffer_);
+                              }),
+               pairs_.end());
   x_at_detection_ = nodes.x;
   detected_ = true;
   ++detections_;
