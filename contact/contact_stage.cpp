@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <unordered_set>
 
 #include "contact/detection.hpp"
 #include "contact/potential_contact_kernels.hpp"
@@ -83,6 +84,10 @@ void ContactStage::compute_boxes(const Model& model) {
 
 namespace {
 
+inline std::uint64_t pair_key(GlobalId a, GlobalId b) {
+  return (static_cast<std::uint64_t>(a) << 32) ^ static_cast<std::uint64_t>(b);
+}
+
 // True if a face plane of one tet has every node of the other more than `distance` beyond it —
 // then the two tets are more than `distance` apart.
 bool tets_farther_than(const Model& model, LocalIndex a, LocalIndex b, double distance) {
@@ -136,6 +141,21 @@ bool ContactStage::detect_if_needed(const Model& model) {
                                 return tets_farther_than(model, p.a, p.b, buffer_);
                               }),
                pairs_.end());
+  // Stick springs of pairs that left the list are released (their energy is dissipated).
+  if (!friction_.empty()) {
+    std::unordered_set<std::uint64_t> kept;
+    kept.reserve(pairs_.size());
+    for (const CandidatePair& p : pairs_) kept.insert(pair_key(tets.gid[p.a], tets.gid[p.b]));
+    for (auto it = friction_.begin(); it != friction_.end();) {
+      if (kept.count(it->first)) {
+        ++it;
+      } else {
+        released_spring_energy_ +=
+            0.5 * it->second.stiffness * it->second.history.tangential_spring.squaredNorm();
+        it = friction_.erase(it);
+      }
+    }
+  }
   x_at_detection_ = nodes.x;
   detected_ = true;
   ++detections_;
@@ -171,18 +191,14 @@ void ContactStage::release_bond(LocalIndex a, LocalIndex b) {
   detected_ = false;
 }
 
-namespace {
-inline std::uint64_t pair_key(GlobalId a, GlobalId b) {
-  return (static_cast<std::uint64_t>(a) << 32) ^ static_cast<std::uint64_t>(b);
-}
-}  // namespace
-
 ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   ContactForceSummary out;
   const TetArrays& tets = model.tets;
   NodeArrays& nodes = model.nodes;
   records_.clear();
   out.candidate_pairs = static_cast<LocalIndex>(pairs_.size());
+  out.friction_dissipated = released_spring_energy_;
+  released_spring_energy_ = 0.0;
   for (const CandidatePair& pair : pairs_) {
     TetCorners a, b;
     for (int c = 0; c < 4; ++c) {
@@ -198,10 +214,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       if (mu > 0.0) {  // contact lost: the stick spring's energy is released (dissipated)
         const auto it = friction_.find(key);
         if (it != friction_.end()) {
-          const double size =
-              std::cbrt(std::abs(tets.volume0[pair.a]) + std::abs(tets.volume0[pair.b]));
           out.friction_dissipated +=
-              0.5 * penalty * size * it->second.tangential_spring.squaredNorm();
+              0.5 * it->second.stiffness * it->second.history.tangential_spring.squaredNorm();
           friction_.erase(it);
         }
       }
@@ -247,7 +261,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       const double size =
           std::cbrt(std::abs(tets.volume0[pair.a]) + std::abs(tets.volume0[pair.b]));
       const FrictionLaw law{mu, penalty * size};
-      FrictionHistory& history = friction_[key];
+      PairFriction& pair_friction = friction_[key];
+      pair_friction.stiffness = law.tangential_stiffness;
+      FrictionHistory& history = pair_friction.history;
       const FrictionResult f =
           coulomb_friction(law, r, relative_velocity_at_centroid(r, va, vb), dt, history);
       for (int c = 0; c < 4; ++c) {

@@ -78,7 +78,12 @@ class ContactStage {
   std::vector<CandidatePair> pairs_;
   std::vector<ContactRecord> records_;
   // Friction history per pair, keyed by the two tets' global ids; kept across re-detection.
-  std::unordered_map<std::uint64_t, FrictionHistory> friction_;
+  struct PairFriction {
+    FrictionHistory history;
+    double stiffness = 0.0;  // N/m, for the energy released when the pair ends
+  };
+  std::unordered_map<std::uint64_t, PairFriction> friction_;
+  double released_spring_energy_ = 0.0;  // J, springs of pairs dropped at the last detection
   std::vector<double> friction_coefficient_, damping_ratio_;
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
   long detections_ = 0;
