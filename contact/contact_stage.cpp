@@ -88,6 +88,19 @@ inline std::uint64_t pair_key(GlobalId a, GlobalId b) {
   return (static_cast<std::uint64_t>(a) << 32) ^ static_cast<std::uint64_t>(b);
 }
 
+// True if two tets have a node at the same reference position (nodes split from one mesh node).
+bool share_reference_node(const Model& model, LocalIndex a, LocalIndex b) {
+  const double* x0 = model.nodes.x0.data();
+  for (int i = 0; i < 4; ++i) {
+    const double* p = x0 + 3 * model.tets.nodes[4 * a + i];
+    for (int j = 0; j < 4; ++j) {
+      const double* q = x0 + 3 * model.tets.nodes[4 * b + j];
+      if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) return true;
+    }
+  }
+  return false;
+}
+
 // True if a face plane of one tet has every node of the other more than `distance` beyond it —
 // then the two tets are more than `distance` apart.
 bool tets_farther_than(const Model& model, LocalIndex a, LocalIndex b, double distance) {
@@ -130,7 +143,13 @@ bool ContactStage::detect_if_needed(const Model& model) {
       return false;
     if (bonds_.empty()) return true;
     const LocalIndex* bonded = bonds_.data() + 4 * static_cast<std::size_t>(a);
-    return bonded[0] != b && bonded[1] != b && bonded[2] != b && bonded[3] != b;
+    if (bonded[0] == b || bonded[1] == b || bonded[2] == b || bonded[3] == b) return false;
+    // Tets of one jointed continuum that met at a mesh node at t = 0 (their nodes were split
+    // from one) cannot overlap while all their joints hold: the joints carry that compression,
+    // and leaving them out keeps contact to the pairs around cracks.
+    if (joint_state_[a] == JointState::intact && joint_state_[b] == JointState::intact)
+      return !share_reference_node(model, a, b);
+    return true;
   };
   detector_.detect(lo_.data(), hi_.data(), tets.size(), buffer_, pairs_, keep);
   // Narrow the list once per cycle: every point of a tet stays within buffer/2 of where it was at
@@ -165,7 +184,9 @@ bool ContactStage::detect_if_needed(const Model& model) {
 void ContactStage::set_bonds(LocalIndex n_tets,
                              const std::vector<std::pair<LocalIndex, LocalIndex>>& pairs) {
   bonds_.assign(4 * static_cast<std::size_t>(n_tets), -1);
+  joint_state_.assign(n_tets, JointState::none);
   for (const auto& [a, b] : pairs) {
+    joint_state_[a] = joint_state_[b] = JointState::intact;
     const LocalIndex tets[2] = {a, b};
     for (int side = 0; side < 2; ++side) {
       const LocalIndex t = tets[side], other = tets[1 - side];
@@ -181,6 +202,7 @@ void ContactStage::set_bonds(LocalIndex n_tets,
 }
 
 void ContactStage::release_bond(LocalIndex a, LocalIndex b) {
+  if (!joint_state_.empty()) joint_state_[a] = joint_state_[b] = JointState::cracked;
   for (int side = 0; side < 2; ++side) {
     const LocalIndex t = side == 0 ? a : b, other = side == 0 ? b : a;
     if (bonds_.empty()) return;

@@ -86,6 +86,8 @@ class ContactStage {
   double released_spring_energy_ = 0.0;  // J, springs of pairs dropped at the last detection
   std::vector<double> friction_coefficient_, damping_ratio_;
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
+  enum class JointState : std::uint8_t { none, intact, cracked };  // of a tet's joints
+  std::vector<JointState> joint_state_;
   long detections_ = 0;
   bool detected_ = false;
 };
