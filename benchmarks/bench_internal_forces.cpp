@@ -1,7 +1,6 @@
 // Throughput of the element stages of a step on one core, against memory bandwidth:
-//   forces     compute_internal_forces + gather_corner_forces (the internal-force stage)
-//   compute    compute_internal_forces alone (12 corner doubles written per tet)
-//   gather     gather_corner_forces alone (per-node sums in canonical tet-gid order)
+//   forces     compute_internal_forces (the internal-force stage: per-tet forces added to the
+//              nodes in ascending tet gid)
 //   integrate  integrate_central_difference (per node; reported per tet of the same mesh)
 // for box meshes of ~1e4, 1e5, 1e6 tets (6 per cell), three element orders (space-filling curve,
 // the generator's lexicographic order, a random permutation of tets and nodes) and both elastic
@@ -179,11 +178,10 @@ struct ByteCount {
   double per_node = 0.0;
   double per_tet_step(double nodes_per_tet) const { return per_tet + per_node * nodes_per_tet; }
 };
-// compute: tet nodes 4×4 + dm_inv 72 + volume0 8 + material 4 + viscosity 8 + corner write 96;
-//          nodes x 24 (v is read only for damped tets; these are undamped).
-constexpr ByteCount compute_bytes{16 + 72 + 8 + 4 + 8 + 96, 24};
-// gather:  slots 4×4 + corner read 96; offsets 4 + f write 24.
-constexpr ByteCount gather_bytes{16 + 96, 4 + 24};
+// forces: tet order 4 + tet nodes 4×4 + dm_inv 72 + volume0 8 + material 4 + viscosity 8;
+//         nodes x 24 + f zeroed 24, read 24 and written 24 (v is read only for damped tets;
+//         these are undamped).
+constexpr ByteCount force_bytes{4 + 16 + 72 + 8 + 4 + 8, 24 + 24 + 24 + 24};
 // integrate (unconstrained nodes): mass 8 + mask 1 + f 24 + v 24+24 + x 24+24.
 constexpr ByteCount integrate_bytes{0, 8 + 1 + 24 + 48 + 48};
 
@@ -301,8 +299,7 @@ int main(int argc, char** argv) {
         perturb(model, cell_size, 777);
         const long n_tets = model.tets.size();
         const double nodes_per_tet = static_cast<double>(model.nodes.size()) / n_tets;
-        std::vector<double> corners;
-        const InternalForceSummary check = compute_internal_forces(model, corners);
+        const InternalForceSummary check = compute_internal_forces(model);
         if (!(check.min_jacobian > 0.0)) {
           std::fprintf(stderr, "perturbed state inverted a tet (J = %g)\n", check.min_jacobian);
           return 1;
@@ -313,36 +310,14 @@ int main(int argc, char** argv) {
           ByteCount bytes;
           bool per_material;
         };
-        const Stage stages[4] = {{"forces",
-                                  {compute_bytes.per_tet + gather_bytes.per_tet,
-                                   compute_bytes.per_node + gather_bytes.per_node},
-                                  true},
-                                 {"compute", compute_bytes, true},
-                                 {"gather", gather_bytes, false},
-                                 {"integrate", integrate_bytes, false}};
+        const Stage stages[2] = {{"forces", force_bytes, true}, {"integrate", integrate_bytes, false}};
         for (const Stage& stage : stages) {
           if (!stage.per_material && law != ElasticModel::neo_hookean) continue;
           const std::string name = stage.name;
           Timing timing;
           if (name == "forces") {
-            timing = time_per_call(
-                [&] {
-                  sink += compute_internal_forces(model, corners).strain_energy;
-                  gather_corner_forces(model.node_corners, corners, model.nodes.f);
-                },
-                min_seconds);
-          } else if (name == "compute") {
-            timing = time_per_call(
-                [&] { sink += compute_internal_forces(model, corners).strain_energy; },
-                min_seconds);
-          } else if (name == "gather") {
-            timing = time_per_call(
-                [&] {
-                  gather_corner_forces(model.node_corners, corners, model.nodes.f);
-                  sink += model.nodes.f[0];
-                },
-                min_seconds);
-          } else {
+            timing = time_per_call([&] { sink += compute_internal_forces(model).strain_energy; },
+                                   min_seconds);          } else {
             // A tiny step keeps the state (and the later stages' inputs) practically unchanged.
             timing = time_per_call(
                 [&] { sink += integrate_central_difference(1e-12, model.nodes).kinetic_energy; },

@@ -18,20 +18,19 @@ namespace {
 #endif
 
 template <class Material>
-FDEM_INLINE_CALLEES inline void tet_force_into(const Model& model, LocalIndex t,
-                                               const Material& material, double* corner,
-                                               InternalForceSummary& sum) {
-  const TetArrays& tets = model.tets;
-  const NodeArrays& nodes = model.nodes;
+FDEM_INLINE_CALLEES inline void add_tet_force(const TetArrays& tets, LocalIndex t,
+                                              const Material& material, NodeArrays& nodes,
+                                              InternalForceSummary& sum) {
   const double viscosity = tets.viscosity[t];
+  const LocalIndex* corner_node = tets.nodes.data() + 4 * static_cast<std::size_t>(t);
   Vec3 x[4], v[4];
-  for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * t + c]);
+  for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), corner_node[c]);
   // The kernel reads velocities only for viscous damping: skip that gather when undamped.
   if (viscosity > 0.0)
-    for (int c = 0; c < 4; ++c) v[c] = vec3_at(nodes.v.data(), tets.nodes[4 * t + c]);
-  const Eigen::Map<const Mat3> dm_inv(tets.dm_inv.data() + 9 * t);
+    for (int c = 0; c < 4; ++c) v[c] = vec3_at(nodes.v.data(), corner_node[c]);
+  const Eigen::Map<const Mat3> dm_inv(tets.dm_inv.data() + 9 * static_cast<std::size_t>(t));
   const TetForce out = tet_internal_force(x, v, dm_inv, tets.volume0[t], material, viscosity);
-  for (int c = 0; c < 4; ++c) vec3_at(corner, c) = out.force[c];
+  for (int c = 0; c < 4; ++c) vec3_at(nodes.f.data(), corner_node[c]) += out.force[c];
   sum.strain_energy += out.strain_energy;
   sum.damping_power += out.damping_power;
   if (!(out.jacobian >= sum.min_jacobian)) {  // NaN counts as worst
@@ -42,38 +41,20 @@ FDEM_INLINE_CALLEES inline void tet_force_into(const Model& model, LocalIndex t,
 
 }  // namespace
 
-InternalForceSummary compute_internal_forces(const Model& model,
-                                             std::vector<double>& corner_forces) {
+InternalForceSummary compute_internal_forces(Model& model) {
   const TetArrays& tets = model.tets;
-  const LocalIndex n_tets = tets.size();
-  corner_forces.resize(12 * static_cast<std::size_t>(n_tets));
+  NodeArrays& nodes = model.nodes;
+  std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
   InternalForceSummary sum;
-  for (LocalIndex t = 0; t < n_tets; ++t) {
+  // Tets in ascending global id: each node receives its contributions in that one order.
+  for (const LocalIndex t : model.tet_force_order) {
     const MaterialProperties& mat = model.materials[tets.material[t]];
-    double* corner = corner_forces.data() + 12 * static_cast<std::size_t>(t);
     if (mat.model == ElasticModel::neo_hookean)
-      tet_force_into(model, t, NeoHookean{mat.lame}, corner, sum);
+      add_tet_force(tets, t, NeoHookean{mat.lame}, nodes, sum);
     else
-      tet_force_into(model, t, StVenantKirchhoff{mat.lame}, corner, sum);
+      add_tet_force(tets, t, StVenantKirchhoff{mat.lame}, nodes, sum);
   }
   return sum;
-}
-
-void gather_corner_forces(const NodeCornerMap& map, const std::vector<double>& corner_forces,
-                          std::vector<double>& f) {
-  const LocalIndex n_nodes = static_cast<LocalIndex>(map.offsets.size()) - 1;
-  for (LocalIndex n = 0; n < n_nodes; ++n) {
-    double fx = 0.0, fy = 0.0, fz = 0.0;
-    for (LocalIndex s = map.offsets[n]; s < map.offsets[n + 1]; ++s) {
-      const double* c = corner_forces.data() + 3 * static_cast<std::size_t>(map.slots[s]);
-      fx += c[0];
-      fy += c[1];
-      fz += c[2];
-    }
-    f[3 * n] = fx;
-    f[3 * n + 1] = fy;
-    f[3 * n + 2] = fz;
-  }
 }
 
 void add_gravity(const Vec3& gravity, NodeArrays& nodes) {

@@ -15,13 +15,9 @@ struct InternalForceSummary {
   LocalIndex min_jacobian_tet = -1;
 };
 
-// Computes every tet's corner forces into corner_forces (12 doubles per tet, overwritten).
-InternalForceSummary compute_internal_forces(const Model& model,
-                                             std::vector<double>& corner_forces);
-
-// f[node] = Σ corner forces in ascending tet gid (overwrites f for every node in the map).
-void gather_corner_forces(const NodeCornerMap& map, const std::vector<double>& corner_forces,
-                          std::vector<double>& f);
+// Sets every node's force to the sum of its tets' internal forces, added in ascending tet global
+// id (model.tet_force_order) so the sum is the same whatever the local layout or rank.
+InternalForceSummary compute_internal_forces(Model& model);
 
 // Adds m·g to every node's force.
 void add_gravity(const Vec3& gravity, NodeArrays& nodes);

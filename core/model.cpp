@@ -66,20 +66,11 @@ std::int32_t count_fragments(const Model& model) {
   return static_cast<std::int32_t>(std::count(is_root.begin(), is_root.end(), 1));
 }
 
-void build_node_corner_map(const TetArrays& tets, LocalIndex n_nodes, NodeCornerMap& map) {
-  const LocalIndex n_tets = tets.size();
-  map.offsets.assign(n_nodes + 1, 0);
-  for (LocalIndex s = 0; s < 4 * n_tets; ++s) ++map.offsets[tets.nodes[s] + 1];
-  std::partial_sum(map.offsets.begin(), map.offsets.end(), map.offsets.begin());
-  // Visit tets in ascending global id so each row comes out sorted by gid.
-  std::vector<LocalIndex> order(n_tets);
+void build_tet_force_order(const TetArrays& tets, std::vector<LocalIndex>& order) {
+  order.resize(tets.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
             [&](LocalIndex a, LocalIndex b) { return tets.gid[a] < tets.gid[b]; });
-  std::vector<LocalIndex> fill(map.offsets.begin(), map.offsets.end() - 1);
-  map.slots.resize(4 * n_tets);
-  for (LocalIndex t : order)
-    for (int c = 0; c < 4; ++c) map.slots[fill[tets.nodes[4 * t + c]]++] = 4 * t + c;
 }
 
 }  // namespace fdem

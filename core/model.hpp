@@ -99,12 +99,6 @@ struct PieceInfo {
   Vec3 centroid0 = Vec3::Zero();  // mass-weighted reference centroid (m)
 };
 
-// Compressed rows: for each node, the (tet, corner) slots that put force on it, in ascending
-// tet global id.  Gathering in this order makes force sums independent of loop order and rank.
-struct NodeCornerMap {
-  std::vector<LocalIndex> offsets;  // n_nodes + 1
-  std::vector<LocalIndex> slots;    // 4*tet + corner
-};
 
 struct Model {
   NodeArrays nodes;
@@ -113,14 +107,16 @@ struct Model {
   std::vector<PieceInfo> pieces;
   std::vector<std::string> body_names;
   std::vector<bool> body_fixed;
-  NodeCornerMap node_corners;
+  // Local tets in ascending global id: the order in which element forces are added to nodes, so a
+  // node's force is the same sum in the same order on any rank and in any local layout.
+  std::vector<LocalIndex> tet_force_order;
   Vec3 gravity = Vec3::Zero();
   JointArrays joints;
   std::vector<JointLawSpec> joint_laws;
 };
 
-// Builds node_corners from tets (call after any change of the tet arrays).
-void build_node_corner_map(const TetArrays& tets, LocalIndex n_nodes, NodeCornerMap& map);
+// Builds tet_force_order from the tets' global ids (call after any change of the tet arrays).
+void build_tet_force_order(const TetArrays& tets, std::vector<LocalIndex>& order);
 
 // Discrete elements now: connected components of tets linked by a shared node or an intact
 // joint.  At t = 0 with intact joints this equals the number of pieces.

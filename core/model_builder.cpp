@@ -521,7 +521,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     vec3_at(nodes.v.data(), n) = body.velocity + body.angular_velocity.cross(r);
   }
 
-  build_node_corner_map(tets, n_nodes, model.node_corners);
+  build_tet_force_order(tets, model.tet_force_order);
   apply_constraints(scene, model);
   return model;
 }

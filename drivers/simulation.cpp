@@ -102,8 +102,7 @@ void Simulation::step() {
   InternalForceSummary forces;
   {
     Timed timed(clocks_[internal]);
-    forces = compute_internal_forces(model_, corner_forces_);
-    gather_corner_forces(model_.node_corners, corner_forces_, nodes.f);
+    forces = compute_internal_forces(model_);
   }
   energy.strain = forces.strain_energy;
 

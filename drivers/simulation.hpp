@@ -102,7 +102,6 @@ class Simulation {
   RunOptions options_;
   StagePlan plan_;
   EnergyLedger ledger_;
-  std::vector<double> corner_forces_;
   double time_ = 0.0;
   long steps_ = 0;
   double dt_ = 0.0, dt_critical_ = 0.0;

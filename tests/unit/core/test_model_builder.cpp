@@ -1,5 +1,6 @@
 // Model assembly: pieces, ordering, ids, masses, the canonical force-gather map.
 #include <catch2/catch.hpp>
+#include <random>
 #include <set>
 
 #include "core/dynamics.hpp"
@@ -59,14 +60,12 @@ TEST_CASE("build_model: masses, pieces, ids and gather map", "[model]") {
   double mass = 0;
   for (double m : model.nodes.mass) mass += m;
   CHECK(mass == Approx(2000.0 * (1.0 / 6 + 1.0 / 6 + 1.0 / 3)).epsilon(1e-14));
-  // gids are a permutation, rows of the gather map are sorted by tet gid
+  // gids are a permutation; forces are added in ascending tet gid
   std::set<GlobalId> ids(model.nodes.gid.begin(), model.nodes.gid.end());
   CHECK(ids.size() == 9);
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    for (LocalIndex s = model.node_corners.offsets[n] + 1; s < model.node_corners.offsets[n + 1];
-         ++s)
-      CHECK(model.tets.gid[model.node_corners.slots[s - 1] / 4] <
-            model.tets.gid[model.node_corners.slots[s] / 4]);
+  REQUIRE(model.tet_force_order.size() == 3);
+  for (std::size_t k = 1; k < model.tet_force_order.size(); ++k)
+    CHECK(model.tets.gid[model.tet_force_order[k - 1]] < model.tets.gid[model.tet_force_order[k]]);
   CHECK(linear_momentum(model.nodes).isApprox(mass * Vec3(1, 2, 3)));
 }
 
@@ -91,14 +90,12 @@ TEST_CASE("element order does not change the physics", "[model]") {
   Model a = build_model(scene, {two_pieces()}, ElementOrder::space_filling_curve);
   Model b = build_model(scene, {two_pieces()}, ElementOrder::as_given);
   REQUIRE(a.tets.size() == b.tets.size());
-  std::vector<double> corners;
   for (Model* m : {&a, &b}) {
     for (LocalIndex n = 0; n < m->nodes.size(); ++n) {
       const Vec3 X = vec3_at(m->nodes.x0.data(), n);
       vec3_at(m->nodes.x.data(), n) = X + 0.01 * Vec3(X.y() * X.z(), X.x() * X.x(), -X.y());
     }
-    compute_internal_forces(*m, corners);
-    gather_corner_forces(m->node_corners, corners, m->nodes.f);
+    compute_internal_forces(*m);
   }
   for (LocalIndex i = 0; i < a.nodes.size(); ++i)
     for (LocalIndex j = 0; j < b.nodes.size(); ++j)
@@ -113,4 +110,47 @@ TEST_CASE("morton keys preserve locality along each axis", "[model]") {
   CHECK(morton_key(Vec3(1, 0, 0), lo, hi) < morton_key(Vec3(0, 1, 0), lo, hi));
   CHECK(morton_key(Vec3(0, 1, 0), lo, hi) < morton_key(Vec3(0, 0, 1), lo, hi));
   CHECK(morton_key(Vec3(1, 1, 1), lo, hi) == 0x7fffffffffffffffULL);
+}
+
+TEST_CASE("nodal forces are bit-identical whatever the local order of the tets", "[model]") {
+  // The same tets (same gids) stored in reversed local order give the same bits: forces are added
+  // in ascending gid, not in storage order (the basis of rank-invariant results).
+  Scene scene = scene_for(1);
+  BodyMesh mesh;
+  mesh.source = "test";
+  for (int k = 0; k < 3; ++k)  // a 2x1x1 strip of Kuhn-like tets sharing nodes
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 3; ++i) mesh.coords.insert(mesh.coords.end(), {double(i), double(j), double(k)});
+  auto id = [](int i, int j, int k) { return static_cast<LocalIndex>((k * 2 + j) * 3 + i); };
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < 2; ++i) {
+      mesh.tets.insert(mesh.tets.end(), {id(i, 0, k), id(i + 1, 0, k), id(i, 1, k), id(i, 0, k + 1)});
+      mesh.tets.insert(mesh.tets.end(), {id(i + 1, 0, k), id(i + 1, 1, k), id(i, 1, k), id(i + 1, 0, k + 1)});
+    }
+  Model a = build_model(scene, {mesh});
+  Model b = a;
+  TetArrays& t = b.tets;
+  const LocalIndex n = t.size();
+  TetArrays reversed = t;
+  for (LocalIndex i = 0; i < n; ++i) {
+    const LocalIndex j = n - 1 - i;
+    reversed.gid[i] = t.gid[j];
+    for (int c = 0; c < 4; ++c) reversed.nodes[4 * i + c] = t.nodes[4 * j + c];
+    for (int c = 0; c < 9; ++c) reversed.dm_inv[9 * i + c] = t.dm_inv[9 * j + c];
+    reversed.volume0[i] = t.volume0[j];
+    reversed.material[i] = t.material[j];
+    reversed.piece[i] = t.piece[j];
+    reversed.viscosity[i] = t.viscosity[j];
+  }
+  b.tets = reversed;
+  build_tet_force_order(b.tets, b.tet_force_order);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  for (std::size_t i = 0; i < a.nodes.x.size(); ++i) a.nodes.x[i] = b.nodes.x[i] = a.nodes.x0[i] + u(rng);
+  compute_internal_forces(a);
+  compute_internal_forces(b);
+  double largest = 0;
+  for (double f : a.nodes.f) largest = std::max(largest, std::abs(f));
+  CHECK(largest > 0);
+  CHECK(a.nodes.f == b.nodes.f);  // bit for bit
 }
