@@ -6,8 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "contact/contact_stage.hpp"
 #include "core/error.hpp"
 #include "drivers/simulation.hpp"
+#include "fracture/joint_stage.hpp"
 #include "io/scene_reader.hpp"
 
 namespace {
@@ -41,6 +43,16 @@ int check(const fdem::Scene& scene) {
   std::printf("  time: end %g s, step %g s (%s; critical %g s), %ld steps\n", scene.time.end,
               sim->time_step(), scene.time.auto_step ? "auto" : "fixed", sim->critical_time_step(),
               static_cast<long>(scene.time.end / sim->time_step() + 0.999999));
+  if (const fdem::ContactStage* contact = sim->contact_stage()) {
+    std::printf("  contact: buffer %g m, penalties", contact->buffer());
+    for (std::size_t m = 0; m < model.materials.size(); ++m)
+      std::printf(" %s %g Pa%s", model.materials[m].name.c_str(), contact->material_penalty()[m],
+                  m + 1 < model.materials.size() ? "," : "");
+    std::printf("\n");
+  }
+  if (model.joints.size() > 0)
+    std::printf("  joints: %d cohesive joints, %zu laws\n", model.joints.size(),
+                sim->joint_stage() ? sim->joint_stage()->laws().size() : std::size_t{0});
   std::printf("  stages:\n");
   for (const auto& s : sim->plan().describe()) std::printf("    %s\n", s.c_str());
   return 0;
