@@ -1,0 +1,262 @@
+// The MPI layer: environment (init/finalize), a communicator value with the reductions and
+// gathers the engine needs, and the two failure paths of a parallel run.  Every MPI call of fdem
+// lives in parallel/; physics sees plain arrays.
+//
+// Failure paths (LAMMPS error->all / error->one):
+// - Collective: at a synchronisation point every rank calls `Communicator::check_errors` with
+//   its local error (or none).  If any rank failed, every rank throws the same exception type
+//   (InputError / NumericalFailure / std::logic_error for internal errors) carrying the message
+//   of the lowest failing rank, so all ranks leave the run together, print once, and finalize.
+//   Use it for everything that can be detected at a point all ranks reach: reading and checking
+//   the scene, building and partitioning the model, the per-step health check (NaN, inverted
+//   tets, energy balance), writing output and checkpoints.
+// - Abort now: `abort_all` prints the message with the rank and calls MPI_Abort with a non-zero
+//   code.  Use it where one rank alone finds an error that the others cannot learn about without
+//   a synchronisation point they may never reach (an exception inside a halo exchange, an
+//   internal invariant broken between two collectives, an exception that escapes to main on one
+//   rank only).  `MpiEnvironment` also installs a terminate handler that aborts all ranks.
+#pragma once
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <exception>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "core/error.hpp"
+
+namespace fdem {
+
+// Initialises MPI (thread level funneled: only the main thread calls MPI) and finalises it at
+// scope exit.  If MPI is already initialised (a test harness, a host program) it does neither.
+// If the scope is left by an exception that not every rank shares (see CollectiveFailure), the
+// destructor aborts all ranks instead of finalising, because MPI_Finalize would wait for ranks
+// that are blocked in a collective.
+class MpiEnvironment {
+ public:
+  MpiEnvironment(int* argc, char*** argv);
+  ~MpiEnvironment();
+  MpiEnvironment(const MpiEnvironment&) = delete;
+  MpiEnvironment& operator=(const MpiEnvironment&) = delete;
+
+  bool owns_mpi() const { return owns_; }
+  int thread_level() const { return provided_; }
+
+ private:
+  bool owns_ = false;
+  int provided_ = MPI_THREAD_SINGLE;
+};
+
+// What one rank found before a synchronisation point.
+enum class ErrorKind : std::int32_t { none = 0, input = 1, numerical = 2, internal = 3 };
+
+struct LocalError {
+  ErrorKind kind = ErrorKind::none;
+  std::string message;
+
+  bool failed() const { return kind != ErrorKind::none; }
+  // Classifies a caught exception: InputError → input, NumericalFailure → numerical, anything
+  // else → internal (its what(), or "unknown exception").
+  static LocalError from(std::exception_ptr error);
+};
+
+// Tag carried by the exceptions check_errors throws: every rank throws one at the same point.
+class CollectiveFailure {
+ public:
+  CollectiveFailure(int first_rank, int failed_ranks);
+  CollectiveFailure(const CollectiveFailure& other);
+  virtual ~CollectiveFailure();
+  int first_rank() const { return first_rank_; }      // lowest rank that failed
+  int failed_ranks() const { return failed_ranks_; }  // how many ranks failed at this point
+  static int live_count();  // collective exceptions alive in this process (for MpiEnvironment)
+
+ private:
+  int first_rank_;
+  int failed_ranks_;
+};
+
+class CollectiveInputError : public InputError, public CollectiveFailure {
+ public:
+  CollectiveInputError(const std::string& what, int first_rank, int failed_ranks)
+      : InputError(what), CollectiveFailure(first_rank, failed_ranks) {}
+};
+
+class CollectiveNumericalFailure : public NumericalFailure, public CollectiveFailure {
+ public:
+  CollectiveNumericalFailure(const std::string& what, int first_rank, int failed_ranks)
+      : NumericalFailure(what), CollectiveFailure(first_rank, failed_ranks) {}
+};
+
+class CollectiveInternalError : public std::logic_error, public CollectiveFailure {
+ public:
+  CollectiveInternalError(const std::string& what, int first_rank, int failed_ranks)
+      : std::logic_error(what), CollectiveFailure(first_rank, failed_ranks) {}
+};
+
+namespace detail {
+template <class T>
+MPI_Datatype mpi_type() {
+  static_assert(std::is_trivially_copyable_v<T>, "MPI helpers move plain values only");
+  if constexpr (std::is_same_v<T, double>)
+    return MPI_DOUBLE;
+  else if constexpr (std::is_same_v<T, float>)
+    return MPI_FLOAT;
+  else if constexpr (std::is_same_v<T, std::int32_t>)
+    return MPI_INT32_T;
+  else if constexpr (std::is_same_v<T, std::int64_t>)
+    return MPI_INT64_T;
+  else if constexpr (std::is_same_v<T, std::uint64_t>)
+    return MPI_UINT64_T;
+  else if constexpr (std::is_same_v<T, std::uint8_t>)
+    return MPI_UINT8_T;
+  else if constexpr (std::is_same_v<T, char>)
+    return MPI_CHAR;
+  else
+    return MPI_BYTE;  // other plain structs travel as bytes (count scaled by sizeof)
+}
+template <class T>
+constexpr int mpi_scale() {
+  return std::is_arithmetic_v<T> ? 1 : static_cast<int>(sizeof(T));
+}
+template <class T>
+constexpr bool reducible() {
+  return std::is_same_v<T, double> || std::is_same_v<T, float> || std::is_same_v<T, std::int32_t> ||
+         std::is_same_v<T, std::int64_t> || std::is_same_v<T, std::uint64_t>;
+}
+int checked_count(std::size_t n, int scale);  // n·scale as an MPI count, or an internal error
+}  // namespace detail
+
+// A communicator value (does not own the MPI_Comm).  All members except rank/size are
+// collective: every rank of the communicator must call them in the same order.
+class Communicator {
+ public:
+  explicit Communicator(MPI_Comm comm = MPI_COMM_WORLD);
+  static Communicator world() { return Communicator(MPI_COMM_WORLD); }
+
+  MPI_Comm handle() const { return comm_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  bool is_root() const { return rank_ == 0; }
+
+  void barrier() const;
+
+  // Reductions of one value (double, float, int32, int64, uint64).  min/max are order-free, so
+  // the same on any rank count; a floating-point sum depends on the rank count (use it for
+  // reports, not for anything that steers the run).
+  template <class T>
+  T min(T value) const {
+    return reduce(value, MPI_MIN);
+  }
+  template <class T>
+  T max(T value) const {
+    return reduce(value, MPI_MAX);
+  }
+  template <class T>
+  T sum(T value) const {
+    return reduce(value, MPI_SUM);
+  }
+  // Element-wise over a vector of the same length on every rank.
+  template <class T>
+  void sum_in_place(std::vector<T>& values) const {
+    reduce_in_place(values, MPI_SUM);
+  }
+  template <class T>
+  void max_in_place(std::vector<T>& values) const {
+    reduce_in_place(values, MPI_MAX);
+  }
+  template <class T>
+  void min_in_place(std::vector<T>& values) const {
+    reduce_in_place(values, MPI_MIN);
+  }
+
+  // One value per rank, in rank order, on every rank.
+  template <class T>
+  std::vector<T> allgather(const T& value) const;
+  // Every rank's array concatenated in rank order, on every rank; `counts` (optional) receives
+  // each rank's length.
+  template <class T>
+  std::vector<T> allgatherv(const std::vector<T>& local, std::vector<int>* counts = nullptr) const;
+
+  // Returns root's string on every rank.
+  std::string broadcast(const std::string& text, int root = 0) const;
+
+  // Collective failure check (see top of file).  Returns normally when no rank failed; else every
+  // rank throws the kind of the lowest failing rank with the message
+  // "rank R: <message>" (+ " (and K more ranks failed)" when several failed).
+  void check_errors(const LocalError& local) const;
+
+  // Runs `body` on every rank, catches what it throws, then check_errors.  `body` must not
+  // communicate on this communicator (a rank that threw would skip those calls).
+  template <class Body>
+  void run_collectively(Body&& body) const {
+    LocalError local;
+    try {
+      body();
+    } catch (...) {
+      local = LocalError::from(std::current_exception());
+    }
+    check_errors(local);
+  }
+
+  // Prints "fdem: rank R of N: <message>" to stderr and ends every rank (MPI_Abort(code)).
+  [[noreturn]] void abort_all(const std::string& message, int code = 1) const;
+
+ private:
+  template <class T>
+  T reduce(T value, MPI_Op op) const {
+    static_assert(detail::reducible<T>(), "reductions take double, float, int32, int64 or uint64");
+    T result{};
+    MPI_Allreduce(&value, &result, 1, detail::mpi_type<T>(), op, comm_);
+    return result;
+  }
+  template <class T>
+  void reduce_in_place(std::vector<T>& values, MPI_Op op) const {
+    static_assert(detail::reducible<T>(), "reductions take double, float, int32, int64 or uint64");
+    MPI_Allreduce(MPI_IN_PLACE, values.data(), detail::checked_count(values.size(), 1),
+                  detail::mpi_type<T>(), op, comm_);
+  }
+
+  MPI_Comm comm_;
+  int rank_ = 0;
+  int size_ = 1;
+};
+
+// abort_all on MPI_COMM_WORLD, usable where no Communicator is at hand (also when MPI is not
+// initialised: then it prints and exits with `code`).
+[[noreturn]] void abort_all_ranks(const std::string& message, int code = 1);
+
+template <class T>
+std::vector<T> Communicator::allgather(const T& value) const {
+  std::vector<T> all(static_cast<std::size_t>(size_));
+  const int n = detail::mpi_scale<T>();
+  MPI_Allgather(&value, n, detail::mpi_type<T>(), all.data(), n, detail::mpi_type<T>(), comm_);
+  return all;
+}
+
+template <class T>
+std::vector<T> Communicator::allgatherv(const std::vector<T>& local,
+                                        std::vector<int>* counts) const {
+  const int scale = detail::mpi_scale<T>();
+  const int my_count = detail::checked_count(local.size(), scale);
+  std::vector<int> raw_counts = allgather(my_count);
+  std::vector<int> displs(raw_counts.size(), 0);
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < raw_counts.size(); ++r) {
+    displs[r] = detail::checked_count(total, 1);
+    total += static_cast<std::size_t>(raw_counts[r]);
+  }
+  detail::checked_count(total, 1);
+  std::vector<T> all(total / static_cast<std::size_t>(scale));
+  MPI_Allgatherv(local.data(), my_count, detail::mpi_type<T>(), all.data(), raw_counts.data(),
+                 displs.data(), detail::mpi_type<T>(), comm_);
+  if (counts) {
+    counts->resize(raw_counts.size());
+    for (std::size_t r = 0; r < raw_counts.size(); ++r) (*counts)[r] = raw_counts[r] / scale;
+  }
+  return all;
+}
+
+}  // namespace fdem
