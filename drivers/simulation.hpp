@@ -106,6 +106,7 @@ class Simulation {
   long steps_ = 0;
   double dt_ = 0.0, dt_critical_ = 0.0;
   StageClock clocks_[n_stages];
+  double energy_floor_ = 0.0;  // J, see the constructor
   std::chrono::steady_clock::time_point wall_start_;
   double next_frame_time_ = 0.0, next_energy_time_ = 0.0;
   std::unique_ptr<RunFiles> files_;
