@@ -1,0 +1,238 @@
+// Communicator on 2–4 ranks: reductions, gathers, broadcast, collective failure, abort.
+// Only CHECK here (no REQUIRE): a rank leaving a test case early would skip its collectives.
+#include <catch2/catch.hpp>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "core/error.hpp"
+#include "parallel/communicator.hpp"
+
+using namespace fdem;
+
+namespace {
+
+// Every rank holds `value`: true on every rank iff all ranks hold the same value.
+template <class T>
+bool same_on_all_ranks(const Communicator& comm, T value) {
+  const auto all = comm.allgather(value);
+  for (const T& v : all)
+    if (!(v == value)) return false;
+  return true;
+}
+
+// Runs `body` collectively and returns what every rank caught: kind, message, first rank.
+struct Caught {
+  std::string type;
+  std::string message;
+  int first_rank = -1;
+  int failed_ranks = 0;
+};
+template <class Body>
+Caught collective(const Communicator& comm, Body&& body) {
+  Caught c;
+  try {
+    comm.run_collectively(body);
+    c.type = "none";
+  } catch (const CollectiveInputError& e) {
+    c = {"input", e.what(), e.first_rank(), e.failed_ranks()};
+  } catch (const CollectiveNumericalFailure& e) {
+    c = {"numerical", e.what(), e.first_rank(), e.failed_ranks()};
+  } catch (const CollectiveInternalError& e) {
+    c = {"internal", e.what(), e.first_rank(), e.failed_ranks()};
+  } catch (...) {
+    c.type = "other";
+  }
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("the runner has 2-4 ranks and MPI at thread level funneled or better", "[mpi]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  CHECK(comm.size() >= 2);
+  CHECK(comm.size() <= 4);
+  int provided = 0;
+  MPI_Query_thread(&provided);
+  CHECK(provided >= MPI_THREAD_FUNNELED);
+}
+
+TEST_CASE("a second MpiEnvironment leaves an initialised MPI alone", "[mpi]") {
+  int argc = 0;
+  char** argv = nullptr;
+  {
+    MpiEnvironment nested(&argc, &argv);
+    CHECK_FALSE(nested.owns_mpi());
+    CHECK(nested.thread_level() >= MPI_THREAD_FUNNELED);
+  }
+  int finalized = 1;
+  MPI_Finalized(&finalized);
+  CHECK(finalized == 0);
+  CHECK(Communicator::world().sum<std::int32_t>(1) == Communicator::world().size());
+}
+
+TEST_CASE("reductions give the exact value and agree on all ranks", "[mpi]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const int n = comm.size(), r = comm.rank();
+  // doubles: exactly representable, so the sum is exact in any order
+  CHECK(comm.min(0.5 + r) == 0.5);
+  CHECK(comm.max(0.5 + r) == n - 0.5);
+  CHECK(comm.sum(0.25 * (r + 1)) == 0.25 * n * (n + 1) / 2);
+  // 64-bit integers beyond 2^32
+  const std::int64_t big = std::int64_t{1} << 40;
+  CHECK(comm.sum<std::int64_t>(big * (r + 1)) == big * n * (n + 1) / 2);
+  CHECK(comm.min<std::int64_t>(-big * r) == -big * (n - 1));
+  CHECK(comm.max<std::int32_t>(r) == n - 1);
+  CHECK(comm.sum<std::uint64_t>(1) == static_cast<std::uint64_t>(n));
+  // element-wise over a vector
+  std::vector<double> v = {1.0 * r, -1.0 * r, 2.0};
+  comm.sum_in_place(v);
+  CHECK(v == std::vector<double>{n * (n - 1) / 2.0, -n * (n - 1) / 2.0, 2.0 * n});
+  std::vector<std::int64_t> m = {r, -r};
+  comm.max_in_place(m);
+  CHECK(m == std::vector<std::int64_t>{n - 1, 0});
+  comm.min_in_place(m);
+  CHECK(m == std::vector<std::int64_t>{n - 1, 0});
+  // a sum of inexact doubles is still one value on every rank
+  CHECK(same_on_all_ranks(comm, comm.sum(0.1 * (r + 1) / 3.0)));
+  comm.barrier();
+}
+
+TEST_CASE("allgather and allgatherv reassemble the global array in rank order", "[mpi]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const int n = comm.size(), r = comm.rank();
+  CHECK(comm.allgather(10 * r) == [&] {
+    std::vector<int> e;
+    for (int k = 0; k < n; ++k) e.push_back(10 * k);
+    return e;
+  }());
+  // rank r holds the global ids [r(r−1)/2, r(r+1)/2): rank 0 holds nothing
+  const std::int64_t begin = std::int64_t(r) * (r - 1) / 2;
+  std::vector<std::int64_t> local;
+  for (int k = 0; k < r; ++k) local.push_back(begin + k);
+  std::vector<int> counts;
+  const auto all = comm.allgatherv(local, &counts);
+  CHECK(all.size() == static_cast<std::size_t>(n * (n - 1) / 2));
+  bool in_order = true;
+  for (std::size_t i = 0; i < all.size(); ++i) in_order = in_order && all[i] == std::int64_t(i);
+  CHECK(in_order);
+  for (int k = 0; k < n; ++k) CHECK(counts[k] == k);
+  // plain structs travel as bytes
+  struct Entry {
+    std::int64_t gid;
+    double x[3];
+  };
+  std::vector<Entry> entries(2, Entry{r, {0.5 * r, 1.0, -1.0}});
+  entries[1].gid = 100 + r;
+  const auto gathered = comm.allgatherv(entries);
+  CHECK(gathered.size() == static_cast<std::size_t>(2 * n));
+  for (int k = 0; k < n && gathered.size() == std::size_t(2 * n); ++k) {
+    CHECK(gathered[2 * k].gid == k);
+    CHECK(gathered[2 * k + 1].gid == 100 + k);
+    CHECK(gathered[2 * k].x[0] == 0.5 * k);
+  }
+}
+
+TEST_CASE("broadcast of a string from any root", "[mpi]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const std::string mine = "scene of rank " + std::to_string(comm.rank()) + " ✓";
+  CHECK(comm.broadcast(mine) == "scene of rank 0 ✓");
+  const int last = comm.size() - 1;
+  CHECK(comm.broadcast(mine, last) == "scene of rank " + std::to_string(last) + " ✓");
+  CHECK(comm.broadcast(comm.rank() == 0 ? std::string() : mine).empty());
+}
+
+TEST_CASE("no error anywhere: check_errors returns on every rank", "[mpi][failure]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const Caught c = collective(comm, [] {});
+  CHECK(c.type == "none");
+}
+
+TEST_CASE("an input error on one rank: every rank throws it with that rank's message",
+          "[mpi][failure]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const int culprit = comm.size() - 1;
+  const Caught c = collective(comm, [&] {
+    if (comm.rank() == culprit)
+      throw InputError("scene.yaml:7: unknown key 'densty' in material 'rock' (valid: density)");
+  });
+  CHECK(c.type == "input");
+  CHECK(c.message ==
+        "rank " + std::to_string(culprit) +
+            ": scene.yaml:7: unknown key 'densty' in material 'rock' (valid: density)");
+  CHECK(c.first_rank == culprit);
+  CHECK(c.failed_ranks == 1);
+  // the exception is also an InputError, so existing handlers (exit code 2) catch it
+  bool is_input_error = false;
+  try {
+    comm.check_errors({ErrorKind::input, "x"});
+  } catch (const InputError&) {
+    is_input_error = true;
+  }
+  CHECK(is_input_error);
+  // the communicator is usable afterwards (no rank left behind in a collective)
+  CHECK(comm.sum<std::int32_t>(1) == comm.size());
+}
+
+TEST_CASE("two ranks fail at once: the lower rank's message wins on all ranks", "[mpi][failure]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const int high = comm.size() - 1, low = comm.size() - 2;
+  const Caught c = collective(comm, [&] {
+    if (comm.rank() == high) throw NumericalFailure("tet 17 inverted at step 300");
+    if (comm.rank() == low) throw InputError("mesh.msh: tet 9 has zero volume");
+  });
+  CHECK(c.type == "input");
+  CHECK(c.message == "rank " + std::to_string(low) +
+                         ": mesh.msh: tet 9 has zero volume (and 1 more rank failed)");
+  CHECK(c.first_rank == low);
+  CHECK(c.failed_ranks == 2);
+  CHECK(same_on_all_ranks(comm, c.message.size()));
+}
+
+TEST_CASE("numerical and internal failures keep their kind", "[mpi][failure]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const Caught numerical = collective(comm, [&] {
+    if (comm.rank() == 0) throw NumericalFailure("NaN velocity at node 12, step 40");
+  });
+  CHECK(numerical.type == "numerical");
+  CHECK(numerical.message == "rank 0: NaN velocity at node 12, step 40");
+  // every rank fails: rank 0 wins, the count says how many
+  const Caught internal = collective(comm, [&] {
+    throw std::logic_error("broken invariant on rank " + std::to_string(comm.rank()));
+  });
+  CHECK(internal.type == "internal");
+  const int others = comm.size() - 1;
+  CHECK(internal.message == "rank 0: broken invariant on rank 0 (and " + std::to_string(others) +
+                                " more rank" + (others > 1 ? "s" : "") + " failed)");
+  CHECK(internal.failed_ranks == comm.size());
+}
+
+// Hidden tests, run by tests/mpi/expect_abort.cmake: they must end every rank with a non-zero
+// exit and the message, while the other ranks wait in a collective (no hang).
+TEST_CASE("abort_all from one rank ends all ranks", "[.abort]") {
+  const Communicator comm = Communicator::world();
+  if (comm.rank() == comm.size() - 1) comm.abort_all("deliberate abort for the test", 3);
+  comm.barrier();  // the other ranks wait here forever unless the abort ends them
+  FAIL("a rank got past the barrier");
+}
+
+TEST_CASE("an exception escaping on one rank ends all ranks", "[.uncaught]") {
+  const Communicator comm = Communicator::world();
+  if (comm.rank() == comm.size() - 1) {
+    // through a noexcept frame: std::terminate, whose handler MpiEnvironment installed
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wterminate"
+    [&]() noexcept { throw std::runtime_error("deliberate escape for the test"); }();
+#pragma GCC diagnostic pop
+  }
+  comm.barrier();
+  FAIL("a rank got past the barrier");
+}
