@@ -194,6 +194,10 @@ TEST_CASE("METIS: one part, fewer tets than parts, tets without neighbours", "[p
   CHECK(std::set<std::int32_t>(eight.begin(), eight.end()).size() == 6);
   check_covers(partition_metis(g, 6), 6, 6);
   CHECK_THROWS_AS(partition_metis(g, 0), InputError);
+  // barely more tets than parts: METIS still gives every part a tet
+  const Model twelve = box_model(2, 1, 1);
+  for (int n_parts : {5, 7, 11})
+    check_covers(partition_metis(element_graph(twelve), n_parts), 12, n_parts);
   // a graph without edges (separate tets): METIS still balances the weights
   const Model many = box_model(6, 6, 6);
   ElementGraph loose = element_graph(many);
