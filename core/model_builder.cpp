@@ -89,6 +89,83 @@ std::vector<MeshFace> sorted_faces(const BodyMesh& mesh) {
   return faces;
 }
 
+// A pair of coincident boundary triangles of two pieces of one body mesh: mesh tets and mesh
+// nodes, b[i] at the position of a[i].
+struct TouchingFaces {
+  LocalIndex tet_a, tet_b;
+  LocalIndex a[3], b[3];
+};
+
+// Boundary triangles of a body mesh that coincide (node positions within tol) with a boundary
+// triangle of another piece of the same mesh, each touching pair once (`joints: interfaces`).
+std::vector<TouchingFaces> touching_piece_faces(const BodyMesh& mesh,
+                                                const std::vector<MeshFace>& faces, double tol) {
+  const LocalIndex n_nodes = static_cast<LocalIndex>(mesh.coords.size() / 3);
+  const auto tet_piece = connected_pieces(mesh.tets, n_nodes, nullptr);
+  const auto cell_of = [&](const Vec3& x) {
+    return std::array<std::int64_t, 3>{static_cast<std::int64_t>(std::floor(x[0] / tol)),
+                                       static_cast<std::int64_t>(std::floor(x[1] / tol)),
+                                       static_cast<std::int64_t>(std::floor(x[2] / tol))};
+  };
+  std::vector<const MeshFace*> boundary;
+  std::map<std::array<LocalIndex, 3>, const MeshFace*> by_key;
+  std::map<std::array<std::int64_t, 3>, std::vector<LocalIndex>> grid;
+  std::vector<std::int32_t> node_piece(n_nodes, -1);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const bool paired = (i + 1 < faces.size() && faces[i + 1].key == faces[i].key) ||
+                        (i > 0 && faces[i - 1].key == faces[i].key);
+    if (paired) continue;
+    boundary.push_back(&faces[i]);
+    by_key[faces[i].key] = &faces[i];
+    for (LocalIndex m : faces[i].key)
+      if (node_piece[m] < 0) {
+        node_piece[m] = tet_piece[faces[i].tet];
+        grid[cell_of(vec3_at(mesh.coords.data(), m))].push_back(m);
+      }
+  }
+  // Boundary nodes of piece `piece` at the position of mesh node m.
+  const auto coincident = [&](LocalIndex m, std::vector<LocalIndex>& out) {
+    out.clear();
+    const Vec3 x = vec3_at(mesh.coords.data(), m);
+    const auto c = cell_of(x);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto g = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (g == grid.end()) continue;
+          for (LocalIndex n : g->second)
+            if (node_piece[n] != node_piece[m] &&
+                (vec3_at(mesh.coords.data(), n) - x).norm() <= tol)
+              out.push_back(n);
+        }
+  };
+  std::vector<TouchingFaces> out;
+  std::vector<LocalIndex> first, second, third;
+  for (const MeshFace* f : boundary) {
+    const std::int32_t piece = tet_piece[f->tet];
+    coincident(f->key[0], first);
+    for (LocalIndex c0 : first) {
+      const std::int32_t other = node_piece[c0];
+      if (other < piece) continue;  // the pair is found from the lower piece
+      TouchingFaces t{f->tet, -1, {f->key[0], f->key[1], f->key[2]}, {c0, -1, -1}};
+      coincident(f->key[1], second);
+      coincident(f->key[2], third);
+      for (LocalIndex c : second)
+        if (node_piece[c] == other) t.b[1] = c;
+      for (LocalIndex c : third)
+        if (node_piece[c] == other) t.b[2] = c;
+      if (t.b[1] < 0 || t.b[2] < 0) continue;
+      std::array<LocalIndex, 3> key = {t.b[0], t.b[1], t.b[2]};
+      std::sort(key.begin(), key.end());
+      const auto it = by_key.find(key);
+      if (it == by_key.end()) continue;  // three coincident nodes that are not one triangle
+      t.tet_b = it->second->tet;
+      out.push_back(t);
+    }
+  }
+  return out;
+}
+
 // A joint before ordering: tets A, B (model indices) and the model nodes of each face, b_i
 // coincident with a_i.
 struct JointDraft {
@@ -105,7 +182,7 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
                   Model& model) {
   const std::int32_t n_materials = static_cast<std::int32_t>(scene.materials.size());
   bool any = !scene.interfaces.empty();
-  for (const BodySpec& body : scene.bodies) any = any || body.joints == JointPlacement::all;
+  for (const BodySpec& body : scene.bodies) any = any || body.joints != JointPlacement::none;
   if (!any) return;
 
   const TetArrays& tets = model.tets;
@@ -158,7 +235,8 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     for (const InterfaceSpec& i : scene.interfaces)
       in_interface =
           in_interface || i.body_a == static_cast<int>(b) || i.body_b == static_cast<int>(b);
-    if (!jointed && !in_interface) continue;
+    const bool bonded_pieces = scene.bodies[b].joints == JointPlacement::interfaces;
+    if (!jointed && !in_interface && !bonded_pieces) continue;
     faces[b] = sorted_faces(meshes[b]);
     const auto& f = faces[b];
     for (std::size_t i = 0; i + 2 < f.size(); ++i)
@@ -170,6 +248,18 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
             << "); joints need a conforming, manifold tetrahedral mesh";
         throw InputError(msg.str());
       }
+    if (bonded_pieces) {  // mortar: joints where the body's pieces touch at t = 0
+      const std::size_t before = drafts.size();
+      for (const TouchingFaces& t :
+           touching_piece_faces(meshes[b], f, 1e-9 * std::max(extent.norm(), 1e-300)))
+        add(b, t.tet_a, t.a, b, t.tet_b, t.b, scene.bodies[b].material);
+      if (drafts.size() == before)
+        throw InputError(scene.source_path + ": body '" + scene.bodies[b].name + "' (" +
+                         meshes[b].source +
+                         ") has joints: interfaces, but no two of its pieces share a triangle at "
+                         "t = 0. Touching pieces need identical triangles (a generated wall with "
+                         "mortar_gap 0, conforming cells) to be bonded.");
+    }
     if (!jointed) continue;
     for (std::size_t i = 0; i + 1 < f.size(); ++i)
       if (f[i].key == f[i + 1].key) {

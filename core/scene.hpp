@@ -2,6 +2,7 @@
 // io/scene_reader fills it from YAML; drivers/ turn it into a Model.
 #pragma once
 
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -54,14 +55,56 @@ struct BoxMeshSpec {
   int cells[3] = {1, 1, 1};
 };
 
+// A wall of rectangular units (bricks, stones) in courses; each unit is its own piece.  Units lie
+// along x, the wall's thickness is y, courses are stacked along z from `origin` (smallest x, y, z).
+struct WallMeshSpec {
+  enum class Bond { stack, running } bond = Bond::stack;
+  Vec3 unit = Vec3::Zero();    // unit size lx (along the wall), ly (thickness), lz (height), m
+  int courses = 1;             // number of courses (rows)
+  int units_per_course = 1;    // full units per course (running bond: n − 1 full + 2 half units)
+  double mortar_gap = 0.0;     // m between neighbouring units (head and bed joints)
+  int cells[3] = {2, 1, 1};    // box cells per full unit (running bond: cells[0] even)
+  Vec3 origin = Vec3::Zero();  // m
+};
+
+// An arch in the x–z plane (depth along y) of curved-wedge voussoirs with radial joints.  The
+// intrados circle has radius `radius` about `origin`; the arch spans y in [origin.y, + depth].
+struct ArchMeshSpec {
+  enum class Kind { semicircular, segmental } kind = Kind::semicircular;
+  double radius = 0.0;     // intrados radius (m)
+  double thickness = 0.0;  // radial (m)
+  double depth = 0.0;      // along y (m)
+  int voussoirs = 1;
+  double half_angle = M_PI / 2;  // rad: half the angle the arch subtends (semicircular: π/2)
+  bool abutments = false;        // a block under each springing
+  double abutment_width = 0.0;   // m along x at the foot, from the intrados springing point
+  double abutment_height = 0.0;  // m below the lower springing corner
+  int cells[3] = {2, 2, 1};      // per voussoir: radial, along the arc, depth
+  Vec3 origin = Vec3::Zero();    // centre of the intrados circle (m)
+};
+
+// A pier of `blocks` equal blocks stacked along z from `origin` (smallest x, y, z).
+struct TowerMeshSpec {
+  Vec3 block = Vec3::Zero();  // m
+  int blocks = 1;
+  int cells[3] = {2, 2, 2};  // box cells per block
+  Vec3 origin = Vec3::Zero();
+};
+
 struct MeshSpec {
-  enum class Kind { box, file } kind = Kind::box;
+  enum class Kind { box, file, wall, arch, tower } kind = Kind::box;
   BoxMeshSpec box;
   std::string file;      // resolved path
   std::string physical;  // optional 3D physical group
+  WallMeshSpec wall;
+  ArchMeshSpec arch;
+  TowerMeshSpec tower;
 };
 
-enum class JointPlacement { none, all };
+// none; all: every interior face of the mesh; interfaces: faces where different pieces of the
+// body touch at t = 0 (mortar between the units of a generated wall), law = the material's
+// fracture.
+enum class JointPlacement { none, all, interfaces };
 
 struct BodySpec {
   std::string name;
@@ -82,13 +125,42 @@ struct RegionSpec {
   Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // axis-aligned box (m), nodes inside at t = 0
 };
 
-// A kinematic load: prescribed velocity on the nodes of some bodies or of a region.  Components
-// given as null in the scene stay free (mask).
+// Ground acceleration record a(t) (m/s² after `scale`), linear between samples, zero outside.
+struct BaseMotionSpec {
+  std::string file;                  // resolved CSV path ("" when given in code)
+  std::vector<double> time;          // s, increasing (read from `file` when empty)
+  std::vector<double> acceleration;  // record units; × scale gives m/s²
+  Vec3 direction = Vec3::UnitX();    // unit vector
+  double scale = 1.0;
+};
+
+// Tilting table: gravity turns about `axis` (right hand) by rate·(t − start), at most `max`.
+struct TiltSpec {
+  Vec3 axis = Vec3::UnitY();  // unit vector
+  double rate = 0.0;          // rad/s
+  double max = 0.0;           // rad
+  double start = 0.0;         // s
+};
+
+// Uniform horizontal acceleration added to gravity: direction·min(rate·(t − start), max).
+struct RampSpec {
+  Vec3 direction = Vec3::UnitX();  // unit vector
+  double rate = 0.0;               // m/s³
+  double max = 0.0;                // m/s²
+  double start = 0.0;              // s
+};
+
+// A load: prescribed velocity on the nodes of some bodies or of a region (components given as
+// null in the scene stay free: mask), a base motion of some bodies, or a time-varying gravity.
 struct LoadSpec {
+  enum class Kind { velocity, base_motion, tilt, ramp } kind = Kind::velocity;
   std::vector<int> bodies;  // body indices (empty: use region)
   std::optional<RegionSpec> region;
   Vec3 velocity = Vec3::Zero();  // m/s
   unsigned dof_mask = 7;         // bit k set: component k prescribed
+  BaseMotionSpec base_motion;    // kind == base_motion (all components prescribed)
+  TiltSpec tilt;                 // kind == tilt
+  RampSpec ramp;                 // kind == ramp
 };
 
 struct OutputSpec {

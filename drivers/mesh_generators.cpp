@@ -1,6 +1,7 @@
 #include "drivers/mesh_generators.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -47,11 +48,153 @@ BodyMesh box_mesh(const BoxMeshSpec& box) {
   return mesh;
 }
 
+BodyMesh mapped_box_mesh(const int cells[3],
+                         const std::function<Vec3(double, double, double)>& map) {
+  BoxMeshSpec unit;
+  unit.min = Vec3::Zero();
+  unit.max = Vec3::Ones();
+  for (int k = 0; k < 3; ++k) unit.cells[k] = cells[k];
+  BodyMesh mesh = box_mesh(unit);
+  for (std::size_t n = 0; n < mesh.coords.size() / 3; ++n) {
+    const Vec3 x = map(mesh.coords[3 * n], mesh.coords[3 * n + 1], mesh.coords[3 * n + 2]);
+    for (int k = 0; k < 3; ++k) mesh.coords[3 * n + k] = x[k];
+  }
+  // A map may reverse orientation (a mirror, polar coordinates): restore positive volumes.
+  for (std::size_t t = 0; t < mesh.tets.size() / 4; ++t) {
+    Vec3 X[4];
+    for (int c = 0; c < 4; ++c) X[c] = vec3_at(mesh.coords.data(), mesh.tets[4 * t + c]);
+    if (tet_reference(X).volume < 0.0) std::swap(mesh.tets[4 * t + 2], mesh.tets[4 * t + 3]);
+  }
+  return mesh;
+}
+
+void append_piece(BodyMesh& mesh, const BodyMesh& piece) {
+  const LocalIndex offset = static_cast<LocalIndex>(mesh.coords.size() / 3);
+  mesh.coords.insert(mesh.coords.end(), piece.coords.begin(), piece.coords.end());
+  for (LocalIndex n : piece.tets) mesh.tets.push_back(offset + n);
+}
+
+namespace {
+
+BodyMesh unit_box(const Vec3& lo, const Vec3& size, int cx, int cy, int cz) {
+  BoxMeshSpec box;
+  box.min = lo;
+  box.max = lo + size;
+  box.cells[0] = cx;
+  box.cells[1] = cy;
+  box.cells[2] = cz;
+  return box_mesh(box);
+}
+
+}  // namespace
+
+BodyMesh wall_mesh(const WallMeshSpec& wall) {
+  const double lx = wall.unit.x(), g = wall.mortar_gap;
+  const int n = wall.units_per_course;
+  const bool running = wall.bond == WallMeshSpec::Bond::running;
+  if (!(wall.unit.minCoeff() > 0.0) || wall.courses < 1 || n < 1 || g < 0.0 ||
+      (running && (!(g < lx) || wall.cells[0] % 2 != 0)))
+    throw InputError(
+        "wall generator: needs unit sizes > 0, courses >= 1, units per course >= 1, "
+        "0 <= mortar gap (< unit length for running bond) and an even cells[0] for running bond");
+  BodyMesh mesh;
+  const Vec3 size = wall.unit;
+  const Vec3 half(0.5 * (lx - g), size.y(), size.z());
+  for (int course = 0; course < wall.courses; ++course) {
+    const double z = wall.origin.z() + course * (size.z() + g);
+    const Vec3 start(wall.origin.x(), wall.origin.y(), z);
+    if (!running || course % 2 == 0) {
+      for (int i = 0; i < n; ++i)
+        append_piece(mesh, unit_box(start + Vec3(i * (lx + g), 0, 0), size, wall.cells[0],
+                                    wall.cells[1], wall.cells[2]));
+      continue;
+    }
+    // Running bond: alternate courses start and end with a half unit (joints offset by half).
+    const int half_cells = wall.cells[0] / 2;
+    append_piece(mesh, unit_box(start, half, half_cells, wall.cells[1], wall.cells[2]));
+    const double first = half.x() + g;
+    for (int i = 0; i + 1 < n; ++i)
+      append_piece(mesh, unit_box(start + Vec3(first + i * (lx + g), 0, 0), size, wall.cells[0],
+                                  wall.cells[1], wall.cells[2]));
+    append_piece(mesh, unit_box(start + Vec3(first + (n - 1) * (lx + g), 0, 0), half, half_cells,
+                                wall.cells[1], wall.cells[2]));
+  }
+  mesh.source = std::string(running ? "running" : "stack") + " bond wall generator";
+  return mesh;
+}
+
+BodyMesh tower_mesh(const TowerMeshSpec& tower) {
+  if (!(tower.block.minCoeff() > 0.0) || tower.blocks < 1)
+    throw InputError("tower generator: needs block sizes > 0 and blocks >= 1");
+  BodyMesh mesh;
+  for (int i = 0; i < tower.blocks; ++i)
+    append_piece(mesh, unit_box(tower.origin + Vec3(0, 0, i * tower.block.z()), tower.block,
+                                tower.cells[0], tower.cells[1], tower.cells[2]));
+  mesh.source = "tower generator";
+  return mesh;
+}
+
+BodyMesh arch_mesh(const ArchMeshSpec& arch) {
+  const double R = arch.radius, t = arch.thickness, alpha = arch.half_angle;
+  const int n = arch.voussoirs;
+  if (!(R > 0.0) || !(t > 0.0) || !(arch.depth > 0.0) || n < 1 || !(alpha > 0.0) ||
+      alpha > 0.5 * M_PI + 1e-12 ||
+      (arch.abutments && (!(arch.abutment_width > 0.0) || !(arch.abutment_height > 0.0))))
+    throw InputError(
+        "arch generator: needs radius, thickness, depth > 0, voussoirs >= 1, a half angle in (0, "
+        "90] degrees and abutment width and height > 0");
+  const Vec3 o = arch.origin;
+  // Joint angles from the right springing (π/2 − α) to the left one (π/2 + α), one table so
+  // both voussoirs at a joint use the same angle.
+  std::vector<double> theta(n + 1);
+  for (int k = 0; k <= n; ++k) theta[k] = 0.5 * M_PI - alpha + 2.0 * alpha * k / n;
+  BodyMesh mesh;
+  for (int k = 0; k < n; ++k) {
+    const double a = theta[k], b = theta[k + 1];
+    append_piece(mesh, mapped_box_mesh(arch.cells, [&](double u, double v, double w) {
+                   const double r = R + u * t, angle = (1.0 - v) * a + v * b;
+                   return Vec3(o.x() + r * std::cos(angle), o.y() + w * arch.depth,
+                               o.z() + r * std::sin(angle));
+                 }));
+  }
+  if (arch.abutments) {
+    // Under each springing a four-sided block (extruded along y): its top is the springing face
+    // (same cells, so it conforms), its foot is horizontal, `height` below the inner corner.
+    const double c = std::cos(theta[0]), s = std::sin(theta[0]);
+    const double size = t / arch.cells[0];
+    const int cells[3] = {arch.cells[0],
+                          std::max(1, static_cast<int>(std::lround(arch.abutment_height / size))),
+                          arch.cells[2]};
+    for (double side : {1.0, -1.0}) {
+      const auto at = [&](double x_rel, double z_rel) {  // mirror x about the arch's axis
+        return Eigen::Vector2d(o.x() + side * x_rel, o.z() + z_rel);
+      };
+      const Eigen::Vector2d top_in = at(R * c, R * s), top_out = at((R + t) * c, (R + t) * s);
+      const Eigen::Vector2d foot_in = at(R * c, R * s - arch.abutment_height);
+      const Eigen::Vector2d foot_out =
+          at(R * c + arch.abutment_width, R * s - arch.abutment_height);
+      append_piece(mesh, mapped_box_mesh(cells, [&](double u, double v, double w) {
+                     const Eigen::Vector2d p = (1 - v) * ((1 - u) * foot_in + u * foot_out) +
+                                               v * ((1 - u) * top_in + u * top_out);
+                     return Vec3(p.x(), o.y() + w * arch.depth, p.y());
+                   }));
+    }
+  }
+  mesh.source = "arch generator";
+  return mesh;
+}
+
 std::vector<BodyMesh> load_body_meshes(const Scene& scene) {
   std::vector<BodyMesh> meshes;
   for (const BodySpec& body : scene.bodies) {
     if (body.mesh.kind == MeshSpec::Kind::box) {
       meshes.push_back(box_mesh(body.mesh.box));
+    } else if (body.mesh.kind == MeshSpec::Kind::wall) {
+      meshes.push_back(wall_mesh(body.mesh.wall));
+    } else if (body.mesh.kind == MeshSpec::Kind::arch) {
+      meshes.push_back(arch_mesh(body.mesh.arch));
+    } else if (body.mesh.kind == MeshSpec::Kind::tower) {
+      meshes.push_back(tower_mesh(body.mesh.tower));
     } else {
       const GmshMesh g = read_gmsh(body.mesh.file, body.mesh.physical);
       BodyMesh mesh;

@@ -11,6 +11,7 @@
 #include "core/model_builder.hpp"
 #include "core/state_hash.hpp"
 #include "core/time_step.hpp"
+#include "drivers/loads.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/run_files.hpp"
 #include "fracture/joint_stage.hpp"
@@ -56,7 +57,8 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options)
                                  "contact_detection", "contact_forces", "external_forces",
                                  "integrate",         "halo_update",    "output"};
   for (int s = 0; s < n_stages; ++s) clocks_[s].name = names[s];
-  plan_.gravity = scene_.gravity.squaredNorm() > 0.0;
+  loads_ = std::make_unique<LoadSchedule>(scene_, model_);
+  plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
   plan_.kinematic_loads = !scene_.loads.empty();
 
   plan_.contact = ContactStage::needed(model_);
@@ -101,6 +103,12 @@ Simulation::~Simulation() = default;
 void Simulation::step() {
   NodeArrays& nodes = model_.nodes;
   EnergyTerms energy;
+
+  // 0 time-dependent loads: gravity (tilt, ramp) at t_n, base velocities for the coming half step
+  if (loads_->active()) {
+    Timed timed(clocks_[external]);
+    loads_->apply(time_, dt_, model_);
+  }
 
   // 1 internal forces: F = Ds·Dm⁻¹, stress, corner forces gathered per node in tet-gid order
   InternalForceSummary forces;

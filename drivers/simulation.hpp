@@ -17,6 +17,7 @@ class SeriesWriter;
 class RunFiles;
 class ContactStage;
 class JointStage;
+class LoadSchedule;
 
 struct RunOptions {
   std::string output_dir = "out";
@@ -112,6 +113,7 @@ class Simulation {
   std::unique_ptr<RunFiles> files_;
   std::unique_ptr<ContactStage> contact_;
   std::unique_ptr<JointStage> joints_;
+  std::unique_ptr<LoadSchedule> loads_;  // time-dependent loads (drivers/loads)
   WorkAccumulator joint_friction_;  // Coulomb slip inside joints (part of dissipated_friction)
 };
 

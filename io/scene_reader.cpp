@@ -337,12 +337,171 @@ MaterialSpec read_material(const Reader& r, const std::string& name, const YAML:
   return m;
 }
 
+// [nx, ny, nz] positive integers (cells per generated unit).
+void read_cells(const Reader& r, const YAML::Node& cells, const std::string& path, int out[3]) {
+  if (!cells.IsSequence() || cells.size() != 3)
+    r.fail(cells, path, "expected three integers [nx, ny, nz]");
+  for (int k = 0; k < 3; ++k) {
+    out[k] = r.integer(cells[k], path);
+    if (out[k] < 1) r.fail(cells[k], path, "each cell count must be >= 1");
+  }
+}
+
+// Three positive sizes [x, y, z] (m).
+Vec3 read_size(const Reader& r, const YAML::Node& node, const std::string& path) {
+  const Vec3 size = r.vec3(node, path);
+  if (!(size.minCoeff() > 0.0)) r.fail(node, path, "each size must be > 0 (m)");
+  return size;
+}
+
+int positive_count(const Reader& r, const YAML::Node& node, const std::string& path,
+                   const std::string& what) {
+  const int n = r.integer(node, path);
+  if (n < 1) r.fail(node, path, std::to_string(n) + " is impossible: " + what + " must be >= 1");
+  return n;
+}
+
+WallMeshSpec read_wall(const Reader& r, const YAML::Node& w, const std::string& path) {
+  r.check_keys(w, path,
+               {"unit", "courses", "length", "units_per_course", "bond", "mortar_gap",
+                "cells_per_unit", "origin"},
+               {"unit", "courses"});
+  WallMeshSpec wall;
+  wall.unit = read_size(r, w["unit"], path + ".unit");
+  wall.courses = positive_count(r, w["courses"], path + ".courses", "the number of courses");
+  if (w["bond"])
+    wall.bond = r.choice(w["bond"], path + ".bond", {"stack", "running"}) == "running"
+                    ? WallMeshSpec::Bond::running
+                    : WallMeshSpec::Bond::stack;
+  if (w["mortar_gap"])
+    wall.mortar_gap = r.non_negative(w["mortar_gap"], path + ".mortar_gap", "mortar gap (m)");
+  const double lx = wall.unit.x(), g = wall.mortar_gap;
+  if (wall.bond == WallMeshSpec::Bond::running && !(g < lx))
+    r.fail(w["mortar_gap"], path + ".mortar_gap",
+           "must be smaller than the unit length " + Reader::format(lx) +
+               " m (running bond has half units of (length - gap)/2)");
+  if (w["length"] && w["units_per_course"])
+    r.fail(w, path, "give either 'length' or 'units_per_course', not both");
+  if (w["units_per_course"]) {
+    wall.units_per_course = positive_count(r, w["units_per_course"], path + ".units_per_course",
+                                           "the number of units per course");
+  } else if (w["length"]) {
+    const double length = r.positive(w["length"], path + ".length", "wall length (m)");
+    // n units and n − 1 gaps make the length.
+    const long n = std::max(1L, std::lround((length + g) / (lx + g)));
+    const double made = n * lx + (n - 1) * g;
+    if (std::abs(made - length) > 1e-6 * length) {
+      const double below = (n > 1 ? n - 1 : 1) * lx + (n > 1 ? n - 2 : 0) * g;
+      r.fail(w["length"], path + ".length",
+             Reader::format(length) + " m is not a whole number of units of " + Reader::format(lx) +
+                 " m with gaps of " + Reader::format(g) + " m: " + std::to_string(n) +
+                 " units make " + Reader::format(made) + " m" +
+                 (n > 1 ? ", " + std::to_string(n - 1) + " make " + Reader::format(below) + " m"
+                        : std::string()) +
+                 ". Give one of these lengths or units_per_course.");
+    }
+    wall.units_per_course = static_cast<int>(n);
+  } else {
+    r.fail(w, path + ".length", "missing 'length' (m) or 'units_per_course'");
+  }
+  if (w["cells_per_unit"]) read_cells(r, w["cells_per_unit"], path + ".cells_per_unit", wall.cells);
+  if (wall.bond == WallMeshSpec::Bond::running && wall.cells[0] % 2 != 0)
+    r.fail(w["cells_per_unit"], path + ".cells_per_unit",
+           "the first count (cells along the unit) must be even for running bond, so the "
+           "half-unit offset falls on a mesh line and touching units share their triangles");
+  if (w["origin"]) wall.origin = r.vec3(w["origin"], path + ".origin");
+  return wall;
+}
+
+ArchMeshSpec read_arch(const Reader& r, const YAML::Node& a, const std::string& path) {
+  r.check_keys(a, path,
+               {"kind", "radius", "thickness", "depth", "voussoirs", "rise", "angle", "abutments",
+                "cells_per_voussoir", "origin"},
+               {"radius", "thickness", "depth", "voussoirs"});
+  ArchMeshSpec arch;
+  if (a["kind"])
+    arch.kind = r.choice(a["kind"], path + ".kind", {"semicircular", "segmental"}) == "segmental"
+                    ? ArchMeshSpec::Kind::segmental
+                    : ArchMeshSpec::Kind::semicircular;
+  arch.radius = r.positive(a["radius"], path + ".radius", "intrados radius (m)");
+  arch.thickness = r.positive(a["thickness"], path + ".thickness", "arch thickness (m)");
+  arch.depth = r.positive(a["depth"], path + ".depth", "arch depth (m)");
+  arch.voussoirs =
+      positive_count(r, a["voussoirs"], path + ".voussoirs", "the number of voussoirs");
+  if (arch.kind == ArchMeshSpec::Kind::semicircular) {
+    for (const char* key : {"rise", "angle"})
+      if (a[key])
+        r.fail(a[key], path + "." + key,
+               std::string("'") + key +
+                   "' applies to kind: segmental only (a semicircular arch "
+                   "subtends 180 degrees)");
+    arch.half_angle = 0.5 * M_PI;
+  } else {
+    if (a["rise"] && a["angle"]) r.fail(a, path, "give either 'rise' or 'angle', not both");
+    if (a["rise"]) {
+      const double rise = r.positive(a["rise"], path + ".rise", "rise of the intrados (m)");
+      if (!(rise < arch.radius))
+        r.fail(a["rise"], path + ".rise",
+               Reader::format(rise) +
+                   " m is impossible: a segmental arch's rise must be below "
+                   "the radius " +
+                   Reader::format(arch.radius) + " m (rise = radius is kind: semicircular)");
+      arch.half_angle = std::acos(1.0 - rise / arch.radius);
+    } else if (a["angle"]) {
+      const double angle = r.number(a["angle"], path + ".angle");
+      if (!(angle > 0.0 && angle < 180.0))
+        r.fail(a["angle"], path + ".angle",
+               Reader::format(angle) +
+                   " is impossible: the angle the arch subtends is in degrees, 0 < angle < 180");
+      arch.half_angle = 0.5 * angle * M_PI / 180.0;
+    } else {
+      r.fail(a, path + ".rise", "a segmental arch needs 'rise' (m) or 'angle' (degrees)");
+    }
+  }
+  if (const YAML::Node ab = a["abutments"]) {
+    const std::string ap = path + ".abutments";
+    r.check_keys(ab, ap, {"width", "height"}, {"width", "height"});
+    arch.abutments = true;
+    arch.abutment_width = r.positive(ab["width"], ap + ".width", "abutment width (m)");
+    arch.abutment_height = r.positive(ab["height"], ap + ".height", "abutment height (m)");
+  }
+  if (a["cells_per_voussoir"])
+    read_cells(r, a["cells_per_voussoir"], path + ".cells_per_voussoir", arch.cells);
+  if (a["origin"]) arch.origin = r.vec3(a["origin"], path + ".origin");
+  return arch;
+}
+
+TowerMeshSpec read_tower(const Reader& r, const YAML::Node& t, const std::string& path) {
+  r.check_keys(t, path, {"block", "blocks", "cells_per_block", "origin"}, {"block", "blocks"});
+  TowerMeshSpec tower;
+  tower.block = read_size(r, t["block"], path + ".block");
+  tower.blocks = positive_count(r, t["blocks"], path + ".blocks", "the number of blocks");
+  if (t["cells_per_block"])
+    read_cells(r, t["cells_per_block"], path + ".cells_per_block", tower.cells);
+  if (t["origin"]) tower.origin = r.vec3(t["origin"], path + ".origin");
+  return tower;
+}
+
 MeshSpec read_mesh(const Reader& r, const YAML::Node& node, const std::string& path,
                    const std::string& scene_dir) {
-  r.check_keys(node, path, {"box", "file", "physical"});
+  r.check_keys(node, path, {"box", "file", "physical", "wall", "arch", "tower"});
   MeshSpec mesh;
+  int kinds = 0;
+  for (const char* key : {"box", "file", "wall", "arch", "tower"}) kinds += node[key] ? 1 : 0;
   if (node["box"] && node["file"]) r.fail(node, path, "give either 'box' or 'file', not both");
-  if (const YAML::Node b = node["box"]) {
+  if (kinds > 1) r.fail(node, path, "give one of box, file, wall, arch, tower, not several");
+  if (node["physical"] && !node["file"])
+    r.fail(node["physical"], path + ".physical", "'physical' applies to 'file' meshes only");
+  if (node["wall"]) {
+    mesh.kind = MeshSpec::Kind::wall;
+    mesh.wall = read_wall(r, node["wall"], path + ".wall");
+  } else if (node["arch"]) {
+    mesh.kind = MeshSpec::Kind::arch;
+    mesh.arch = read_arch(r, node["arch"], path + ".arch");
+  } else if (node["tower"]) {
+    mesh.kind = MeshSpec::Kind::tower;
+    mesh.tower = read_tower(r, node["tower"], path + ".tower");
+  } else if (const YAML::Node b = node["box"]) {
     const std::string bp = path + ".box";
     r.check_keys(b, bp, {"min", "max", "cells"}, {"min", "max"});
     mesh.kind = MeshSpec::Kind::box;
@@ -372,7 +531,7 @@ MeshSpec read_mesh(const Reader& r, const YAML::Node& node, const std::string& p
              "mesh file '" + mesh.file + "' does not exist (paths are relative to the scene file)");
     if (node["physical"]) mesh.physical = r.string(node["physical"], path + ".physical");
   } else {
-    r.fail(node, path, "a mesh needs one of: box, file");
+    r.fail(node, path, "a mesh needs one of: box, file, wall, arch, tower");
   }
   return mesh;
 }
@@ -394,6 +553,57 @@ std::vector<int> read_body_list(const Reader& r, const YAML::Node& node, const s
     out.push_back(static_cast<int>(it - names.begin()));
   }
   return out;
+}
+
+// A unit vector from a non-zero [x, y, z].
+Vec3 direction(const Reader& r, const YAML::Node& node, const std::string& path) {
+  const Vec3 d = r.vec3(node, path);
+  if (!(d.norm() > 0.0)) r.fail(node, path, "a direction must not be [0, 0, 0]");
+  return d.normalized();
+}
+
+BaseMotionSpec read_base_motion(const Reader& r, const YAML::Node& node, const std::string& path,
+                                const std::string& scene_dir) {
+  r.check_keys(node, path, {"file", "direction", "scale"}, {"file", "direction"});
+  BaseMotionSpec spec;
+  const std::filesystem::path p(r.string(node["file"], path + ".file"));
+  spec.file = p.is_absolute() ? p.string()
+                              : (std::filesystem::path(scene_dir) / p).lexically_normal().string();
+  if (!std::filesystem::exists(spec.file))
+    r.fail(node["file"], path + ".file",
+           "acceleration record '" + spec.file +
+               "' does not exist (paths are relative to the scene file; CSV rows: time, "
+               "acceleration)");
+  spec.direction = direction(r, node["direction"], path + ".direction");
+  if (node["scale"]) spec.scale = r.number(node["scale"], path + ".scale");
+  return spec;
+}
+
+LoadSpec read_tilt(const Reader& r, const YAML::Node& node, const std::string& path) {
+  r.check_keys(node, path, {"axis", "rate", "max", "start"}, {"axis", "rate", "max"});
+  LoadSpec load;
+  load.kind = LoadSpec::Kind::tilt;
+  load.tilt.axis = direction(r, node["axis"], path + ".axis");
+  const double deg = M_PI / 180.0;
+  load.tilt.rate = r.positive(node["rate"], path + ".rate", "tilt rate (degrees/s)") * deg;
+  load.tilt.max = r.positive(node["max"], path + ".max", "largest tilt (degrees)") * deg;
+  if (load.tilt.max > M_PI)
+    r.fail(node["max"], path + ".max", "the largest tilt is in degrees and at most 180");
+  if (node["start"])
+    load.tilt.start = r.non_negative(node["start"], path + ".start", "start time (s)");
+  return load;
+}
+
+LoadSpec read_ramp(const Reader& r, const YAML::Node& node, const std::string& path) {
+  r.check_keys(node, path, {"direction", "rate", "max", "start"}, {"direction", "rate", "max"});
+  LoadSpec load;
+  load.kind = LoadSpec::Kind::ramp;
+  load.ramp.direction = direction(r, node["direction"], path + ".direction");
+  load.ramp.rate = r.positive(node["rate"], path + ".rate", "acceleration rate (m/s^3)");
+  load.ramp.max = r.positive(node["max"], path + ".max", "largest acceleration (m/s^2)");
+  if (node["start"])
+    load.ramp.start = r.non_negative(node["start"], path + ".start", "start time (s)");
+  return load;
 }
 
 }  // namespace
@@ -478,13 +688,17 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     }
     body.material = static_cast<int>(it - material_names.begin());
     if (b["fixed"]) body.fixed = r.boolean(b["fixed"], bp + ".fixed");
-    if (b["joints"])
-      body.joints = r.choice(b["joints"], bp + ".joints", {"none", "all"}) == "all"
-                        ? JointPlacement::all
-                        : JointPlacement::none;
-    if (body.joints == JointPlacement::all && !scene.materials[body.material].fracture)
-      r.fail(b["joints"], bp + ".joints",
-             "'all' needs fracture properties: add a 'fracture:' block to material '" + mat + "'");
+    if (b["joints"]) {
+      const std::string joints =
+          r.choice(b["joints"], bp + ".joints", {"none", "all", "interfaces"});
+      body.joints = joints == "all"          ? JointPlacement::all
+                    : joints == "interfaces" ? JointPlacement::interfaces
+                                             : JointPlacement::none;
+      if (body.joints != JointPlacement::none && !scene.materials[body.material].fracture)
+        r.fail(b["joints"], bp + ".joints",
+               "'" + joints + "' needs fracture properties: add a 'fracture:' block to material '" +
+                   mat + "'");
+    }
     if (b["velocity"]) body.velocity = r.vec3(b["velocity"], bp + ".velocity");
     if (b["angular_velocity"])
       body.angular_velocity = r.vec3(b["angular_velocity"], bp + ".angular_velocity");
@@ -517,8 +731,33 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     for (std::size_t i = 0; i < loads.size(); ++i) {
       const std::string lp = "loads[" + std::to_string(i) + "]";
       const YAML::Node l = loads[i];
-      r.check_keys(l, lp, {"bodies", "region", "velocity"}, {"velocity"});
+      r.check_keys(l, lp, {"bodies", "region", "velocity", "base_motion", "tilt", "ramp"});
       LoadSpec load;
+      if (l["tilt"] || l["ramp"]) {
+        const bool tilt = static_cast<bool>(l["tilt"]);
+        const std::string key = tilt ? "tilt" : "ramp";
+        if (l.size() != 1)
+          r.fail(l, lp,
+                 "a '" + key + "' load changes gravity everywhere: give it alone, as {" + key +
+                     ": {...}}");
+        scene.loads.push_back(tilt ? read_tilt(r, l["tilt"], lp + ".tilt")
+                                   : read_ramp(r, l["ramp"], lp + ".ramp"));
+        continue;
+      }
+      if (const YAML::Node bm = l["base_motion"]) {
+        if (!l["bodies"] || l["region"] || l["velocity"])
+          r.fail(l, lp,
+                 "a base motion moves whole bodies: give {bodies: [...], base_motion: {...}} "
+                 "without 'region' or 'velocity'");
+        load.kind = LoadSpec::Kind::base_motion;
+        load.bodies = read_body_list(r, l["bodies"], lp + ".bodies", body_names);
+        load.base_motion = read_base_motion(r, bm, lp + ".base_motion", scene_dir);
+        scene.loads.push_back(load);
+        continue;
+      }
+      if (!l["velocity"])
+        r.fail(l, lp + ".velocity",
+               "missing required key 'velocity' (or give base_motion, tilt or ramp)");
       if (l["bodies"] && l["region"]) r.fail(l, lp, "give either 'bodies' or 'region', not both");
       if (l["bodies"]) {
         load.bodies = read_body_list(r, l["bodies"], lp + ".bodies", body_names);

@@ -397,7 +397,7 @@ TEST_CASE("references between sections are checked", "[io]") {
   SECTION("joints value misspelt") {
     const std::string msg = input_error(minimal_plus("    joints: al\n"));
     CHECK_THAT(msg, StartsWith("scene.yaml:10:13: bodies[0].joints: 'al' is not valid. Did you "
-                               "mean 'all'? Valid values: none, all."));
+                               "mean 'all'? Valid values: none, all, interfaces."));
   }
   SECTION("interface naming an unknown body") {
     const std::string msg = input_error(minimal_plus(

@@ -1,0 +1,147 @@
+#include "drivers/loads.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace fdem {
+
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
+}
+
+// Parses a whole field as a finite number.
+bool parse_number(const std::string& field, double& out) {
+  const std::string f = trim(field);
+  if (f.empty()) return false;
+  char* end = nullptr;
+  out = std::strtod(f.c_str(), &end);
+  return end == f.c_str() + f.size() && std::isfinite(out);
+}
+
+}  // namespace
+
+void read_acceleration_record(const std::string& path, BaseMotionSpec& spec) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the acceleration record");
+  spec.time.clear();
+  spec.acceleration.clear();
+  std::string line;
+  int line_number = 0;
+  bool header_allowed = true;
+  while (std::getline(in, line)) {
+    ++line_number;
+    const std::string text = trim(line);
+    if (text.empty() || text[0] == '#') continue;
+    const auto comma = text.find(',');
+    double t = 0, a = 0;
+    const bool two = comma != std::string::npos && text.find(',', comma + 1) == std::string::npos;
+    if (!two || !parse_number(text.substr(0, comma), t) ||
+        !parse_number(text.substr(comma + 1), a)) {
+      if (header_allowed && spec.time.empty()) {  // a column header such as "time,acceleration"
+        header_allowed = false;
+        continue;
+      }
+      std::ostringstream msg;
+      msg << path << ":" << line_number << ": expected a row 'time, acceleration' (two numbers "
+          << "separated by a comma), got '" << text << "'";
+      throw InputError(msg.str());
+    }
+    header_allowed = false;
+    if (t < 0.0) {
+      std::ostringstream msg;
+      msg << path << ":" << line_number << ": time " << t << " s is negative; records start at "
+          << "t >= 0";
+      throw InputError(msg.str());
+    }
+    if (!spec.time.empty() && !(t > spec.time.back())) {
+      std::ostringstream msg;
+      msg << path << ":" << line_number << ": time " << t
+          << " s does not increase (previous row: " << spec.time.back() << " s)";
+      throw InputError(msg.str());
+    }
+    spec.time.push_back(t);
+    spec.acceleration.push_back(a);
+  }
+  if (spec.time.size() < 2)
+    throw InputError(path +
+                     ": an acceleration record needs at least two rows 'time, "
+                     "acceleration' (found " +
+                     std::to_string(spec.time.size()) + ")");
+}
+
+double base_velocity(const BaseMotionSpec& spec, double t) {
+  const auto& T = spec.time;
+  const auto& A = spec.acceleration;
+  if (T.empty() || t <= T.front()) return 0.0;
+  double v = 0.0;  // ∫ a dt in record units
+  for (std::size_t i = 0; i + 1 < T.size(); ++i) {
+    const double h = T[i + 1] - T[i];
+    if (t < T[i + 1]) {
+      const double s = t - T[i];
+      v += A[i] * s + 0.5 * (A[i + 1] - A[i]) * s * s / h;
+      return spec.scale * v;
+    }
+    v += 0.5 * (A[i] + A[i + 1]) * h;
+  }
+  return spec.scale * v;
+}
+
+double tilt_angle(const TiltSpec& tilt, double t) {
+  return std::clamp(tilt.rate * (t - tilt.start), 0.0, tilt.max);
+}
+
+double ramp_acceleration(const RampSpec& ramp, double t) {
+  return std::clamp(ramp.rate * (t - ramp.start), 0.0, ramp.max);
+}
+
+Vec3 gravity_at(const Scene& scene, double t) {
+  Vec3 g = scene.gravity;
+  for (const LoadSpec& load : scene.loads)
+    if (load.kind == LoadSpec::Kind::tilt)
+      g = Eigen::AngleAxisd(tilt_angle(load.tilt, t), load.tilt.axis) * g;
+  for (const LoadSpec& load : scene.loads)
+    if (load.kind == LoadSpec::Kind::ramp)
+      g += ramp_acceleration(load.ramp, t) * load.ramp.direction;
+  return g;
+}
+
+LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
+  scene_.gravity = scene.gravity;
+  for (const LoadSpec& load : scene.loads) {
+    if (load.kind == LoadSpec::Kind::tilt || load.kind == LoadSpec::Kind::ramp) {
+      scene_.loads.push_back(load);
+      changes_gravity_ = true;
+    } else if (load.kind == LoadSpec::Kind::base_motion) {
+      Base base{load.base_motion, {}};
+      if (base.motion.time.empty()) read_acceleration_record(base.motion.file, base.motion);
+      if (base.motion.time.size() != base.motion.acceleration.size() || base.motion.time.size() < 2)
+        throw InputError(scene.source_path +
+                         ": a base motion needs at least two samples of time and acceleration");
+      for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
+        const std::int32_t body = model.pieces[model.nodes.piece[n]].body;
+        if (std::find(load.bodies.begin(), load.bodies.end(), body) != load.bodies.end())
+          base.nodes.push_back(n);
+      }
+      bases_.push_back(std::move(base));
+    }
+  }
+}
+
+void LoadSchedule::apply(double t, double dt, Model& model) const {
+  if (changes_gravity_) model.gravity = gravity_at(scene_, t);
+  for (const Base& base : bases_) {
+    const Vec3 v = base_velocity(base.motion, t + 0.5 * dt) * base.motion.direction;
+    for (LocalIndex n : base.nodes) vec3_at(model.nodes.prescribed_velocity.data(), n) = v;
+  }
+}
+
+}  // namespace fdem

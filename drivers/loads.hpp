@@ -1,0 +1,57 @@
+// Time-dependent loads (scene `loads:`): ground motion from an acceleration record, tilting
+// tables and horizontal-acceleration ramps.  LoadSchedule::apply is the one place where they are
+// evaluated each step; constant prescribed velocities stay in apply_constraints.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/model.hpp"
+#include "core/scene.hpp"
+
+namespace fdem {
+
+// Reads a CSV acceleration record, rows "time, acceleration" (s, record units).  Blank lines,
+// lines starting with '#' and one header line before the first data row are skipped.  Throws
+// InputError naming the file and line for anything else that is not two numbers, for times
+// that do not increase, negative times, or fewer than two rows.
+void read_acceleration_record(const std::string& path, BaseMotionSpec& spec);
+
+// Ground velocity (m/s, along spec.direction) at time t: the exact integral from 0 of the
+// acceleration scale·a(t), a linear between samples and zero before the first and after the last
+// sample (so the velocity holds its final value).
+double base_velocity(const BaseMotionSpec& spec, double t);
+
+// Gravity at time t: scene gravity turned by the tilts (in scene order), plus the ramps.
+Vec3 gravity_at(const Scene& scene, double t);
+
+// Tilt angle (rad) and ramp acceleration (m/s²) at time t.
+double tilt_angle(const TiltSpec& tilt, double t);
+double ramp_acceleration(const RampSpec& ramp, double t);
+
+class LoadSchedule {
+ public:
+  // Reads the records not given in code and lists the nodes each base motion moves.
+  LoadSchedule(const Scene& scene, const Model& model);
+
+  bool changes_gravity() const { return changes_gravity_; }
+  bool moves_bases() const { return !bases_.empty(); }
+  bool active() const { return changes_gravity_ || moves_bases(); }
+
+  // Sets the model's loads for the step from t to t + dt: gravity at t (forces at t), base
+  // nodes' prescribed velocity at t + dt/2 (central difference stores half-step velocities).
+  void apply(double t, double dt, Model& model) const;
+
+  const Scene& scene() const { return scene_; }
+
+ private:
+  struct Base {
+    BaseMotionSpec motion;
+    std::vector<LocalIndex> nodes;
+  };
+  Scene scene_;  // gravity, tilts and ramps (records filled)
+  std::vector<Base> bases_;
+  bool changes_gravity_ = false;
+};
+
+}  // namespace fdem
