@@ -64,12 +64,13 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options)
   plan_.contact = ContactStage::needed(model_);
   const CriticalStep critical = fdem::critical_time_step(model_);
   dt_critical_ = critical.dt;
-  if (plan_.contact) {
-    contact_ = std::make_unique<ContactStage>(model_, ContactSettings{scene_.contact_buffer});
   // Energies below this are round-off for the model (1e-12 of Σ E·V, J): a balance "error" among
   // them says nothing about stability.
   for (LocalIndex t = 0; t < model_.tets.size(); ++t)
-    energy_floor_ += 1e-12 * model_.materials[model_.tets.material[t]].young * std::abs(model_.tets.volume0[t]);
+    energy_floor_ +=
+        1e-12 * model_.materials[model_.tets.material[t]].young * std::abs(model_.tets.volume0[t]);
+  if (plan_.contact) {
+    contact_ = std::make_unique<ContactStage>(model_, ContactSettings{scene_.contact_buffer});
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
     const double dt_contact = contact_->critical_time_step(model_);
     dt_critical_ =
@@ -110,7 +111,7 @@ void Simulation::step() {
     loads_->apply(time_, dt_, model_);
   }
 
-  // 1 internal forces: F = Ds·Dm⁻¹, stress, corner forces gathered per node in tet-gid order
+  // 1 internal forces: F = Ds·Dm⁻¹, stress, nodal forces added in ascending tet gid
   InternalForceSummary forces;
   {
     Timed timed(clocks_[internal]);
@@ -229,7 +230,8 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
   // turns negative when a mode oscillates beyond it (velocities flip sign every step).
   const EnergyTerms& e = ledger_.current();
   // (At step 0 it is −m(a·dt)²/8 for a body starting at rest: harmless, hence steps_ > 10.)
-  if (steps_ > 10 && e.kinetic < -1e-3 * std::max(e.scale(), 1e-300) && -e.kinetic > energy_floor_) {
+  if (steps_ > 10 && e.kinetic < -1e-3 * std::max(e.scale(), 1e-300) &&
+      -e.kinetic > energy_floor_) {
     std::ostringstream msg;
     msg << "numerical failure at step " << steps_ << " (t = " << time_
         << " s): the run is unstable — nodal "

@@ -106,15 +106,15 @@ class Simulation {
   double time_ = 0.0;
   long steps_ = 0;
   double dt_ = 0.0, dt_critical_ = 0.0;
-  StageClock clocks_[n_stages];
   double energy_floor_ = 0.0;  // J, see the constructor
+  StageClock clocks_[n_stages];
   std::chrono::steady_clock::time_point wall_start_;
   double next_frame_time_ = 0.0, next_energy_time_ = 0.0;
   std::unique_ptr<RunFiles> files_;
   std::unique_ptr<ContactStage> contact_;
   std::unique_ptr<JointStage> joints_;
   std::unique_ptr<LoadSchedule> loads_;  // time-dependent loads (drivers/loads)
-  WorkAccumulator joint_friction_;  // Coulomb slip inside joints (part of dissipated_friction)
+  WorkAccumulator joint_friction_;       // Coulomb slip inside joints (part of dissipated_friction)
 };
 
 // Builds a Simulation from a scene file (meshes loaded or generated).
