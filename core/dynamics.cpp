@@ -64,7 +64,7 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes) {
 
 IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
   IntegrationSummary out;
-  double kinetic2 = 0.0, max_dx2 = 0.0;
+  double kinetic2 = 0.0, kinetic_half2 = 0.0, max_dx2 = 0.0;
   for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
     const double m = nodes.mass[n];
     const std::uint8_t mask = nodes.constrained[n];
@@ -80,6 +80,7 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
         out.constraint_work_after += 0.5 * reaction * dt * v_new;
       }
       kinetic2 += m * v_old * v_new;
+      kinetic_half2 += m * v_new * v_new;
       out.momentum_before[k] += m * v_old;
       out.momentum_after[k] += m * v_new;
       nodes.v[i] = v_new;
@@ -90,6 +91,7 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
     max_dx2 = std::max(max_dx2, dx2);
   }
   out.kinetic_energy = 0.5 * kinetic2;
+  out.kinetic_energy_half_step = 0.5 * kinetic_half2;
   out.max_displacement_increment = std::sqrt(max_dx2);
   out.finite = std::isfinite(kinetic2);
   return out;

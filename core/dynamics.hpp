@@ -25,9 +25,10 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes);
 struct IntegrationSummary {
   double kinetic_energy = 0.0;  // J, ½m·v⁻·v⁺ (the energy central difference conserves)
   double constraint_work_before = 0.0;  // J, reactions at prescribed components · (x_n − x_n−1)/2
-  double constraint_work_after = 0.0;   // J, reactions · (x_n+1 − x_n)/2
-  Vec3 momentum_before = Vec3::Zero();  // Σ m·v_n−½ (kg m/s), for the work of uniform loads
-  Vec3 momentum_after = Vec3::Zero();   // Σ m·v_n+½
+  double constraint_work_after = 0.0;     // J, reactions · (x_n+1 − x_n)/2
+  double kinetic_energy_half_step = 0.0;  // J, ½m|v_n+½|² (grows in an unstable run)
+  Vec3 momentum_before = Vec3::Zero();    // Σ m·v_n−½ (kg m/s), for the work of uniform loads
+  Vec3 momentum_after = Vec3::Zero();     // Σ m·v_n+½
   double max_displacement_increment = 0.0;  // m, largest |Δx| of a node this step
   bool finite = true;                       // false if any velocity became NaN or infinite
 };

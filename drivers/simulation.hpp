@@ -106,7 +106,9 @@ class Simulation {
   double time_ = 0.0;
   long steps_ = 0;
   double dt_ = 0.0, dt_critical_ = 0.0;
-  double energy_floor_ = 0.0;  // J, see the constructor
+  double energy_floor_ = 0.0;       // J, see the constructor
+  double energy_input_ = 0.0;       // J, largest energy put in so far (see check_state)
+  double kinetic_half_step_ = 0.0;  // J, ½m|v_n+½|² of the last step
   StageClock clocks_[n_stages];
   std::chrono::steady_clock::time_point wall_start_;
   double next_frame_time_ = 0.0, next_energy_time_ = 0.0;
