@@ -310,14 +310,16 @@ int main(int argc, char** argv) {
           ByteCount bytes;
           bool per_material;
         };
-        const Stage stages[2] = {{"forces", force_bytes, true}, {"integrate", integrate_bytes, false}};
+        const Stage stages[2] = {{"forces", force_bytes, true},
+                                 {"integrate", integrate_bytes, false}};
         for (const Stage& stage : stages) {
           if (!stage.per_material && law != ElasticModel::neo_hookean) continue;
           const std::string name = stage.name;
           Timing timing;
           if (name == "forces") {
             timing = time_per_call([&] { sink += compute_internal_forces(model).strain_energy; },
-                                   min_seconds);          } else {
+                                   min_seconds);
+          } else {
             // A tiny step keeps the state (and the later stages' inputs) practically unchanged.
             timing = time_per_call(
                 [&] { sink += integrate_central_difference(1e-12, model.nodes).kinetic_energy; },

@@ -99,7 +99,6 @@ struct PieceInfo {
   Vec3 centroid0 = Vec3::Zero();  // mass-weighted reference centroid (m)
 };
 
-
 struct Model {
   NodeArrays nodes;
   TetArrays tets;

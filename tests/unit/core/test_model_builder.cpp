@@ -120,12 +120,15 @@ TEST_CASE("nodal forces are bit-identical whatever the local order of the tets",
   mesh.source = "test";
   for (int k = 0; k < 3; ++k)  // a 2x1x1 strip of Kuhn-like tets sharing nodes
     for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 3; ++i) mesh.coords.insert(mesh.coords.end(), {double(i), double(j), double(k)});
+      for (int i = 0; i < 3; ++i)
+        mesh.coords.insert(mesh.coords.end(), {double(i), double(j), double(k)});
   auto id = [](int i, int j, int k) { return static_cast<LocalIndex>((k * 2 + j) * 3 + i); };
   for (int k = 0; k < 2; ++k)
     for (int i = 0; i < 2; ++i) {
-      mesh.tets.insert(mesh.tets.end(), {id(i, 0, k), id(i + 1, 0, k), id(i, 1, k), id(i, 0, k + 1)});
-      mesh.tets.insert(mesh.tets.end(), {id(i + 1, 0, k), id(i + 1, 1, k), id(i, 1, k), id(i + 1, 0, k + 1)});
+      mesh.tets.insert(mesh.tets.end(),
+                       {id(i, 0, k), id(i + 1, 0, k), id(i, 1, k), id(i, 0, k + 1)});
+      mesh.tets.insert(mesh.tets.end(),
+                       {id(i + 1, 0, k), id(i + 1, 1, k), id(i, 1, k), id(i + 1, 0, k + 1)});
     }
   Model a = build_model(scene, {mesh});
   Model b = a;
@@ -146,7 +149,8 @@ TEST_CASE("nodal forces are bit-identical whatever the local order of the tets",
   build_tet_force_order(b.tets, b.tet_force_order);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-0.05, 0.05);
-  for (std::size_t i = 0; i < a.nodes.x.size(); ++i) a.nodes.x[i] = b.nodes.x[i] = a.nodes.x0[i] + u(rng);
+  for (std::size_t i = 0; i < a.nodes.x.size(); ++i)
+    a.nodes.x[i] = b.nodes.x[i] = a.nodes.x0[i] + u(rng);
   compute_internal_forces(a);
   compute_internal_forces(b);
   double largest = 0;
