@@ -43,9 +43,16 @@ struct TetArrays {
   // held by joints, and become contact partners when those break).  Empty: the piece is the group
   // (models assembled by hand).  Not touched by resize().
   std::vector<std::int32_t> contact_group;
+  // Parallel roles (docs/parallel.md).  Local tets are always in ascending gid.  `owned`: this
+  // rank owns the tet (reports its energies, writes it in frames and checkpoints); `active`: the
+  // tet touches a node this rank owns, or is owned, so this rank computes its forces.  Empty: every
+  // tet is owned and active (one rank).  Not touched by resize().
+  std::vector<std::uint8_t> owned, active;
 
   LocalIndex size() const { return static_cast<LocalIndex>(gid.size()); }
   void resize(LocalIndex n);
+  bool is_owned(LocalIndex t) const { return owned.empty() || owned[t]; }
+  bool is_active(LocalIndex t) const { return active.empty() || active[t]; }
   std::int32_t group_of(LocalIndex t) const {
     return contact_group.empty() ? piece[t] : contact_group[t];
   }
