@@ -29,7 +29,7 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
     piece_fixed_[p] = model.body_fixed[model.pieces[p].body];
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
-    compute_boxes(model);
+    compute_boxes(model, model.nodes.x.data());
     std::vector<double> size(model.tets.size());
     for (LocalIndex t = 0; t < model.tets.size(); ++t)
       size[t] = std::max({hi_[3 * t] - lo_[3 * t], hi_[3 * t + 1] - lo_[3 * t + 1],
@@ -64,9 +64,8 @@ double ContactStage::critical_time_step(const Model& model) const {
   return dt;
 }
 
-void ContactStage::compute_boxes(const Model& model) {
+void ContactStage::compute_boxes(const Model& model, const double* x) {
   const TetArrays& tets = model.tets;
-  const double* x = model.nodes.x.data();
   lo_.resize(3 * tets.size());
   hi_.resize(3 * tets.size());
   for (LocalIndex t = 0; t < tets.size(); ++t)
@@ -103,11 +102,12 @@ bool share_reference_node(const Model& model, LocalIndex a, LocalIndex b) {
 
 // True if a face plane of one tet has every node of the other more than `distance` beyond it —
 // then the two tets are more than `distance` apart.
-bool tets_farther_than(const Model& model, LocalIndex a, LocalIndex b, double distance) {
+bool tets_farther_than(const Model& model, const double* positions, LocalIndex a, LocalIndex b,
+                       double distance) {
   Vec3 x[2][4];
   for (int c = 0; c < 4; ++c) {
-    x[0][c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * a + c]);
-    x[1][c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * b + c]);
+    x[0][c] = vec3_at(positions, model.tets.nodes[4 * a + c]);
+    x[1][c] = vec3_at(positions, model.tets.nodes[4 * b + c]);
   }
   for (int side = 0; side < 2; ++side) {
     const Vec3(&p)[4] = x[side];
@@ -129,15 +129,51 @@ bool tets_farther_than(const Model& model, LocalIndex a, LocalIndex b, double di
 
 }  // namespace
 
-bool ContactStage::detect_if_needed(const Model& model) {
+bool ContactStage::detection_due(const Model& model) const {
   const NodeArrays& nodes = model.nodes;
-  if (detected_ &&
-      !detection_needed(max_node_displacement(nodes.x.data(), x_at_detection_.data(), nodes.size()),
-                        buffer_))
-    return false;
-  compute_boxes(model);
+  return !detected_ ||
+         detection_needed(max_node_displacement(nodes.x.data(), x_at_detection_.data(),
+                                                nodes.n_owned),
+                          buffer_);
+}
+
+bool ContactStage::detect_if_needed(const Model& model) {
+  if (!detection_due(model)) return false;
+  detect(model);
+  return true;
+}
+
+void ContactStage::detect(const Model& model) {
+  run_detection(model, model.nodes.x.data());
+  // Stick springs of pairs that left the list are released (their energy is dissipated).
+  if (!friction_.empty()) {
+    std::unordered_set<std::uint64_t> kept;
+    kept.reserve(pairs_.size());
+    for (const CandidatePair& p : pairs_)
+      kept.insert(pair_key(model.tets.gid[p.a], model.tets.gid[p.b]));
+    for (auto it = friction_.begin(); it != friction_.end();) {
+      if (kept.count(it->first)) {
+        ++it;
+      } else {
+        if (it->second.owned)
+          released_spring_energy_ +=
+              0.5 * it->second.stiffness * it->second.history.tangential_spring.squaredNorm();
+        it = friction_.erase(it);
+      }
+    }
+  }
+  x_at_detection_ = model.nodes.x;
+  detected_ = true;
+  ++detections_;
+}
+
+void ContactStage::run_detection(const Model& model, const double* x) {
+  compute_boxes(model, x);
   const TetArrays& tets = model.tets;
+  const bool all_active = tets.active.empty();
   const auto keep = [&](LocalIndex a, LocalIndex b) {
+    // A pair between two tets this rank does not compute is left to the ranks that do.
+    if (!all_active && !tets.active[a] && !tets.active[b]) return false;
     const std::int32_t pa = tets.piece[a], pb = tets.piece[b];
     if (tets.group_of(a) == tets.group_of(b) || (piece_fixed_[pa] && piece_fixed_[pb]))
       return false;
@@ -157,28 +193,66 @@ bool ContactStage::detect_if_needed(const Model& model) {
   // than `buffer` apart cannot touch before the next detection.
   pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
                               [&](const CandidatePair& p) {
-                                return tets_farther_than(model, p.a, p.b, buffer_);
+                                return tets_farther_than(model, x, p.a, p.b, buffer_);
                               }),
                pairs_.end());
-  // Stick springs of pairs that left the list are released (their energy is dissipated).
-  if (!friction_.empty()) {
-    std::unordered_set<std::uint64_t> kept;
-    kept.reserve(pairs_.size());
-    for (const CandidatePair& p : pairs_) kept.insert(pair_key(tets.gid[p.a], tets.gid[p.b]));
-    for (auto it = friction_.begin(); it != friction_.end();) {
-      if (kept.count(it->first)) {
-        ++it;
-      } else {
-        released_spring_energy_ +=
-            0.5 * it->second.stiffness * it->second.history.tangential_spring.squaredNorm();
-        it = friction_.erase(it);
-      }
-    }
+}
+
+void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection,
+                          std::vector<std::uint8_t> tet_joint_state,
+                          const std::vector<FrictionEntry>& friction, bool detected) {
+  const TetArrays& tets = model.tets;
+  FDEM_VERIFY(x_at_detection.size() == model.nodes.x.size(), "positions at detection per node");
+  FDEM_VERIFY(tet_joint_state.empty() ||
+                  tet_joint_state.size() == static_cast<std::size_t>(tets.size()),
+              "joint state per tet");
+  std::vector<std::pair<LocalIndex, LocalIndex>> bonds;
+  for (LocalIndex j = 0; j < model.joints.size(); ++j)
+    if (!model.joints.broken[j])
+      bonds.emplace_back(model.joints.tets[2 * j], model.joints.tets[2 * j + 1]);
+  if (!tet_joint_state.empty()) {  // the scene has joints: bonds and joint states filter pairs
+    set_bonds(tets.size(), bonds);
+    for (LocalIndex t = 0; t < tets.size(); ++t)
+      joint_state_[t] = static_cast<JointState>(tet_joint_state[t]);
   }
-  x_at_detection_ = nodes.x;
-  detected_ = true;
-  ++detections_;
-  return true;
+  std::unordered_map<GlobalId, LocalIndex> local;
+  for (LocalIndex t = 0; t < tets.size(); ++t) local.emplace(tets.gid[t], t);
+  friction_.clear();
+  for (const FrictionEntry& e : friction) {
+    PairFriction& pf = friction_[pair_key(e.a, e.b)];
+    pf.history.tangential_spring = e.spring;
+    pf.stiffness = e.stiffness;
+    const auto it = local.find(e.a);
+    pf.owned = it != local.end() && tets.is_owned(it->second);
+  }
+  x_at_detection_ = std::move(x_at_detection);
+  detected_ = detected;
+  pairs_.clear();
+  if (detected_) run_detection(model, x_at_detection_.data());
+}
+
+std::vector<FrictionEntry> ContactStage::friction_entries() const {
+  std::vector<FrictionEntry> out;
+  out.reserve(friction_.size());
+  for (const auto& [key, pf] : friction_) {
+    FrictionEntry e;
+    e.a = static_cast<GlobalId>(key >> 32);
+    e.b = static_cast<GlobalId>(key & 0xffffffffULL);
+    e.spring = pf.history.tangential_spring;
+    e.stiffness = pf.stiffness;
+    out.push_back(e);
+  }
+  std::sort(out.begin(), out.end(), [](const FrictionEntry& p, const FrictionEntry& q) {
+    return p.a != q.a ? p.a < q.a : p.b < q.b;
+  });
+  return out;
+}
+
+std::vector<std::uint8_t> ContactStage::tet_joint_states() const {
+  std::vector<std::uint8_t> out(joint_state_.size());
+  for (std::size_t t = 0; t < joint_state_.size(); ++t)
+    out[t] = static_cast<std::uint8_t>(joint_state_[t]);
+  return out;
 }
 
 void ContactStage::set_bonds(LocalIndex n_tets,
@@ -202,10 +276,12 @@ void ContactStage::set_bonds(LocalIndex n_tets,
 }
 
 void ContactStage::release_bond(LocalIndex a, LocalIndex b) {
-  if (!joint_state_.empty()) joint_state_[a] = joint_state_[b] = JointState::cracked;
+  detected_ = false;
   for (int side = 0; side < 2; ++side) {
     const LocalIndex t = side == 0 ? a : b, other = side == 0 ? b : a;
-    if (bonds_.empty()) return;
+    if (t < 0) continue;  // that tet is not held here (parallel runs)
+    if (!joint_state_.empty()) joint_state_[t] = JointState::cracked;
+    if (bonds_.empty()) continue;
     for (int k = 0; k < 4; ++k)
       if (bonds_[4 * static_cast<std::size_t>(t) + k] == other)
         bonds_[4 * static_cast<std::size_t>(t) + k] = -1;
@@ -218,7 +294,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   const TetArrays& tets = model.tets;
   NodeArrays& nodes = model.nodes;
   records_.clear();
-  out.candidate_pairs = static_cast<LocalIndex>(pairs_.size());
+  out.candidate_pairs = static_cast<LocalIndex>(pairs_.size());  // held here, not unique
   out.friction_dissipated = released_spring_energy_;
   released_spring_energy_ = 0.0;
   for (const CandidatePair& pair : pairs_) {
@@ -232,19 +308,21 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     const double mu = std::min(friction_coefficient_[ma], friction_coefficient_[mb]);
     const ContactPairResult r = potential_contact(a, b, penalty);
     const std::uint64_t key = pair_key(tets.gid[pair.a], tets.gid[pair.b]);
+    // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
+    const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
     if (!r.overlapping) {
       if (mu > 0.0) {  // contact lost: the stick spring's energy is released (dissipated)
         const auto it = friction_.find(key);
         if (it != friction_.end()) {
-          out.friction_dissipated +=
-              0.5 * it->second.stiffness * it->second.history.tangential_spring.squaredNorm();
+          out.friction_dissipated += share * 0.5 * it->second.stiffness *
+                                     it->second.history.tangential_spring.squaredNorm();
           friction_.erase(it);
         }
       }
       continue;
     }
-    ++out.active_pairs;
-    out.energy += r.energy;
+    out.active_pairs += share > 0.0 ? 1 : 0;
+    out.energy += share * r.energy;
     for (int c = 0; c < 4; ++c) {
       vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += r.force_contactor[c];
       vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += r.force_target[c];
@@ -275,7 +353,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) -=
             r.centroid_weights_target[c] * f_n * r.normal;
       }
-      out.damping_dissipated += -f_n * v_n * dt;
+      out.damping_dissipated += share * -f_n * v_n * dt;
     }
     Vec3 tangential = Vec3::Zero();
     if (mu > 0.0) {
@@ -285,6 +363,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       const FrictionLaw law{mu, penalty * size};
       PairFriction& pair_friction = friction_[key];
       pair_friction.stiffness = law.tangential_stiffness;
+      pair_friction.owned = share > 0.0;
       FrictionHistory& history = pair_friction.history;
       const FrictionResult f =
           coulomb_friction(law, r, relative_velocity_at_centroid(r, va, vb), dt, history);
@@ -292,11 +371,11 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += f.force_target[c];
       }
-      out.friction_dissipated += f.slip_dissipation + f.released_energy;
-      out.friction_spring_energy += f.spring_energy;
+      out.friction_dissipated += share * (f.slip_dissipation + f.released_energy);
+      out.friction_spring_energy += share * f.spring_energy;
       tangential = f.tangential_force;
     }
-    records_.push_back({r.centroid, r.normal_force * r.normal, tangential});
+    if (share > 0.0) records_.push_back({r.centroid, r.normal_force * r.normal, tangential});
   }
   out.friction_work_before = out.friction_work_after = 0.5 * out.friction_dissipated;
   return out;

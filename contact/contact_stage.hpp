@@ -19,6 +19,14 @@ struct ContactSettings {
   double buffer = -1.0;  // m; < 0: automatic (0.25 × median tet box size)
 };
 
+// Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with
+// the pair when the model is redistributed or checkpointed.
+struct FrictionEntry {
+  GlobalId a = 0, b = 0;
+  Vec3 spring = Vec3::Zero();  // stick spring (m)
+  double stiffness = 0.0;      // N/m
+};
+
 struct ContactForceSummary {
   double energy = 0.0;                                           // Σ U of overlapping pairs (J)
   double friction_work_before = 0.0, friction_work_after = 0.0;  // trapezoid halves (J)
@@ -46,6 +54,24 @@ class ContactStage {
   // Re-detects candidate pairs when the buffer is used up (or on the first call).  Returns true
   // if detection ran.
   bool detect_if_needed(const Model& model);
+  // Whether this rank's nodes call for detection (a node moved more than buffer/2, a bond was
+  // released, or none ran yet); a parallel run detects when any rank says so.
+  bool detection_due(const Model& model) const;
+  // Detection at the current positions.
+  void detect(const Model& model);
+
+  // Parallel runs (docs/parallel.md): after the model was redistributed, take over the state
+  // that travelled with it — positions at the last detection (3 per local node), each local
+  // tet's joint state, the friction history of the pairs held here — rebuild the bonds from the
+  // model's intact joints and repeat the last detection at the positions it saw, which gives
+  // the candidate pairs the previous layout had.  `detected`: whether a detection happened yet.
+  void rebind(const Model& model, std::vector<double> x_at_detection,
+              std::vector<std::uint8_t> tet_joint_state, const std::vector<FrictionEntry>& friction,
+              bool detected);
+  std::vector<FrictionEntry> friction_entries() const;
+  const std::vector<double>& x_at_detection() const { return x_at_detection_; }
+  std::vector<std::uint8_t> tet_joint_states() const;
+  bool detected() const { return detected_; }
   // Adds contact forces to model.nodes.f (pairs in ascending (gid, gid) order).
   ContactForceSummary add_forces(Model& model, double dt);
 
@@ -54,6 +80,7 @@ class ContactStage {
   void set_bonds(LocalIndex n_tets, const std::vector<std::pair<LocalIndex, LocalIndex>>& pairs);
   // A joint broke: its two tets become contact partners.  The next detect_if_needed() re-runs
   // detection (the pair is already inside the buffer, so the buffer rule would not notice).
+  // An index of −1 is a tet not held by this rank.
   void release_bond(LocalIndex a, LocalIndex b);
 
   // Penalty (Pa) of each material as resolved (auto → 10 × Young's modulus).
@@ -68,7 +95,8 @@ class ContactStage {
   const std::vector<ContactRecord>& records() const { return records_; }
 
  private:
-  void compute_boxes(const Model& model);
+  void compute_boxes(const Model& model, const double* x);
+  void run_detection(const Model& model, const double* x);
 
   double buffer_ = 0.0;
   std::vector<double> penalty_;
@@ -81,6 +109,7 @@ class ContactStage {
   struct PairFriction {
     FrictionHistory history;
     double stiffness = 0.0;  // N/m, for the energy released when the pair ends
+    bool owned = true;       // this rank owns tet a: it reports the pair's energies
   };
   std::unordered_map<std::uint64_t, PairFriction> friction_;
   double released_spring_energy_ = 0.0;  // J, springs of pairs dropped at the last detection

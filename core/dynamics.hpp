@@ -2,6 +2,8 @@
 // order, gravity, and the central-difference update with its energy bookkeeping.
 #pragma once
 
+#include <functional>
+
 #include <vector>
 
 #include "core/model.hpp"
@@ -42,7 +44,10 @@ struct PieceMotion {
   Vec3 velocity = Vec3::Zero();
   Vec3 rotation = Vec3::Zero();  // rotation vector (axis × angle, rad) of the best-fit rotation
 };
-std::vector<PieceMotion> piece_motions(const Model& model);
+// `sum_over_ranks` (parallel runs): adds a vector element-wise over all ranks in place, so each
+// rank's owned nodes contribute to the pieces they belong to.
+std::vector<PieceMotion> piece_motions(
+    const Model& model, const std::function<void(std::vector<double>&)>& sum_over_ranks = {});
 
 // Total linear and angular momentum (about the origin) of the owned nodes.
 Vec3 linear_momentum(const NodeArrays& nodes);

@@ -67,8 +67,9 @@ std::int32_t count_fragments(const Model& model) {
 }
 
 void build_tet_force_order(const TetArrays& tets, std::vector<LocalIndex>& order) {
-  order.resize(tets.size());
-  std::iota(order.begin(), order.end(), 0);
+  order.clear();
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (tets.is_active(t)) order.push_back(t);
   std::sort(order.begin(), order.end(),
             [&](LocalIndex a, LocalIndex b) { return tets.gid[a] < tets.gid[b]; });
 }

@@ -170,6 +170,12 @@ struct OutputSpec {
   double energy_every = 0.0;      // s between energy.csv rows; 0: same as frames
 };
 
+// Parallel runs (docs/parallel.md): when the decomposition is revisited.
+struct ParallelSpec {
+  double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this
+  long redistribute_every = 0;        // steps; also redistribute this often (0: at detections only)
+};
+
 struct Scene {
   std::string name;
   std::string source_path;  // the YAML file, for messages
@@ -181,6 +187,7 @@ struct Scene {
   std::vector<LoadSpec> loads;
   OutputSpec output;
   double contact_buffer = -1.0;  // m; < 0: automatic
+  ParallelSpec parallel;
 };
 
 }  // namespace fdem

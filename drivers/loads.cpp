@@ -121,17 +121,24 @@ LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
       scene_.loads.push_back(load);
       changes_gravity_ = true;
     } else if (load.kind == LoadSpec::Kind::base_motion) {
-      Base base{load.base_motion, {}};
+      Base base{load.base_motion, load.bodies, {}};
       if (base.motion.time.empty()) read_acceleration_record(base.motion.file, base.motion);
       if (base.motion.time.size() != base.motion.acceleration.size() || base.motion.time.size() < 2)
         throw InputError(scene.source_path +
                          ": a base motion needs at least two samples of time and acceleration");
-      for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
-        const std::int32_t body = model.pieces[model.nodes.piece[n]].body;
-        if (std::find(load.bodies.begin(), load.bodies.end(), body) != load.bodies.end())
-          base.nodes.push_back(n);
-      }
       bases_.push_back(std::move(base));
+    }
+  }
+  rebind(model);
+}
+
+void LoadSchedule::rebind(const Model& model) {
+  for (Base& base : bases_) {
+    base.nodes.clear();
+    for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
+      const std::int32_t body = model.pieces[model.nodes.piece[n]].body;
+      if (std::find(base.bodies.begin(), base.bodies.end(), body) != base.bodies.end())
+        base.nodes.push_back(n);
     }
   }
 }

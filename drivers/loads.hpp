@@ -43,10 +43,13 @@ class LoadSchedule {
   void apply(double t, double dt, Model& model) const;
 
   const Scene& scene() const { return scene_; }
+  // The model's nodes changed (parallel redistribution): list the base nodes again.
+  void rebind(const Model& model);
 
  private:
   struct Base {
     BaseMotionSpec motion;
+    std::vector<std::int32_t> bodies;
     std::vector<LocalIndex> nodes;
   };
   Scene scene_;  // gravity, tilts and ramps (records filled)

@@ -11,6 +11,7 @@
 #include "drivers/simulation.hpp"
 #include "fracture/joint_stage.hpp"
 #include "io/scene_reader.hpp"
+#include "parallel/communicator.hpp"
 
 namespace {
 
@@ -60,7 +61,25 @@ int check(const fdem::Scene& scene) {
 
 }  // namespace
 
+int run_command(int argc, char** argv, const fdem::Communicator& world);
+
 int main(int argc, char** argv) {
+  // Under mpirun every rank runs the same command; one rank alone is a serial run.
+  fdem::MpiEnvironment environment(&argc, &argv);
+  const fdem::Communicator world = fdem::Communicator::world();
+  return run_command(argc, argv, world);
+}
+
+// Reports an error: a collective one (every rank has it) once from rank 0 and returns the exit
+// code; one that only this rank has ends every rank (the others may wait in a collective).
+int fail(const fdem::Communicator& world, const std::exception& e, bool collective, int code,
+         const char* prefix) {
+  if (world.size() > 1 && !collective) world.abort_all(prefix + std::string(e.what()), code);
+  if (world.rank() == 0) std::fprintf(stderr, "fdem: %s%s\n", prefix, e.what());
+  return code;
+}
+
+int run_command(int argc, char** argv, const fdem::Communicator& world) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     std::fputs(usage, stderr);
@@ -119,13 +138,16 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    const fdem::Scene scene = fdem::read_scene(scene_path, overrides);
-    if (command == "check") return check(scene);
-    auto sim = fdem::make_simulation(scene, options);
+    fdem::Scene scene;
+    world.run_collectively([&] { scene = fdem::read_scene(scene_path, overrides); });
+    if (command == "check") return world.rank() == 0 ? check(scene) : 0;
+    if (world.rank() != 0) options.quiet = true;
+    auto sim = fdem::make_simulation(scene, options, &world);
     const fdem::RunReport report = sim->run();
     if (report.status != "completed") {
-      std::fprintf(stderr, "fdem: %s\nThe last good frame and summary.json are in %s.\n",
-                   report.reason.c_str(), options.output_dir.c_str());
+      if (world.rank() == 0)
+        std::fprintf(stderr, "fdem: %s\nThe last good frame and summary.json are in %s.\n",
+                     report.reason.c_str(), options.output_dir.c_str());
       return 3;
     }
     if (!options.quiet)
@@ -133,13 +155,12 @@ int main(int argc, char** argv) {
                    options.output_dir.c_str());
     return 0;
   } catch (const fdem::InputError& e) {
-    std::fprintf(stderr, "fdem: error: %s\n", e.what());
-    return 2;
+    return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr, 2,
+                "error: ");
   } catch (const fdem::NumericalFailure& e) {
-    std::fprintf(stderr, "fdem: %s\n", e.what());
-    return 3;
+    return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr, 3, "");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "fdem: error: %s\n", e.what());
-    return 1;
+    return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr, 1,
+                "error: ");
   }
 }

@@ -48,10 +48,14 @@ std::ostream& operator<<(std::ostream& out, JsonNumber n) {
 }
 }  // namespace
 
-RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>& fields)
+RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>& fields,
+                   int rank, int ranks)
     : directory_(directory),
       fields_(fields),
+      rank_(rank),
+      ranks_(ranks),
       frames_(create_output_directory(directory), "frames") {
+  if (rank_ != 0) return;
   energy_.open(std::filesystem::path(directory) / "energy.csv");
   energy_ << "time,kinetic,strain,gravity,contact,joint,dissipated_fracture,dissipated_friction,"
              "dissipated_damping,external_work,total,balance_error\n";
@@ -64,6 +68,7 @@ RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>&
 }
 
 void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balance_error) {
+  if (rank_ != 0) return;
   energy_ << time << ',' << e.kinetic << ',' << e.strain << ',' << e.gravity << ',' << e.contact
           << ',' << e.joint << ',' << e.dissipated_fracture << ',' << e.dissipated_friction << ','
           << e.dissipated_damping << ',' << e.external_work << ',' << e.total() << ','
@@ -71,8 +76,9 @@ void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balanc
   energy_.flush();
 }
 
-void RunFiles::write_bodies_rows(double time, const Model& model) {
-  const auto motion = piece_motions(model);
+void RunFiles::write_bodies_rows(double time, const Model& model,
+                                 const std::vector<PieceMotion>& motion) {
+  if (rank_ != 0) return;
   for (std::size_t p = 0; p < model.pieces.size(); ++p) {
     const PieceInfo& piece = model.pieces[p];
     const PieceMotion& m = motion[p];
@@ -98,6 +104,7 @@ std::vector<double> tet_damage(const Model& model) {
 }
 
 void RunFiles::write_frame(double time, const Model& model, const std::vector<FrameField>& extra) {
+  if (ranks_ > 1) return;  // PARALLEL-FRAMES: pieces per rank
   const std::string relative = frames_.next_frame_path() + ".vtu";
   std::vector<FrameField> fields = extra;
   if (std::find(fields_.begin(), fields_.end(), "damage") != fields_.end())
@@ -136,6 +143,7 @@ void RunFiles::write_cracks(double time, const Model& model) {
 }
 
 void RunFiles::write_contacts(double time, const std::vector<ContactRecord>& records) {
+  if (ranks_ > 1) return;  // PARALLEL-FRAMES: pieces per rank
   if (!contacts_) contacts_ = std::make_unique<SeriesWriter>(directory_, "contacts");
   std::vector<double> points, normal, tangential;
   for (const ContactRecord& r : records)
@@ -158,28 +166,30 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
   j << "  \"scene\": \"" << json_escape(scene_name) << "\",\n";
   j << "  \"status\": \"" << r.status << "\",\n";
   if (!r.reason.empty()) j << "  \"reason\": \"" << json_escape(r.reason) << "\",\n";
-  j << "  \"ranks\": 1,\n";
+  j << "  \"ranks\": " << r.ranks << ",\n";
   j << "  \"steps\": " << r.steps << ",\n";
   j << "  \"end_time\": " << JsonNumber{r.time} << ",\n";
   j << "  \"time_step\": " << JsonNumber{r.time_step} << ",\n";
   j << "  \"critical_time_step\": " << JsonNumber{r.critical_time_step} << ",\n";
   j << "  \"wall_seconds\": " << JsonNumber{r.wall_seconds} << ",\n";
-  j << "  \"nodes\": " << model.nodes.size() << ",\n";
-  j << "  \"elements\": " << model.tets.size() << ",\n";
+  j << "  \"nodes\": " << r.nodes << ",\n";
+  j << "  \"elements\": " << r.elements << ",\n";
   j << "  \"pieces\": " << model.pieces.size() << ",\n";
-  const JointArrays& joints = model.joints;
-  long broken = 0, by_mode[3] = {0, 0, 0};  // tension, shear, mixed
-  for (LocalIndex i = 0; i < joints.size(); ++i) {
-    if (!joints.broken[i]) continue;
-    ++broken;
-    const auto mode = static_cast<FailureMode>(joints.mode[i]);
-    ++by_mode[mode == FailureMode::tension ? 0 : mode == FailureMode::shear ? 1 : 2];
-  }
-  j << "  \"joints\": " << joints.size() << ",\n";
-  j << "  \"broken_joints\": " << broken << ",\n";
-  j << "  \"broken_by_mode\": {\"tension\": " << by_mode[0] << ", \"shear\": " << by_mode[1]
-    << ", \"mixed\": " << by_mode[2] << "},\n";
-  j << "  \"fragments\": " << count_fragments(model) << ",\n";
+  j << "  \"joints\": " << r.joints << ",\n";
+  j << "  \"broken_joints\": " << r.broken_joints << ",\n";
+  j << "  \"broken_by_mode\": {\"tension\": " << r.broken_by_mode[0]
+    << ", \"shear\": " << r.broken_by_mode[1] << ", \"mixed\": " << r.broken_by_mode[2] << "},\n";
+  if (r.fragments >= 0) j << "  \"fragments\": " << r.fragments << ",\n";
+  if (r.parallel)
+    j << "  \"decomposition\": {\"imbalance\": " << JsonNumber{r.imbalance}
+      << ", \"max_imbalance\": " << JsonNumber{r.max_imbalance}
+      << ", \"redistributions\": " << r.redistributions << ", \"rebalances\": " << r.rebalances
+      << ", \"migrated_elements\": " << r.migrated_elements
+      << ", \"halo_elements_max\": " << r.halo_elements_max
+      << ", \"ghost_nodes_max\": " << r.ghost_nodes_max
+      << ", \"ghost_nodes_mean\": " << r.ghost_nodes_mean
+      << ", \"neighbours_max\": " << r.neighbours_max
+      << ", \"communication_seconds\": " << JsonNumber{r.communication_seconds} << "},\n";
   j << "  \"stages\": {";
   bool first = true;
   for (const auto& s : r.stages) {
@@ -189,8 +199,7 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
     first = false;
   }
   j << "\n  },\n";
-  const double element_steps =
-      static_cast<double>(model.tets.size()) * static_cast<double>(r.steps);
+  const double element_steps = static_cast<double>(r.elements) * static_cast<double>(r.steps);
   j << "  \"throughput\": {\"element_steps_per_second\": "
     << JsonNumber{r.wall_seconds > 0 ? element_steps / r.wall_seconds : 0.0} << "},\n";
   const EnergyTerms& e = r.energy;
@@ -209,6 +218,7 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
 
 void RunFiles::write_summary(const RunReport& report, const Model& model,
                              const std::string& scene_name) {
+  if (rank_ != 0) return;
   write_file_atomically((std::filesystem::path(directory_) / "summary.json").string(),
                         summary_json(report, model, scene_name));
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "contact/contact_stage.hpp"
+#include "core/dynamics.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
 #include "io/vtk_output.hpp"
@@ -19,9 +20,12 @@ struct StagePlan;
 
 class RunFiles {
  public:
-  RunFiles(const std::string& directory, const std::vector<std::string>& fields);
+  // On N ranks every rank makes one (frames are written in pieces by every rank); the CSV and
+  // JSON files are written by rank 0 alone.
+  RunFiles(const std::string& directory, const std::vector<std::string>& fields, int rank = 0,
+           int ranks = 1);
   void write_energy_row(double time, const EnergyTerms& e, double balance_error);
-  void write_bodies_rows(double time, const Model& model);
+  void write_bodies_rows(double time, const Model& model, const std::vector<PieceMotion>& motion);
   // A frame of the tets; with `damage` in the fields, the per-tet damage; in a model with joints
   // also a frame of the "cracks" series (broken joint faces).
   void write_frame(double time, const Model& model, const std::vector<FrameField>& extra = {});
@@ -36,6 +40,7 @@ class RunFiles {
  private:
   std::string directory_;
   std::vector<std::string> fields_;
+  int rank_ = 0, ranks_ = 1;
   std::ofstream energy_, bodies_;
   SeriesWriter frames_;
   std::unique_ptr<SeriesWriter> contacts_, cracks_;

@@ -1,6 +1,7 @@
 #include "drivers/simulation.hpp"
 
 #include <cmath>
+#include <functional>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -9,12 +10,15 @@
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
 #include "core/model_builder.hpp"
+#include "fracture/joint_kernels.hpp"
 #include "core/state_hash.hpp"
 #include "core/time_step.hpp"
 #include "drivers/loads.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/run_files.hpp"
 #include "fracture/joint_stage.hpp"
+#include "parallel/communicator.hpp"
+#include "parallel/distribution.hpp"
 
 namespace fdem {
 
@@ -53,11 +57,12 @@ std::vector<std::string> StagePlan::describe() const {
   return s;
 }
 
-Simulation::Simulation(Scene scene, Model model, RunOptions options)
-    : scene_(std::move(scene)), model_(std::move(model)), options_(std::move(options)) {
-  const char* names[n_stages] = {"internal_forces",   "joint_forces",   "fracture",
+Simulation::Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm)
+    : scene_(std::move(scene)), model_(std::move(model)), options_(std::move(options)), comm_(comm) {
+  const char* names[n_stages] = {"internal_forces", "joint_forces",   "fracture",
                                  "contact_detection", "contact_forces", "external_forces",
-                                 "integrate",         "halo_update",    "output"};
+                                 "integrate",       "halo_update",    "redistribution",
+                                 "output"};
   for (int s = 0; s < n_stages; ++s) clocks_[s].name = names[s];
   loads_ = std::make_unique<LoadSchedule>(scene_, model_);
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
@@ -96,6 +101,80 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options)
   if (!std::isfinite(dt_) || dt_ <= 0.0)
     throw InputError(scene_.source_path + ": could not determine a time step (critical step " +
                      std::to_string(critical.dt) + " s)");
+  // N ranks: everything above came from the whole model (the same on every rank); now keep this
+  // rank's part and halo.
+  if (comm_ && comm_->size() > 1) {
+    TravellingState whole, local_state;
+    whole.x_at_detection = model_.nodes.x;
+    if (contact_) whole.tet_joint_state = contact_->tet_joint_states();
+    if (joints_) whole.joint_history = joints_->history();
+    DistributionSettings settings;
+    settings.rebalance_threshold = scene_.parallel.rebalance_threshold;
+    Model local;
+    distribution_ = std::make_unique<Distribution>(*comm_, settings, model_, whole,
+                                                   contact_ ? contact_->buffer() : 0.0, local,
+                                                   local_state);
+    model_ = std::move(local);
+    rebind_stages(local_state, false);
+  }
+}
+
+bool Simulation::is_root() const { return !comm_ || comm_->rank() == 0; }
+
+void Simulation::rebind_stages(TravellingState& state, bool detected) {
+  if (contact_)
+    contact_->rebind(model_, std::move(state.x_at_detection), std::move(state.tet_joint_state),
+                     state.friction, detected);
+  if (joints_) joints_->rebind(model_, std::move(state.joint_history));
+  loads_->rebind(model_);
+}
+
+void Simulation::redistribute() {
+  TravellingState state;
+  std::vector<std::int32_t> pairs_per_tet;
+  if (contact_) {
+    state.x_at_detection = contact_->x_at_detection();
+    state.tet_joint_state = contact_->tet_joint_states();
+    state.friction = contact_->friction_entries();
+    pairs_per_tet.assign(static_cast<std::size_t>(model_.tets.size()), 0);
+    for (const CandidatePair& p : contact_->candidates()) ++pairs_per_tet[p.a];
+  } else {
+    state.x_at_detection = model_.nodes.x;
+  }
+  if (joints_) state.joint_history = joints_->history();
+  distribution_->redistribute(model_, state, pairs_per_tet);
+  rebind_stages(state, contact_ && contact_->detected());
+  redistribute_pending_ = false;
+}
+
+// Joints break where they are computed; the owner of tet A tells every rank, so that every copy
+// of the joint and every copy of its tets' contact state changes at the same step as on one rank.
+void Simulation::share_broken_joints() {
+  struct Broken {
+    GlobalId joint, tet_a, tet_b;
+    double time;
+    std::int32_t mode;
+  };
+  std::vector<Broken> mine;
+  for (LocalIndex b : joints_->newly_broken())
+    mine.push_back({model_.joints.gid[b], model_.tets.gid[model_.joints.tets[2 * b]],
+                    model_.tets.gid[model_.joints.tets[2 * b + 1]], model_.joints.failure_time[b],
+                    model_.joints.mode[b]});
+  if (comm_->sum(static_cast<std::int64_t>(mine.size())) == 0) return;
+  const std::vector<Broken> all = comm_->allgatherv(mine);
+  const auto local_tet = [&](GlobalId gid) -> LocalIndex {  // local tets are in ascending gid
+    const auto it = std::lower_bound(model_.tets.gid.begin(), model_.tets.gid.end(), gid);
+    return it != model_.tets.gid.end() && *it == gid
+               ? static_cast<LocalIndex>(it - model_.tets.gid.begin())
+               : -1;
+  };
+  for (const Broken& b : all) {
+    const auto it = std::lower_bound(model_.joints.gid.begin(), model_.joints.gid.end(), b.joint);
+    if (it != model_.joints.gid.end() && *it == b.joint)
+      joints_->mark_broken(model_, static_cast<LocalIndex>(it - model_.joints.gid.begin()), b.time,
+                           static_cast<std::uint8_t>(b.mode));
+    if (contact_) contact_->release_bond(local_tet(b.tet_a), local_tet(b.tet_b));
+  }
 }
 
 Simulation::~Simulation() = default;
@@ -106,6 +185,21 @@ Simulation::~Simulation() = default;
 void Simulation::step() {
   NodeArrays& nodes = model_.nodes;
   EnergyTerms energy;
+
+  if (distribution_) {
+    // 8 (previous step) halo update completes: ghost positions and velocities at t_n
+    if (halo_in_flight_) {
+      Timed timed(clocks_[halo]);
+      distribution_->finish_halo_exchange(nodes);
+      halo_in_flight_ = false;
+    }
+    // 4b redistribution after a detection cycle: re-balance, migrate, rebuild the halo
+    const long every = scene_.parallel.redistribute_every;
+    if (redistribute_pending_ || (every > 0 && steps_ > 0 && steps_ % every == 0)) {
+      Timed timed(clocks_[migration]);
+      redistribute();
+    }
+  }
 
   // 0 time-dependent loads: gravity (tilt, ramp) at t_n, base velocities for the coming half step
   if (loads_->active()) {
@@ -119,43 +213,41 @@ void Simulation::step() {
     Timed timed(clocks_[internal]);
     forces = compute_internal_forces(model_);
   }
-  energy.strain = forces.strain_energy;
 
   // 2 joint forces: cohesive joints in ascending joint gid
+  JointStepSummary j;
   if (plan_.joints) {
-    JointStepSummary j;
     {
       Timed timed(clocks_[joints]);
       j = joints_->add_forces(model_, time_);
     }
-    energy.joint = j.stored_energy;
-    // The joints' dissipation covers x_{n-1} -> x_n, so all of it is "before" work at t_n.
-    energy.dissipated_fracture = ledger_.fracture.add(j.fracture_dissipated, 0.0);
-    energy.dissipated_friction = joint_friction_.add(j.friction_dissipated, 0.0);
     // 3 fracture: the tets of newly broken joints become contact partners
-    if (j.newly_broken > 0 && contact_) {
-      Timed timed(clocks_[fracture]);
+    Timed timed(clocks_[fracture]);
+    if (distribution_)
+      share_broken_joints();
+    else if (j.newly_broken > 0 && contact_)
       for (LocalIndex b : joints_->newly_broken())
         contact_->release_bond(model_.joints.tets[2 * b], model_.joints.tets[2 * b + 1]);
-    }
   }
-
-  double contact_damping = 0.0;  // J dissipated by contact dashpots this step
 
   // 4 contact detection: only when a node has moved more than buffer/2 since the last one
   if (plan_.contact) {
     Timed timed(clocks_[detection]);
-    contact_->detect_if_needed(model_);
+    if (distribution_) {
+      if (comm_->max(static_cast<std::int32_t>(contact_->detection_due(model_))) > 0) {
+        contact_->detect(model_);
+        redistribute_pending_ = true;
+      }
+    } else {
+      contact_->detect_if_needed(model_);
+    }
   }
 
   // 5 contact forces: potential tet–tet contact over the candidate pairs
+  ContactForceSummary c;
   if (plan_.contact) {
     Timed timed(clocks_[contact]);
-    const ContactForceSummary c = contact_->add_forces(model_, dt_);
-    contact_damping = c.damping_dissipated;
-    energy.contact = c.energy + c.friction_spring_energy;
-    energy.dissipated_friction +=
-        ledger_.friction.add(c.friction_work_before, c.friction_work_after);
+    c = contact_->add_forces(model_, dt_);
   }
 
   // 6 external forces
@@ -173,9 +265,66 @@ void Simulation::step() {
     motion = integrate_central_difference(dt_, nodes);
   }
 
-  // 8 halo update: nothing to exchange on one rank.
+  // 8 halo update: post the ghost exchange now, complete it at the start of the next step
+  if (distribution_) {
+    Timed timed(clocks_[halo]);
+    distribution_->start_halo_exchange(nodes);
+    halo_in_flight_ = true;
+  }
+
+  // The energy terms of every rank (each counts what it owns) in one reduction.
+  if (distribution_) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<double> terms = {forces.strain_energy,
+                                 forces.damping_power,
+                                 j.stored_energy,
+                                 j.fracture_dissipated,
+                                 j.friction_dissipated,
+                                 c.damping_dissipated,
+                                 c.energy,
+                                 c.friction_spring_energy,
+                                 c.friction_work_before,
+                                 c.friction_work_after,
+                                 motion.kinetic_energy,
+                                 motion.kinetic_energy_half_step,
+                                 motion.constraint_work_before,
+                                 motion.constraint_work_after,
+                                 motion.momentum_before.x(),
+                                 motion.momentum_before.y(),
+                                 motion.momentum_before.z(),
+                                 motion.momentum_after.x(),
+                                 motion.momentum_after.y(),
+                                 motion.momentum_after.z(),
+                                 motion.finite ? 0.0 : 1.0};
+    comm_->sum_in_place(terms);
+    int i = 0;
+    for (double* v : {&forces.strain_energy, &forces.damping_power, &j.stored_energy,
+                      &j.fracture_dissipated, &j.friction_dissipated, &c.damping_dissipated,
+                      &c.energy, &c.friction_spring_energy, &c.friction_work_before,
+                      &c.friction_work_after, &motion.kinetic_energy,
+                      &motion.kinetic_energy_half_step, &motion.constraint_work_before,
+                      &motion.constraint_work_after})
+      *v = terms[i++];
+    motion.momentum_before = Vec3(terms[14], terms[15], terms[16]);
+    motion.momentum_after = Vec3(terms[17], terms[18], terms[19]);
+    motion.finite = terms[20] == 0.0;
+    reduction_seconds_ +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
 
   // Energy balance at t_n
+  energy.strain = forces.strain_energy;
+  if (plan_.joints) {
+    energy.joint = j.stored_energy;
+    // The joints' dissipation covers x_{n-1} -> x_n, so all of it is "before" work at t_n.
+    energy.dissipated_fracture = ledger_.fracture.add(j.fracture_dissipated, 0.0);
+    energy.dissipated_friction = joint_friction_.add(j.friction_dissipated, 0.0);
+  }
+  if (plan_.contact) {
+    energy.contact = c.energy + c.friction_spring_energy;
+    energy.dissipated_friction +=
+        ledger_.friction.add(c.friction_work_before, c.friction_work_after);
+  }
   energy.kinetic = motion.kinetic_energy;
   kinetic_half_step_ = motion.kinetic_energy_half_step;
   // Gravity potential = − its trapezoid work, ½dt·g·(Σm·v⁻ + Σm·v⁺) per step: exact for a constant
@@ -183,7 +332,7 @@ void Simulation::step() {
   if (plan_.gravity)
     energy.gravity = -ledger_.gravity.add(0.5 * dt_ * model_.gravity.dot(motion.momentum_before),
                                           0.5 * dt_ * model_.gravity.dot(motion.momentum_after));
-  const double damping_step = forces.damping_power * dt_ + contact_damping;
+  const double damping_step = forces.damping_power * dt_ + c.damping_dissipated;
   energy.dissipated_damping = ledger_.damping.add(0.5 * damping_step, 0.5 * damping_step);
   energy.external_work =
       ledger_.external.add(motion.constraint_work_before, motion.constraint_work_after);
@@ -193,7 +342,10 @@ void Simulation::step() {
       std::max({energy_input_, std::abs(ledger_.initial_total()), std::abs(energy.external_work),
                 std::abs(ledger_.external.through_previous), std::abs(energy.gravity),
                 std::abs(ledger_.gravity.through_previous), energy_floor_});
-  check_state(forces, motion.finite);
+  if (distribution_)  // a failure on any rank stops every rank with its message
+    comm_->run_collectively([&] { check_state(forces, motion.finite); });
+  else
+    check_state(forces, motion.finite);
 
   time_ += dt_;
   ++steps_;
@@ -271,8 +423,45 @@ RunReport Simulation::report() const {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
   r.energy = ledger_.current();
   r.balance_error = ledger_.balance_error();
-  r.state_hash = hash_to_hex(state_hash(model_.nodes));
   for (const auto& c : clocks_) r.stages.push_back(c);
+  r.pieces = static_cast<long>(model_.pieces.size());
+  // Counts of what this rank owns (joints: by their tet A), summed over the ranks below.
+  std::vector<std::int64_t> counts = {model_.nodes.n_owned, 0, 0, 0, 0, 0, 0};
+  for (LocalIndex t = 0; t < model_.tets.size(); ++t) counts[1] += model_.tets.is_owned(t);
+  const JointArrays& joints = model_.joints;
+  for (LocalIndex i = 0; i < joints.size(); ++i) {
+    if (!model_.tets.is_owned(joints.tets[2 * i])) continue;
+    ++counts[2];
+    if (!joints.broken[i]) continue;
+    ++counts[3];
+    const auto mode = static_cast<FailureMode>(joints.mode[i]);
+    ++counts[4 + (mode == FailureMode::tension ? 0 : mode == FailureMode::shear ? 1 : 2)];
+  }
+  if (distribution_) {
+    comm_->sum_in_place(counts);
+    r.ranks = comm_->size();
+    r.state_hash = hash_to_hex(global_state_hash(model_.nodes, *comm_));
+    const DistributionReport& d = distribution_->report();
+    r.parallel = true;
+    r.imbalance = d.imbalance;
+    r.max_imbalance = d.max_imbalance;
+    r.redistributions = d.cycles;
+    r.rebalances = d.rebalances;
+    r.migrated_elements = d.migrated_tets;
+    r.halo_elements_max = d.halo_tets_max;
+    r.ghost_nodes_max = d.ghost_nodes_max;
+    r.ghost_nodes_mean = d.ghost_nodes_sum / comm_->size();
+    r.neighbours_max = d.neighbours_max;
+    r.communication_seconds = clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;
+  } else {
+    r.state_hash = hash_to_hex(state_hash(model_.nodes));
+    r.fragments = count_fragments(model_);
+  }
+  r.nodes = counts[0];
+  r.elements = counts[1];
+  r.joints = counts[2];
+  r.broken_joints = counts[3];
+  for (int m = 0; m < 3; ++m) r.broken_by_mode[m] = counts[4 + m];
   return r;
 }
 
@@ -291,9 +480,17 @@ void Simulation::write_outputs(bool force) {
       next_energy_time_ = scene_.time.end;
   }
   if (force || time_ >= next_frame_time_ - 1e-12 * dt_) {
+    std::function<void(std::vector<double>&)> sum_over_ranks;
+    if (distribution_) {
+      if (halo_in_flight_) {  // frames show ghost nodes of owned tets: complete the exchange
+        distribution_->finish_halo_exchange(model_.nodes);
+        halo_in_flight_ = false;
+      }
+      sum_over_ranks = [this](std::vector<double>& v) { comm_->sum_in_place(v); };
+    }
     files_->write_frame(time_, model_);
     if (contact_) files_->write_contacts(time_, contact_->records());
-    files_->write_bodies_rows(time_, model_);
+    files_->write_bodies_rows(time_, model_, piece_motions(model_, sum_over_ranks));
     if (scene_.output.every > 0)
       while (next_frame_time_ <= time_ + 1e-12 * dt_) next_frame_time_ += scene_.output.every;
     else
@@ -303,8 +500,17 @@ void Simulation::write_outputs(bool force) {
 
 RunReport Simulation::run() {
   wall_start_ = std::chrono::steady_clock::now();
-  if (options_.write_output)
-    files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields);
+  if (options_.write_output) {
+    if (comm_)  // rank 0 creates the directory first: every rank writes its frame pieces there
+      comm_->run_collectively([&] {
+        if (comm_->rank() == 0)
+          files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields, 0,
+                                              comm_->size());
+      });
+    if (!files_)
+      files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields,
+                                          comm_ ? comm_->rank() : 0, comm_ ? comm_->size() : 1);
+  }
   const long total_steps = static_cast<long>(std::ceil(scene_.time.end / dt_ - 1e-9));
   RunReport result;
   auto last_progress = wall_start_;
@@ -314,8 +520,9 @@ RunReport Simulation::run() {
       step();
       write_outputs(steps_ == total_steps);
       const auto now = std::chrono::steady_clock::now();
-      if (!options_.quiet && (std::chrono::duration<double>(now - last_progress).count() > 0.5 ||
-                              steps_ == total_steps)) {
+      if (!options_.quiet && is_root() &&
+          (std::chrono::duration<double>(now - last_progress).count() > 0.5 ||
+           steps_ == total_steps)) {
         last_progress = now;
         const double wall = std::chrono::duration<double>(now - wall_start_).count();
         const double rate = steps_ / std::max(wall, 1e-9);
@@ -330,13 +537,13 @@ RunReport Simulation::run() {
     result = report();
     result.status = "completed";
   } catch (const NumericalFailure& failure) {
-    if (!options_.quiet) std::fprintf(stderr, "\n");
+    if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
     result = report();
     result.status = "failed";
     result.reason = failure.what();
   }
   if (files_) files_->write_summary(result, model_, scene_.name);
-  if (!options_.quiet) {
+  if (!options_.quiet && is_root()) {
     std::fprintf(stderr, "\n%-20s %12s %10s %8s\n", "stage", "seconds", "calls", "share");
     double total = 0.0;
     for (const auto& c : result.stages) total += c.seconds;
@@ -347,16 +554,33 @@ RunReport Simulation::run() {
     std::fprintf(
         stderr, "wall %.3f s, %ld steps, %.3g element-steps/s, energy balance error %.2e\n",
         result.wall_seconds, result.steps,
-        result.wall_seconds > 0 ? double(model_.tets.size()) * result.steps / result.wall_seconds
+        result.wall_seconds > 0 ? double(result.elements) * result.steps / result.wall_seconds
                                 : 0.0,
         result.balance_error);
+    if (result.parallel)
+      std::fprintf(stderr,
+                   "%d ranks: imbalance %.3f (max %.3f), %ld redistributions, %ld re-partitions, "
+                   "%ld elements migrated, halo up to %ld elements / %ld ghost nodes, "
+                   "communication %.3f s\n",
+                   result.ranks, result.imbalance, result.max_imbalance, result.redistributions,
+                   result.rebalances, result.migrated_elements, result.halo_elements_max,
+                   result.ghost_nodes_max, result.communication_seconds);
   }
   return result;
 }
 
-std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options) {
-  Model model = build_model(scene, load_body_meshes(scene));
-  return std::make_unique<Simulation>(scene, std::move(model), std::move(options));
+std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options,
+                                            const Communicator* comm) {
+  if (!comm || comm->size() == 1) {
+    Model model = build_model(scene, load_body_meshes(scene));
+    return std::make_unique<Simulation>(scene, std::move(model), std::move(options), comm);
+  }
+  // Every rank builds the same whole model; a bad scene or mesh stops every rank with the message.
+  // What the constructor checks before distributing is decided from that same model, so every
+  // rank throws alike there.
+  Model model;
+  comm->run_collectively([&] { model = build_model(scene, load_body_meshes(scene)); });
+  return std::make_unique<Simulation>(scene, std::move(model), std::move(options), comm);
 }
 
 }  // namespace fdem

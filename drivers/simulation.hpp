@@ -15,6 +15,9 @@ namespace fdem {
 
 class SeriesWriter;
 class RunFiles;
+class Communicator;
+class Distribution;
+struct TravellingState;
 class ContactStage;
 class JointStage;
 class LoadSchedule;
@@ -53,11 +56,24 @@ struct RunReport {
   double balance_error = 0.0;
   std::string state_hash;
   std::vector<StageClock> stages;
+  // Counts over all ranks.
+  int ranks = 1;
+  long nodes = 0, elements = 0, pieces = 0, joints = 0, broken_joints = 0;
+  long broken_by_mode[3] = {0, 0, 0};  // tension, shear, mixed
+  long fragments = -1;                 // discrete elements now (−1: not counted on N ranks)
+  // Decomposition (N ranks): imbalance = max/mean owned cost, halo and migration sizes.
+  bool parallel = false;
+  double imbalance = 1.0, max_imbalance = 1.0;
+  long redistributions = 0, rebalances = 0, migrated_elements = 0;
+  long halo_elements_max = 0, ghost_nodes_max = 0, ghost_nodes_mean = 0, neighbours_max = 0;
+  double communication_seconds = 0.0;  // halo exchange + redistribution + reductions (rank 0)
 };
 
 class Simulation {
  public:
-  Simulation(Scene scene, Model model, RunOptions options);
+  // `comm`: the ranks that run it together (nullptr or one rank: serial).  On N ranks every rank
+  // passes the same whole model; each keeps its part and halo (parallel/distribution.hpp).
+  Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm = nullptr);
   ~Simulation();
 
   // Runs to scene.time.end (writing outputs); never throws NumericalFailure: a failure is
@@ -91,10 +107,15 @@ class Simulation {
     external,
     integrate,
     halo,
+    migration,
     output,
     n_stages
   };
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
+  void redistribute();
+  void rebind_stages(TravellingState& state, bool detected);
+  void share_broken_joints();
+  bool is_root() const;
   void write_outputs(bool force);
   void start_half_step(NodeArrays& nodes) const;
 
@@ -117,9 +138,15 @@ class Simulation {
   std::unique_ptr<JointStage> joints_;
   std::unique_ptr<LoadSchedule> loads_;  // time-dependent loads (drivers/loads)
   WorkAccumulator joint_friction_;       // Coulomb slip inside joints (part of dissipated_friction)
+  const Communicator* comm_ = nullptr;
+  std::unique_ptr<Distribution> distribution_;  // N ranks only
+  bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step
+  bool halo_in_flight_ = false;                 // ghost exchange posted, not yet completed
+  double reduction_seconds_ = 0.0;
 };
 
 // Builds a Simulation from a scene file (meshes loaded or generated).
-std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options);
+std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options,
+                                            const Communicator* comm = nullptr);
 
 }  // namespace fdem

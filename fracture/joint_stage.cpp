@@ -1,5 +1,6 @@
 #include "fracture/joint_stage.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -58,17 +59,21 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
   JointArrays& joints = model.joints;
   NodeArrays& nodes = model.nodes;
   const LocalIndex n = joints.size();
+  const TetArrays& tets = model.tets;
   for (LocalIndex j = 0; j < n; ++j) {
     if (joints.broken[j]) continue;
+    const LocalIndex tet_a = joints.tets[2 * j], tet_b = joints.tets[2 * j + 1];
+    if (!tets.is_active(tet_a) && !tets.is_active(tet_b)) continue;  // other ranks compute it
+    const double share = tets.is_owned(tet_a) ? 1.0 : 0.0;  // the owner of A reports it
     const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
     Vec3 x[6];
     for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[i]);
     JointHistory& h = history_[j];
     const JointForce f = joint_force(x, joints.area0[j], laws_[joints.law[j]], h);
     for (int i = 0; i < 6; ++i) vec3_at(nodes.f.data(), id[i]) += f.force[i];
-    out.stored_energy += f.stored_energy;
-    out.fracture_dissipated += f.fracture_energy;
-    out.friction_dissipated += f.friction_energy;
+    out.stored_energy += share * f.stored_energy;
+    out.fracture_dissipated += share * f.fracture_energy;
+    out.friction_dissipated += share * f.friction_energy;
     joints.damage[j] = h.damage();
     if (f.newly_broken) {
       h.failure_time = time;
@@ -78,10 +83,35 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
       newly_broken_.push_back(j);
     }
   }
+  // Count the ones this rank reports; the others learn of them through mark_broken.
+  newly_broken_.erase(std::remove_if(newly_broken_.begin(), newly_broken_.end(),
+                                     [&](LocalIndex j) { return !tets.is_owned(joints.tets[2 * j]); }),
+                      newly_broken_.end());
   broken_ += static_cast<LocalIndex>(newly_broken_.size());
   out.newly_broken = static_cast<LocalIndex>(newly_broken_.size());
   out.broken = broken_;
   return out;
+}
+
+void JointStage::rebind(const Model& model, std::vector<JointHistory> history) {
+  FDEM_VERIFY(history.size() == static_cast<std::size_t>(model.joints.size()),
+              "one history per local joint");
+  history_ = std::move(history);
+  newly_broken_.clear();
+}
+
+void JointStage::mark_broken(Model& model, LocalIndex j, double time, std::uint8_t mode) {
+  JointArrays& joints = model.joints;
+  if (joints.broken[j]) return;
+  JointHistory& h = history_[j];
+  h.broken = true;
+  h.mode = static_cast<FailureMode>(mode);
+  h.failure_time = time;
+  for (auto& p : h.point) p.damage = 1.0;
+  joints.broken[j] = 1;
+  joints.mode[j] = mode;
+  joints.failure_time[j] = time;
+  joints.damage[j] = 1.0;
 }
 
 double JointStage::critical_time_step(const Model& model) const {

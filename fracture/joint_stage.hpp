@@ -31,6 +31,8 @@ class JointStage {
 
   // Advances every intact joint to the current positions, adds its forces to model.nodes.f in
   // ascending joint gid, and marks joints that break with `time` (s) and their failure mode.
+  // With parallel roles, only joints with an active tet are computed, and only those whose tet A
+  // is owned count in the energies and in newly_broken().
   // The dissipation terms cover the motion since the previous call, so for the trapezoid
   // accumulators of core/energy.hpp they are all "before" work (see docs/fracture-model.md).
   JointStepSummary add_forces(Model& model, double time);
@@ -43,6 +45,12 @@ class JointStage {
   // Gershgorin on M⁻¹K bounds ω² by max over nodes of Σ 2·k·A0/3 / m.  Combine with the other
   // bounds by adding ω².
   double critical_time_step(const Model& model) const;
+
+  // Parallel runs: the local joints changed (redistribution); take their histories (one per
+  // local joint, in the model's joint order).
+  void rebind(const Model& model, std::vector<JointHistory> history);
+  // A joint that broke on another rank: mark the local copy broken at `time` with `mode`.
+  void mark_broken(Model& model, LocalIndex joint, double time, std::uint8_t mode);
 
   const std::vector<CohesiveLaw>& laws() const { return laws_; }
   const std::vector<JointHistory>& history() const { return history_; }

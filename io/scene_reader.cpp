@@ -629,7 +629,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   scene.source_path = path;
   r.check_keys(root, "",
                {"name", "time", "gravity", "materials", "bodies", "interfaces", "loads", "output",
-                "contact"},
+                "contact", "parallel"},
                {"time", "materials", "bodies"});
   scene.name =
       root["name"] ? r.string(root["name"], "name") : std::filesystem::path(path).stem().string();
@@ -805,6 +805,21 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
         scene.output.fields.push_back(
             r.choice(fields[i], "output.fields",
                      {"displacement", "velocity", "stress", "damage", "contact_force"}));
+    }
+  }
+
+  if (const YAML::Node parallel = root["parallel"]) {
+    r.check_keys(parallel, "parallel", {"rebalance_threshold", "redistribute_every"});
+    if (parallel["rebalance_threshold"])
+      scene.parallel.rebalance_threshold =
+          r.non_negative(parallel["rebalance_threshold"], "parallel.rebalance_threshold",
+                         "load imbalance (max/mean cost) above which ranks re-partition");
+    if (parallel["redistribute_every"]) {
+      const int every = r.integer(parallel["redistribute_every"], "parallel.redistribute_every");
+      if (every < 0)
+        r.fail(parallel["redistribute_every"], "parallel.redistribute_every",
+               "expected a number of steps >= 0 (0: only at contact detections)");
+      scene.parallel.redistribute_every = every;
     }
   }
 

@@ -1,0 +1,707 @@
+#include "parallel/distribution.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <type_traits>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "core/state_hash.hpp"
+#include "parallel/partition.hpp"
+
+namespace fdem {
+
+namespace {
+
+// Rows as they travel: plain values, node and tet references as global ids.
+struct TetRow {
+  GlobalId gid;
+  GlobalId nodes[4];
+  double dm_inv[9];
+  double volume0, viscosity;
+  std::int32_t material, piece, contact_group;
+  std::uint8_t joint_state;
+};
+struct NodeRow {
+  GlobalId gid;
+  double x[3], x0[3], v[3], prescribed_velocity[3], x_at_detection[3];
+  double mass;
+  std::int32_t piece;
+  std::uint8_t constrained;
+};
+struct JointRow {
+  GlobalId gid;
+  GlobalId nodes[6];
+  GlobalId tets[2];
+  double area0, failure_time, damage;
+  std::int32_t law;
+  std::uint8_t broken, mode;
+  JointHistory history;
+};
+struct FrictionRow {
+  GlobalId a, b;
+  double spring[3];
+  double stiffness;
+};
+struct BlockHeader {
+  std::int64_t tets = 0, nodes = 0, joints = 0, friction = 0;
+};
+static_assert(std::is_trivially_copyable_v<JointHistory>, "joint history travels as bytes");
+
+template <class T>
+void append(std::vector<char>& out, const T& value) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const std::size_t at = out.size();
+  out.resize(at + sizeof(T));
+  std::memcpy(out.data() + at, &value, sizeof(T));
+}
+
+template <class T>
+T take(const char*& p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  p += sizeof(T);
+  return value;
+}
+
+// Axis-aligned box of a tet at the current positions: lo xyz, hi xyz.
+void tet_box(const Model& model, LocalIndex t, double box[6]) {
+  const double* x = model.nodes.x.data();
+  for (int k = 0; k < 3; ++k) {
+    box[k] = std::numeric_limits<double>::infinity();
+    box[3 + k] = -box[k];
+  }
+  for (int c = 0; c < 4; ++c) {
+    const LocalIndex n = model.tets.nodes[4 * static_cast<std::size_t>(t) + c];
+    for (int k = 0; k < 3; ++k) {
+      box[k] = std::min(box[k], x[3 * n + k]);
+      box[3 + k] = std::max(box[3 + k], x[3 * n + k]);
+    }
+  }
+}
+
+bool boxes_meet(const double* a, const double* b) {
+  for (int k = 0; k < 3; ++k)
+    if (a[k] > b[3 + k] || b[k] > a[3 + k]) return false;
+  return true;
+}
+
+// Packs the rows that travel with a set of tets: the tets, their nodes (once per block), the
+// joints whose first tet they are, and their friction pairs (pairs keyed by their first tet).
+class RowPacker {
+ public:
+  RowPacker(const Model& model, const TravellingState& state)
+      : model_(model), state_(state), stamp_(model.nodes.size(), -1) {
+    const JointArrays& joints = model.joints;
+    joint_offsets_.assign(static_cast<std::size_t>(model.tets.size()) + 1, 0);
+    for (LocalIndex j = 0; j < joints.size(); ++j) ++joint_offsets_[joints.tets[2 * j] + 1];
+    std::partial_sum(joint_offsets_.begin(), joint_offsets_.end(), joint_offsets_.begin());
+    joint_list_.resize(static_cast<std::size_t>(joints.size()));
+    std::vector<std::int64_t> fill(joint_offsets_.begin(), joint_offsets_.end() - 1);
+    for (LocalIndex j = 0; j < joints.size(); ++j) joint_list_[fill[joints.tets[2 * j]]++] = j;
+  }
+
+  void pack(const std::vector<LocalIndex>& tet_list, std::vector<char>& out) {
+    ++mark_;
+    const NodeArrays& nodes = model_.nodes;
+    const TetArrays& tets = model_.tets;
+    const JointArrays& joints = model_.joints;
+    std::vector<LocalIndex> node_list, joint_list;
+    std::vector<const FrictionEntry*> friction_list;
+    for (LocalIndex t : tet_list) {
+      for (int c = 0; c < 4; ++c) {
+        const LocalIndex n = tets.nodes[4 * static_cast<std::size_t>(t) + c];
+        if (stamp_[n] != mark_) {
+          stamp_[n] = mark_;
+          node_list.push_back(n);
+        }
+      }
+      for (std::int64_t k = joint_offsets_[t]; k < joint_offsets_[t + 1]; ++k)
+        joint_list.push_back(joint_list_[k]);
+      const GlobalId g = tets.gid[t];
+      auto it = std::lower_bound(
+          state_.friction.begin(), state_.friction.end(), g,
+          [](const FrictionEntry& e, GlobalId value) { return e.a < value; });
+      for (; it != state_.friction.end() && it->a == g; ++it) friction_list.push_back(&*it);
+    }
+    BlockHeader header;
+    header.tets = static_cast<std::int64_t>(tet_list.size());
+    header.nodes = static_cast<std::int64_t>(node_list.size());
+    header.joints = static_cast<std::int64_t>(joint_list.size());
+    header.friction = static_cast<std::int64_t>(friction_list.size());
+    out.reserve(out.size() + sizeof(header) + tet_list.size() * sizeof(TetRow) +
+                node_list.size() * sizeof(NodeRow) + joint_list.size() * sizeof(JointRow) +
+                friction_list.size() * sizeof(FrictionRow));
+    append(out, header);
+    for (LocalIndex t : tet_list) {
+      TetRow row{};
+      row.gid = tets.gid[t];
+      for (int c = 0; c < 4; ++c) row.nodes[c] = nodes.gid[tets.nodes[4 * t + c]];
+      std::copy_n(&tets.dm_inv[9 * static_cast<std::size_t>(t)], 9, row.dm_inv);
+      row.volume0 = tets.volume0[t];
+      row.viscosity = tets.viscosity[t];
+      row.material = tets.material[t];
+      row.piece = tets.piece[t];
+      row.contact_group = tets.group_of(t);
+      row.joint_state = state_.tet_joint_state.empty() ? 0 : state_.tet_joint_state[t];
+      append(out, row);
+    }
+    for (LocalIndex n : node_list) {
+      NodeRow row{};
+      row.gid = nodes.gid[n];
+      for (int k = 0; k < 3; ++k) {
+        row.x[k] = nodes.x[3 * n + k];
+        row.x0[k] = nodes.x0[3 * n + k];
+        row.v[k] = nodes.v[3 * n + k];
+        row.prescribed_velocity[k] = nodes.prescribed_velocity[3 * n + k];
+        row.x_at_detection[k] = state_.x_at_detection[3 * n + k];
+      }
+      row.mass = nodes.mass[n];
+      row.piece = nodes.piece[n];
+      row.constrained = nodes.constrained[n];
+      append(out, row);
+    }
+    for (LocalIndex j : joint_list) {
+      JointRow row{};
+      row.gid = joints.gid[j];
+      for (int i = 0; i < 6; ++i) row.nodes[i] = nodes.gid[joints.nodes[6 * j + i]];
+      for (int i = 0; i < 2; ++i) row.tets[i] = tets.gid[joints.tets[2 * j + i]];
+      row.area0 = joints.area0[j];
+      row.failure_time = joints.failure_time[j];
+      row.damage = joints.damage[j];
+      row.law = joints.law[j];
+      row.broken = joints.broken[j];
+      row.mode = joints.mode[j];
+      row.history = state_.joint_history[j];
+      append(out, row);
+    }
+    for (const FrictionEntry* e : friction_list) {
+      FrictionRow row{};
+      row.a = e->a;
+      row.b = e->b;
+      for (int k = 0; k < 3; ++k) row.spring[k] = e->spring[k];
+      row.stiffness = e->stiffness;
+      append(out, row);
+    }
+  }
+
+ private:
+  const Model& model_;
+  const TravellingState& state_;
+  std::vector<int> stamp_;
+  int mark_ = 0;
+  std::vector<std::int64_t> joint_offsets_;
+  std::vector<LocalIndex> joint_list_;
+};
+
+// Boxes (lo xyz, hi xyz per part) of the tets each part owns, grown by `margin`, and which parts'
+// boxes a tet meets.
+struct PartBoxes {
+  std::vector<double> box;  // 6 per part
+  std::vector<int> near;    // parts whose grown box meets this rank's region (candidates)
+
+  void grow(double margin) {
+    for (std::size_t p = 0; p < box.size() / 6; ++p)
+      for (int k = 0; k < 3; ++k) {
+        box[6 * p + k] -= margin;
+        box[6 * p + 3 + k] += margin;
+      }
+  }
+};
+
+}  // namespace
+
+Distribution::Distribution(const Communicator& comm, DistributionSettings settings,
+                           const Model& global, const TravellingState& global_state,
+                           double buffer, Model& local, TravellingState& local_state)
+    : comm_(comm), settings_(settings), buffer_(buffer) {
+  const auto start = std::chrono::steady_clock::now();
+  const TetArrays& tets = global.tets;
+  const int ranks = comm_.size(), me = comm_.rank();
+  // Node → its smallest tet gid: fixed for the whole run (fracture breaks joints, never tets).
+  GlobalId max_node = -1, max_tet = -1;
+  for (LocalIndex n = 0; n < global.nodes.size(); ++n) max_node = std::max(max_node, global.nodes.gid[n]);
+  for (LocalIndex t = 0; t < tets.size(); ++t) max_tet = std::max(max_tet, tets.gid[t]);
+  node_first_tet_.assign(static_cast<std::size_t>(max_node + 1), std::numeric_limits<GlobalId>::max());
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    for (int c = 0; c < 4; ++c) {
+      GlobalId& first = node_first_tet_[global.nodes.gid[tets.nodes[4 * t + c]]];
+      first = std::min(first, tets.gid[t]);
+    }
+
+  // Initial partition: METIS on the element graph (faces and joints, weighted by cost), on rank 0.
+  part_.assign(static_cast<std::size_t>(max_tet + 1), 0);
+  if (ranks > 1) {
+    std::string encoded;
+    if (me == 0) {
+      CostModel cost;
+      cost.joint = settings_.joint_cost;
+      const ElementGraph graph = element_graph(global, cost);
+      const std::vector<std::int32_t> parts = partition_metis(graph, ranks);
+      for (std::int32_t v = 0; v < graph.n_vertices(); ++v)
+        part_[static_cast<std::size_t>(graph.gid[v])] = parts[v];
+      encoded.assign(reinterpret_cast<const char*>(part_.data()),
+                     part_.size() * sizeof(std::int32_t));
+    }
+    encoded = comm_.broadcast(encoded, 0);
+    std::memcpy(part_.data(), encoded.data(), part_.size() * sizeof(std::int32_t));
+  }
+
+  // This rank's tets: its own and every tet within the margin of their box.
+  std::vector<double> boxes(6 * static_cast<std::size_t>(ranks));
+  for (int p = 0; p < ranks; ++p)
+    for (int k = 0; k < 3; ++k) {
+      boxes[6 * p + k] = std::numeric_limits<double>::infinity();
+      boxes[6 * p + 3 + k] = -std::numeric_limits<double>::infinity();
+    }
+  double extent = 0.0;
+  std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
+    tet_box(global, t, b);
+    const int p = part_[static_cast<std::size_t>(tets.gid[t])];
+    for (int k = 0; k < 3; ++k) {
+      boxes[6 * p + k] = std::min(boxes[6 * p + k], b[k]);
+      boxes[6 * p + 3 + k] = std::max(boxes[6 * p + 3 + k], b[3 + k]);
+      extent = std::max(extent, b[3 + k] - b[k]);
+    }
+  }
+  const double margin = 2.0 * extent + 2.0 * buffer_;
+  double* mine = &boxes[6 * static_cast<std::size_t>(me)];
+  for (int k = 0; k < 3; ++k) {
+    mine[k] -= margin;
+    mine[3 + k] += margin;
+  }
+  std::vector<LocalIndex> selected;
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (part_[static_cast<std::size_t>(tets.gid[t])] == me ||
+        boxes_meet(&tet_boxes[6 * static_cast<std::size_t>(t)], mine))
+      selected.push_back(t);
+  has_joint_state_ = !global_state.tet_joint_state.empty();
+  std::vector<char> rows;
+  RowPacker(global, global_state).pack(selected, rows);
+  local.materials = global.materials;
+  local.pieces = global.pieces;
+  local.body_names = global.body_names;
+  local.body_fixed = global.body_fixed;
+  local.gravity = global.gravity;
+  local.joint_laws = global.joint_laws;
+  assemble(rows, local, local_state);
+  build_exchange(local);
+  report_.cycles = 1;
+  update_report(local);
+  report_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Distribution::assemble(const std::vector<char>& rows, Model& model,
+                            TravellingState& state) const {
+  const int me = comm_.rank();
+  std::vector<TetRow> tet_rows;
+  std::vector<NodeRow> node_rows;
+  std::vector<JointRow> joint_rows;
+  std::vector<FrictionRow> friction_rows;
+  for (const char* p = rows.data(); p < rows.data() + rows.size();) {
+    const BlockHeader header = take<BlockHeader>(p);
+    for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
+    for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
+    for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
+    for (std::int64_t i = 0; i < header.friction; ++i) friction_rows.push_back(take<FrictionRow>(p));
+  }
+  const auto by_gid = [](const auto& a, const auto& b) { return a.gid < b.gid; };
+  const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
+  std::sort(tet_rows.begin(), tet_rows.end(), by_gid);
+  FDEM_VERIFY(std::adjacent_find(tet_rows.begin(), tet_rows.end(), same_gid) == tet_rows.end(),
+              "a tet arrives once");
+  std::sort(node_rows.begin(), node_rows.end(), by_gid);
+  node_rows.erase(std::unique(node_rows.begin(), node_rows.end(), same_gid), node_rows.end());
+  // Owned nodes first (integrated here), then ghosts; each range in ascending gid.
+  std::stable_partition(node_rows.begin(), node_rows.end(),
+                        [&](const NodeRow& r) { return owner_of_node(r.gid) == me; });
+
+  NodeArrays& nodes = model.nodes;
+  const LocalIndex n_nodes = static_cast<LocalIndex>(node_rows.size());
+  nodes.resize(n_nodes);
+  nodes.n_owned = 0;
+  state.x_at_detection.assign(3 * static_cast<std::size_t>(n_nodes), 0.0);
+  std::unordered_map<GlobalId, LocalIndex> node_index;
+  node_index.reserve(node_rows.size());
+  for (LocalIndex n = 0; n < n_nodes; ++n) {
+    const NodeRow& r = node_rows[n];
+    if (owner_of_node(r.gid) == me) nodes.n_owned = n + 1;
+    nodes.gid[n] = r.gid;
+    for (int k = 0; k < 3; ++k) {
+      nodes.x[3 * n + k] = r.x[k];
+      nodes.x0[3 * n + k] = r.x0[k];
+      nodes.v[3 * n + k] = r.v[k];
+      nodes.f[3 * n + k] = 0.0;
+      nodes.prescribed_velocity[3 * n + k] = r.prescribed_velocity[k];
+      state.x_at_detection[3 * n + k] = r.x_at_detection[k];
+    }
+    nodes.mass[n] = r.mass;
+    nodes.piece[n] = r.piece;
+    nodes.constrained[n] = r.constrained;
+    node_index.emplace(r.gid, n);
+  }
+
+  TetArrays& tets = model.tets;
+  const LocalIndex n_tets = static_cast<LocalIndex>(tet_rows.size());
+  tets.resize(n_tets);
+  tets.n_owned = 0;
+  tets.contact_group.resize(n_tets);
+  tets.owned.assign(n_tets, 0);
+  tets.active.assign(n_tets, 0);
+  state.tet_joint_state.assign(has_joint_state_ ? n_tets : 0, 0);
+  std::unordered_map<GlobalId, LocalIndex> tet_index;
+  tet_index.reserve(tet_rows.size());
+  for (LocalIndex t = 0; t < n_tets; ++t) {
+    const TetRow& r = tet_rows[t];
+    tets.gid[t] = r.gid;
+    bool touches_owned = false;
+    for (int c = 0; c < 4; ++c) {
+      const auto it = node_index.find(r.nodes[c]);
+      FDEM_VERIFY(it != node_index.end(), "a tet arrives with its nodes");
+      tets.nodes[4 * t + c] = it->second;
+      touches_owned = touches_owned || it->second < nodes.n_owned;
+    }
+    std::copy_n(r.dm_inv, 9, &tets.dm_inv[9 * static_cast<std::size_t>(t)]);
+    tets.volume0[t] = r.volume0;
+    tets.viscosity[t] = r.viscosity;
+    tets.material[t] = r.material;
+    tets.piece[t] = r.piece;
+    tets.contact_group[t] = r.contact_group;
+    tets.owned[t] = owner_of_tet(r.gid) == me;
+    tets.active[t] = tets.owned[t] || touches_owned;
+    tets.n_owned += tets.owned[t];
+    if (has_joint_state_) state.tet_joint_state[t] = r.joint_state;
+    tet_index.emplace(r.gid, t);
+  }
+  build_tet_force_order(tets, model.tet_force_order);
+
+  // Joints whose two tets are both here (a joint with one tet missing is never computed here).
+  std::sort(joint_rows.begin(), joint_rows.end(), by_gid);
+  joint_rows.erase(std::unique(joint_rows.begin(), joint_rows.end(), same_gid), joint_rows.end());
+  joint_rows.erase(std::remove_if(joint_rows.begin(), joint_rows.end(),
+                                  [&](const JointRow& r) {
+                                    return !tet_index.count(r.tets[0]) ||
+                                           !tet_index.count(r.tets[1]);
+                                  }),
+                   joint_rows.end());
+  JointArrays& joints = model.joints;
+  const LocalIndex n_joints = static_cast<LocalIndex>(joint_rows.size());
+  joints = JointArrays{};
+  joints.resize(n_joints);
+  state.joint_history.assign(static_cast<std::size_t>(n_joints), JointHistory{});
+  for (LocalIndex j = 0; j < n_joints; ++j) {
+    const JointRow& r = joint_rows[j];
+    joints.gid[j] = r.gid;
+    for (int i = 0; i < 6; ++i) {
+      const auto it = node_index.find(r.nodes[i]);
+      FDEM_VERIFY(it != node_index.end(), "a joint's nodes are those of its tets");
+      joints.nodes[6 * j + i] = it->second;
+    }
+    for (int i = 0; i < 2; ++i) joints.tets[2 * j + i] = tet_index.at(r.tets[i]);
+    joints.area0[j] = r.area0;
+    joints.failure_time[j] = r.failure_time;
+    joints.damage[j] = r.damage;
+    joints.law[j] = r.law;
+    joints.broken[j] = r.broken;
+    joints.mode[j] = r.mode;
+    state.joint_history[j] = r.history;
+  }
+
+  state.friction.clear();
+  state.friction.reserve(friction_rows.size());
+  for (const FrictionRow& r : friction_rows) {
+    FrictionEntry e;
+    e.a = r.a;
+    e.b = r.b;
+    e.spring = Vec3(r.spring[0], r.spring[1], r.spring[2]);
+    e.stiffness = r.stiffness;
+    state.friction.push_back(e);
+  }
+  std::sort(state.friction.begin(), state.friction.end(),
+            [](const FrictionEntry& p, const FrictionEntry& q) {
+              return p.a != q.a ? p.a < q.a : p.b < q.b;
+            });
+}
+
+void Distribution::redistribute(Model& model, TravellingState& state,
+                                const std::vector<std::int32_t>& pairs_per_tet) {
+  const auto start = std::chrono::steady_clock::now();
+  const int ranks = comm_.size(), me = comm_.rank();
+  const TetArrays& tets = model.tets;
+
+  // Owned cost: tets, their intact joints (half each side), contact pairs on their first tet.
+  std::vector<double> cost(static_cast<std::size_t>(tets.size()), 0.0);
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (tets.is_owned(t))
+      cost[t] = 1.0 + (pairs_per_tet.empty() ? 0.0 : settings_.pair_cost * pairs_per_tet[t]);
+  for (LocalIndex j = 0; j < model.joints.size(); ++j)
+    if (!model.joints.broken[j])
+      for (int side = 0; side < 2; ++side) {
+        const LocalIndex t = model.joints.tets[2 * j + side];
+        if (tets.is_owned(t)) cost[t] += 0.5 * settings_.joint_cost;
+      }
+  double my_cost = 0.0;
+  for (LocalIndex t = 0; t < tets.size(); ++t) my_cost += cost[t];
+  const std::vector<double> rank_cost = comm_.allgather(my_cost);
+  const double total = std::accumulate(rank_cost.begin(), rank_cost.end(), 0.0);
+  const double mean = total / ranks;
+  const double before =
+      mean > 0.0 ? *std::max_element(rank_cost.begin(), rank_cost.end()) / mean : 1.0;
+  report_.imbalance_before = before;
+  report_.max_imbalance = std::max(report_.max_imbalance, before);
+  report_.imbalance = before;
+
+  long migrated = 0;
+  if (ranks > 1 && before > settings_.rebalance_threshold) {
+    // Weighted recursive coordinate bisection over the current centroids of all tets; every rank
+    // runs it on the same gathered arrays, so every rank gets the same partition.
+    std::vector<double> centroids, weights;
+    std::vector<GlobalId> gids;
+    for (LocalIndex t = 0; t < tets.size(); ++t) {
+      if (!tets.is_owned(t)) continue;
+      Vec3 c = Vec3::Zero();
+      for (int k = 0; k < 4; ++k) c += vec3_at(model.nodes.x.data(), tets.nodes[4 * t + k]);
+      c *= 0.25;
+      for (int k = 0; k < 3; ++k) centroids.push_back(c[k]);
+      weights.push_back(cost[t]);
+      gids.push_back(tets.gid[t]);
+    }
+    const std::vector<double> all_centroids = comm_.allgatherv(centroids);
+    const std::vector<double> all_weights = comm_.allgatherv(weights);
+    const std::vector<GlobalId> all_gids = comm_.allgatherv(gids);
+    const std::vector<std::int32_t> parts =
+        partition_rcb(all_centroids, all_weights, all_gids, ranks);
+    for (std::size_t i = 0; i < all_gids.size(); ++i) {
+      std::int32_t& owner = part_[static_cast<std::size_t>(all_gids[i])];
+      if (owner != parts[i]) ++migrated;
+      owner = parts[i];
+    }
+    report_.imbalance = imbalance(all_weights, parts, ranks);
+    ++report_.rebalances;
+    report_.migrated_tets += migrated;
+  }
+
+  // Boxes of the tets each rank will own, and the margin around them.
+  std::vector<double> lo(3 * static_cast<std::size_t>(ranks), std::numeric_limits<double>::infinity());
+  std::vector<double> hi(3 * static_cast<std::size_t>(ranks), -std::numeric_limits<double>::infinity());
+  std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
+  double extent = 0.0;
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
+    tet_box(model, t, b);
+    if (!tets.is_owned(t)) continue;
+    const int p = owner_of_tet(tets.gid[t]);
+    for (int k = 0; k < 3; ++k) {
+      lo[3 * p + k] = std::min(lo[3 * p + k], b[k]);
+      hi[3 * p + k] = std::max(hi[3 * p + k], b[3 + k]);
+      extent = std::max(extent, b[3 + k] - b[k]);
+    }
+  }
+  comm_.min_in_place(lo);
+  comm_.max_in_place(hi);
+  const double margin = 2.0 * comm_.max(extent) + 2.0 * buffer_;
+  std::vector<double> boxes(6 * static_cast<std::size_t>(ranks));
+  for (int p = 0; p < ranks; ++p)
+    for (int k = 0; k < 3; ++k) {
+      boxes[6 * p + k] = lo[3 * p + k] - margin;
+      boxes[6 * p + 3 + k] = hi[3 * p + k] + margin;
+    }
+  // Ranks whose grown box meets the box of what this rank owns now: the only possible receivers.
+  double region[6] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                      std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                      -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (tets.is_owned(t))
+      for (int k = 0; k < 3; ++k) {
+        region[k] = std::min(region[k], tet_boxes[6 * t + k]);
+        region[3 + k] = std::max(region[3 + k], tet_boxes[6 * t + 3 + k]);
+      }
+  std::vector<int> near;
+  for (int p = 0; p < ranks; ++p)
+    if (boxes_meet(region, &boxes[6 * static_cast<std::size_t>(p)])) near.push_back(p);
+
+  std::vector<std::vector<LocalIndex>> lists(static_cast<std::size_t>(ranks));
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    if (!tets.is_owned(t)) continue;
+    const int owner = owner_of_tet(tets.gid[t]);
+    lists[owner].push_back(t);
+    for (int p : near)
+      if (p != owner && boxes_meet(&tet_boxes[6 * static_cast<std::size_t>(t)],
+                                   &boxes[6 * static_cast<std::size_t>(p)]))
+        lists[p].push_back(t);
+  }
+  RowPacker packer(model, state);
+  std::vector<char> send;
+  std::vector<int> send_counts(ranks, 0), send_offsets(ranks, 0);
+  for (int p = 0; p < ranks; ++p) {
+    send_offsets[p] = static_cast<int>(send.size());
+    if (!lists[p].empty()) packer.pack(lists[p], send);
+    const std::size_t bytes = send.size() - static_cast<std::size_t>(send_offsets[p]);
+    FDEM_VERIFY(bytes < static_cast<std::size_t>(std::numeric_limits<int>::max()),
+                "a migration message under 2 GiB");
+    send_counts[p] = static_cast<int>(bytes);
+  }
+  std::vector<int> receive_counts(ranks, 0), receive_offsets(ranks, 0);
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
+  std::size_t received = 0;
+  for (int p = 0; p < ranks; ++p) {
+    receive_offsets[p] = static_cast<int>(received);
+    received += static_cast<std::size_t>(receive_counts[p]);
+  }
+  FDEM_VERIFY(received < static_cast<std::size_t>(std::numeric_limits<int>::max()),
+              "migration data under 2 GiB per rank");
+  std::vector<char> receive(received);
+  MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, receive.data(),
+                receive_counts.data(), receive_offsets.data(), MPI_BYTE, comm_.handle());
+  send.clear();
+  send.shrink_to_fit();
+  assemble(receive, model, state);
+  build_exchange(model);
+  ++report_.cycles;
+  update_report(model);
+  report_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Distribution::build_exchange(const Model& model) {
+  const int ranks = comm_.size();
+  const NodeArrays& nodes = model.nodes;
+  // What this rank receives: its ghosts, from their owners (ghosts are in ascending gid).
+  std::vector<std::vector<LocalIndex>> receive(static_cast<std::size_t>(ranks));
+  std::vector<std::vector<GlobalId>> request(static_cast<std::size_t>(ranks));
+  for (LocalIndex n = nodes.n_owned; n < nodes.size(); ++n) {
+    const int owner = owner_of_node(nodes.gid[n]);
+    FDEM_VERIFY(owner != comm_.rank(), "a ghost node is owned elsewhere");
+    receive[owner].push_back(n);
+    request[owner].push_back(nodes.gid[n]);
+  }
+  std::vector<int> send_counts(ranks), send_offsets(ranks), receive_counts(ranks),
+      receive_offsets(ranks);
+  std::vector<GlobalId> flat;
+  for (int p = 0; p < ranks; ++p) {
+    send_offsets[p] = static_cast<int>(flat.size());
+    send_counts[p] = static_cast<int>(request[p].size());
+    flat.insert(flat.end(), request[p].begin(), request[p].end());
+  }
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
+  int total = 0;
+  for (int p = 0; p < ranks; ++p) {
+    receive_offsets[p] = total;
+    total += receive_counts[p];
+  }
+  std::vector<GlobalId> asked(static_cast<std::size_t>(total));
+  MPI_Alltoallv(flat.data(), send_counts.data(), send_offsets.data(), MPI_INT64_T, asked.data(),
+                receive_counts.data(), receive_offsets.data(), MPI_INT64_T, comm_.handle());
+  std::unordered_map<GlobalId, LocalIndex> owned_index;
+  owned_index.reserve(static_cast<std::size_t>(nodes.n_owned));
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) owned_index.emplace(nodes.gid[n], n);
+  neighbours_.clear();
+  for (int p = 0; p < ranks; ++p) {
+    if (receive[p].empty() && receive_counts[p] == 0) continue;
+    Neighbour nb;
+    nb.rank = p;
+    nb.receive = std::move(receive[p]);
+    for (int i = 0; i < receive_counts[p]; ++i) {
+      const auto it = owned_index.find(asked[receive_offsets[p] + i]);
+      FDEM_VERIFY(it != owned_index.end(), "a rank asks for a node this rank owns");
+      nb.send.push_back(it->second);
+    }
+    nb.send_buffer.resize(6 * nb.send.size());
+    nb.receive_buffer.resize(6 * nb.receive.size());
+    neighbours_.push_back(std::move(nb));
+  }
+}
+
+void Distribution::start_halo_exchange(const NodeArrays& nodes) {
+  const auto start = std::chrono::steady_clock::now();
+  requests_.clear();
+  constexpr int tag = 8;  // stage 8 of the step
+  for (Neighbour& nb : neighbours_)
+    if (!nb.receive.empty()) {
+      requests_.emplace_back();
+      MPI_Irecv(nb.receive_buffer.data(), static_cast<int>(nb.receive_buffer.size()), MPI_DOUBLE,
+                nb.rank, tag, comm_.handle(), &requests_.back());
+    }
+  for (Neighbour& nb : neighbours_)
+    if (!nb.send.empty()) {
+      double* out = nb.send_buffer.data();
+      for (LocalIndex n : nb.send) {
+        for (int k = 0; k < 3; ++k) *out++ = nodes.x[3 * n + k];
+        for (int k = 0; k < 3; ++k) *out++ = nodes.v[3 * n + k];
+      }
+      requests_.emplace_back();
+      MPI_Isend(nb.send_buffer.data(), static_cast<int>(nb.send_buffer.size()), MPI_DOUBLE,
+                nb.rank, tag, comm_.handle(), &requests_.back());
+    }
+  halo_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Distribution::finish_halo_exchange(NodeArrays& nodes) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!requests_.empty())
+    MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE);
+  requests_.clear();
+  for (const Neighbour& nb : neighbours_) {
+    const double* in = nb.receive_buffer.data();
+    for (LocalIndex n : nb.receive) {
+      for (int k = 0; k < 3; ++k) nodes.x[3 * n + k] = *in++;
+      for (int k = 0; k < 3; ++k) nodes.v[3 * n + k] = *in++;
+    }
+  }
+  halo_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Distribution::update_report(const Model& model) {
+  const long owned = model.tets.n_owned;
+  const long halo = model.tets.size() - model.tets.n_owned;
+  const long ghosts = model.nodes.size() - model.nodes.n_owned;
+  const long neighbours = static_cast<long>(neighbours_.size());
+  std::vector<std::int64_t> low = {owned, halo, ghosts}, high = {owned, halo, ghosts, neighbours},
+                            sum = {halo, ghosts};
+  comm_.min_in_place(low);
+  comm_.max_in_place(high);
+  comm_.sum_in_place(sum);
+  report_.owned_tets_min = low[0];
+  report_.owned_tets_max = high[0];
+  report_.halo_tets_min = low[1];
+  report_.halo_tets_max = high[1];
+  report_.halo_tets_sum = sum[0];
+  report_.ghost_nodes_min = low[2];
+  report_.ghost_nodes_max = high[2];
+  report_.ghost_nodes_sum = sum[1];
+  report_.neighbours_max = high[3];
+}
+
+std::uint64_t global_state_hash(const NodeArrays& nodes, const Communicator& comm) {
+  struct Row {
+    GlobalId gid;
+    double x[3], v[3];
+  };
+  std::vector<Row> mine(static_cast<std::size_t>(nodes.n_owned));
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
+    mine[n].gid = nodes.gid[n];
+    for (int k = 0; k < 3; ++k) {
+      mine[n].x[k] = nodes.x[3 * n + k];
+      mine[n].v[k] = nodes.v[3 * n + k];
+    }
+  }
+  const std::vector<Row> all = comm.allgatherv(mine);
+  NodeArrays whole;
+  whole.resize(static_cast<LocalIndex>(all.size()));
+  whole.n_owned = whole.size();
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    whole.gid[i] = all[i].gid;
+    for (int k = 0; k < 3; ++k) {
+      whole.x[3 * i + k] = all[i].x[k];
+      whole.v[3 * i + k] = all[i].v[k];
+    }
+  }
+  return state_hash(whole);
+}
+
+}  // namespace fdem

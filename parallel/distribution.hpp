@@ -1,0 +1,112 @@
+// The distributed model: which rank owns which tet, the halo each rank holds, migration of tets
+// with everything that travels with them, and the per-step ghost exchange (docs/parallel.md).
+//
+// Owner computes.  A tet's owner is part[gid]; a node's owner is the owner of the lowest-gid tet
+// that holds it.  A rank holds every tet whose box comes within a margin of the box of the tets it
+// owns (margin = 2 × the largest tet extent + 2 × the contact buffer), which covers every tet that
+// shares a node with an owned node, every contact partner such a tet can meet before the next
+// detection, and every joint between them; it computes the forces of the tets that touch a node it
+// owns (`TetArrays::active`), adds them in ascending gid, and so sums every owned node's force in
+// the order one rank does.  Only positions and velocities of ghost nodes travel each step.
+//
+// Redistribution happens at contact-detection cycles: the owned cost (tets, joints, contact
+// pairs) is compared across ranks, a weighted recursive coordinate bisection re-partitions when
+// the imbalance exceeds a threshold, and every owner sends each of its tets — with its nodes, the
+// joints whose first tet it is, its friction pairs and contact state — to the new owner and to
+// every rank whose margin box it meets.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "contact/contact_stage.hpp"
+#include "core/model.hpp"
+#include "fracture/joint_kernels.hpp"
+#include "parallel/communicator.hpp"
+
+namespace fdem {
+
+// Stage state outside Model that moves with the local entries.
+struct TravellingState {
+  std::vector<double> x_at_detection;         // 3 per local node (m)
+  std::vector<std::uint8_t> tet_joint_state;  // per local tet (empty: scene without joints)
+  std::vector<JointHistory> joint_history;    // per local joint
+  std::vector<FrictionEntry> friction;        // friction pairs held here
+};
+
+struct DistributionSettings {
+  double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this
+  double pair_cost = 10.0;            // cost of a contact candidate pair (a tet costs 1)
+  double joint_cost = 1.0;            // cost of an intact joint
+};
+
+// What the last (re)distribution did, the same on every rank.
+struct DistributionReport {
+  long cycles = 0;                    // redistributions so far (the first is the initial one)
+  long rebalances = 0;                // of which re-partitioned
+  long migrated_tets = 0;             // tets that changed owner, summed over all cycles
+  double imbalance = 1.0;             // max/mean owned cost after the last cycle
+  double imbalance_before = 1.0;      // ... before its re-partition
+  double max_imbalance = 1.0;         // largest imbalance seen at a cycle (before re-partition)
+  long owned_tets_min = 0, owned_tets_max = 0;
+  long halo_tets_min = 0, halo_tets_max = 0, halo_tets_sum = 0;
+  long ghost_nodes_min = 0, ghost_nodes_max = 0, ghost_nodes_sum = 0;
+  long neighbours_max = 0;            // ranks a rank exchanges ghosts with
+  double seconds = 0.0;               // wall time spent redistributing (this rank)
+};
+
+class Distribution {
+ public:
+  // Collective.  Every rank passes the same whole model (built from the scene) and the contact
+  // buffer (m, 0 without contact).  Partitions it with METIS on the element graph (rank 0,
+  // broadcast), and returns through `local`/`local_state` this rank's part with its halo.
+  Distribution(const Communicator& comm, DistributionSettings settings, const Model& global,
+               const TravellingState& global_state, double buffer, Model& local,
+               TravellingState& local_state);
+
+  // Collective, at a contact-detection cycle: measures the owned cost (`pairs_per_tet`: contact
+  // candidate pairs per local tet, counted on the pair's first tet), re-partitions when the
+  // imbalance exceeds the threshold, migrates, and rebuilds the halo and the ghost exchange.
+  void redistribute(Model& model, TravellingState& state,
+                    const std::vector<std::int32_t>& pairs_per_tet);
+
+  // Split-phase ghost exchange of positions and velocities: start() after integration posts the
+  // sends and receives, finish() completes them and writes the ghost entries.
+  void start_halo_exchange(const NodeArrays& nodes);
+  void finish_halo_exchange(NodeArrays& nodes);
+
+  int owner_of_tet(GlobalId tet) const { return part_[static_cast<std::size_t>(tet)]; }
+  int owner_of_node(GlobalId node) const {
+    return part_[static_cast<std::size_t>(node_first_tet_[static_cast<std::size_t>(node)])];
+  }
+  const DistributionReport& report() const { return report_; }
+  const Communicator& comm() const { return comm_; }
+  double halo_seconds() const { return halo_seconds_; }
+
+ private:
+  struct Neighbour {
+    int rank = 0;
+    std::vector<LocalIndex> send, receive;  // local node indices
+    std::vector<double> send_buffer, receive_buffer;
+  };
+  void assemble(const std::vector<char>& rows, Model& model, TravellingState& state) const;
+  void build_exchange(const Model& model);
+  void update_report(const Model& model);
+
+  Communicator comm_;
+  DistributionSettings settings_;
+  double buffer_ = 0.0;
+  std::vector<std::int32_t> part_;          // by tet gid: owning rank
+  std::vector<GlobalId> node_first_tet_;    // by node gid: smallest tet gid holding it (static)
+  std::vector<Neighbour> neighbours_;
+  std::vector<MPI_Request> requests_;
+  DistributionReport report_;
+  double halo_seconds_ = 0.0;
+  bool has_joint_state_ = false;  // the scene has joints: tets carry their joint state
+};
+
+// Collective: state_hash (core/state_hash.hpp) of the owned nodes of all ranks, the value one rank
+// holding every node computes.
+std::uint64_t global_state_hash(const NodeArrays& nodes, const Communicator& comm);
+
+}  // namespace fdem
