@@ -341,7 +341,6 @@ class EveryPieceWriter : public ParallelWriter {
 template <class ParallelWriter>
 void write_piece(const std::string& stem, const std::string& extension, vtkDataObject* data,
                  int rank, int ranks) {
-  FDEM_VERIFY(ranks > 1 && rank >= 0 && rank < ranks, "frame piece rank");
   const std::string summary = frame_file_name(stem, extension, ranks);
   vtkSmartPointer<EveryPieceWriter<ParallelWriter>> writer =
       vtkSmartPointer<EveryPieceWriter<ParallelWriter>>::Take(
@@ -362,6 +361,12 @@ void write_piece(const std::string& stem, const std::string& extension, vtkDataO
   if (rank == 0) write_file_atomically(summary, writer->GetOutputString());
 }
 
+// Checks the rank numbers; true on one rank (a plain .vtu/.vtp, no pieces).
+bool single_rank(int rank, int ranks) {
+  FDEM_VERIFY(ranks >= 1 && rank >= 0 && rank < ranks, "frame rank");
+  return ranks == 1;
+}
+
 }  // namespace
 
 void write_tet_frame(const std::string& path, const Model& model,
@@ -372,7 +377,8 @@ void write_tet_frame(const std::string& path, const Model& model,
 void write_parallel_tet_frame(const std::string& stem, const Model& model,
                               const std::vector<std::string>& fields,
                               const std::vector<FrameField>& extra, int rank, int ranks) {
-  if (ranks == 1) return write_tet_frame(frame_file_name(stem, "vtu", 1), model, fields, extra);
+  if (single_rank(rank, ranks))
+    return write_tet_frame(frame_file_name(stem, "vtu", 1), model, fields, extra);
   write_piece<vtkXMLPUnstructuredGridWriter>(stem, "vtu", owned_tet_grid(model, fields, extra),
                                              rank, ranks);
 }
@@ -384,7 +390,8 @@ void write_point_frame(const std::string& path, const std::vector<double>& point
 
 void write_parallel_point_frame(const std::string& stem, const std::vector<double>& points,
                                 const std::vector<FrameField>& point_fields, int rank, int ranks) {
-  if (ranks == 1) return write_point_frame(frame_file_name(stem, "vtp", 1), points, point_fields);
+  if (single_rank(rank, ranks))
+    return write_point_frame(frame_file_name(stem, "vtp", 1), points, point_fields);
   write_piece<vtkXMLPPolyDataWriter>(stem, "vtp", point_poly(points, point_fields), rank, ranks);
 }
 
@@ -398,7 +405,7 @@ void write_parallel_triangle_frame(const std::string& stem, const std::vector<do
                                    const std::vector<std::int64_t>& triangles,
                                    const std::vector<FrameField>& cell_fields, int rank,
                                    int ranks) {
-  if (ranks == 1)
+  if (single_rank(rank, ranks))
     return write_triangle_frame(frame_file_name(stem, "vtp", 1), points, triangles, cell_fields);
   write_piece<vtkXMLPPolyDataWriter>(stem, "vtp", triangle_poly(points, triangles, cell_fields),
                                      rank, ranks);
