@@ -1,0 +1,83 @@
+// Checkpoint files: the whole run state in ONE parallel-HDF5 file, written collectively by every
+// rank (each writes the rows it owns) and readable by any number of ranks.
+//
+// Layout (self-describing; `h5dump -A` shows the header):
+//   /                 attributes format = "fdem-checkpoint", version = 1, ranks, n_nodes, n_tets,
+//                     n_joints, reference_hash, joint_history_bytes
+//   /run/<name>       one scalar dataset per named value: float64 for header.doubles, int64 for
+//                     header.integers, in the order the driver gave them (creation order tracked)
+//   /nodes/gid        int64[n_nodes] = 0..n_nodes-1 (row i is the node of gid i)
+//   /nodes/{x, v, x_at_detection, prescribed_velocity}   float64[n_nodes][3]
+//   /joints/gid       int64[n_joints] = 0..n_joints-1
+//   /joints/{broken, mode}            uint8[n_joints]
+//   /joints/{failure_time, damage}    float64[n_joints]
+//   /joints/history   uint8[n_joints][joint_history_bytes] (opaque per-joint history records)
+//   /friction/{a, b}  int64[m] (a < b), /friction/spring float64[m][3], /friction/stiffness
+//                     float64[m]; written in rank order, read back sorted by (a, b)
+//
+// The write goes to `path + ".tmp"`, is flushed to storage and closed, and only then renamed to
+// `path` by rank 0 (an atomic replace on POSIX file systems), so a crash during the write never
+// leaves a torn file under the final name.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/types.hpp"
+#include "parallel/communicator.hpp"
+
+namespace fdem {
+
+// Format version written into and required from every checkpoint file.
+constexpr int checkpoint_format_version = 1;
+
+// The run state a restart needs, beside the rows: named scalars chosen by the driver.
+struct CheckpointHeader {
+  std::int64_t n_nodes = 0, n_tets = 0, n_joints = 0;  // global counts (scene check on restart)
+  std::uint64_t reference_hash = 0;  // hash of reference positions: the scene must match
+  int ranks = 1;  // ranks that wrote the file (write_checkpoint stores comm.size(), not this)
+  std::vector<std::pair<std::string, double>> doubles;         // time, dt, ledger terms, ...
+  std::vector<std::pair<std::string, std::int64_t>> integers;  // step, detections, ...
+};
+
+// One rank's share of a checkpoint (what it owns), or after reading, everything, sorted by gid.
+struct CheckpointRows {
+  std::vector<GlobalId> node_gid;  // nodes: gids are dense 0..n_nodes-1 overall
+  std::vector<double> node_x, node_v, node_x_at_detection,
+      node_prescribed_velocity;     // 3 per node (m, m/s, m, m/s)
+  std::vector<GlobalId> joint_gid;  // joints: gids dense 0..n_joints-1 overall
+  std::vector<std::uint8_t> joint_broken, joint_mode;
+  std::vector<double> joint_failure_time, joint_damage;  // s, dimensionless
+  std::size_t joint_history_bytes = 0;                   // fixed size of one joint's history record
+  std::vector<std::uint8_t> joint_history;       // joint_history_bytes per joint (opaque bytes)
+  std::vector<GlobalId> friction_a, friction_b;  // friction pairs (a < b), any count
+  std::vector<double> friction_spring;           // 3 per pair (m)
+  std::vector<double> friction_stiffness;        // N/m
+};
+
+// Collective.  Writes `path` via `path + ".tmp"` (MPI-IO on comm.handle()), flushes and closes
+// it, then rank 0 renames it to `path` and every rank waits for that.  Node and joint rows go to
+// their gid positions: the owned rows first move (MPI_Alltoallv) to the rank whose contiguous
+// block of gids holds them, then every rank writes its block as one hyperslab with collective
+// I/O (a rank with no rows still takes part).  Friction rows are appended in rank order.
+//
+// Checked first, on every rank together: the header is the same on every rank, the row arrays
+// have matching lengths, friction pairs have a < b, joint_history_bytes agrees, and the owned
+// node / joint gids of all ranks form exactly 0..n-1 once each.  A violation is a bug of the
+// caller and throws CollectiveInternalError on every rank.  A file that cannot be created or an
+// HDF5 failure throws CollectiveInputError on every rank, naming the file; the .tmp file is then
+// removed and an existing file at `path` is left as it was.
+void write_checkpoint(const std::string& path, const Communicator& comm,
+                      const CheckpointHeader& header, const CheckpointRows& owned);
+
+// Collective.  Every rank reads the whole file: rows sorted by gid (the file stores them so),
+// friction pairs sorted by (a, b).  A missing file, a file that is not an fdem checkpoint, a
+// different format version, or a dataset of the wrong size or type throws CollectiveInputError
+// on every rank naming the file and what is wrong.
+std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& path,
+                                                            const Communicator& comm);
+
+}  // namespace fdem

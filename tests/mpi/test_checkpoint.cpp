@@ -1,0 +1,529 @@
+// Checkpoint files on 1–4 ranks: collective write of owned rows into one HDF5 file, read back
+// everywhere bit-exactly, any writer count, errors on every rank, temp file + rename.
+// Only CHECK here (no REQUIRE): a rank leaving a test case early would skip its collectives.
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "parallel/checkpoint.hpp"
+#include "parallel/communicator.hpp"
+
+using namespace fdem;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A directory under /tmp that rank 0 creates and removes; every rank gets its name.
+class SharedTempDir {
+ public:
+  explicit SharedTempDir(const Communicator& comm) : comm_(comm) {
+    std::string name;
+    if (comm.is_root()) {
+      static int counter = 0;
+      name = (fs::temp_directory_path() / ("fdem-checkpoint-test-" + std::to_string(::getpid()) +
+                                           "-" + std::to_string(counter++)))
+                 .string();
+      fs::remove_all(name);
+      fs::create_directories(name);
+    }
+    path_ = comm.broadcast(name, 0);
+  }
+  ~SharedTempDir() {
+    comm_.barrier();
+    if (comm_.is_root()) {
+      std::error_code ignored;
+      fs::remove_all(path_, ignored);
+    }
+  }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  Communicator comm_;
+  std::string path_;
+};
+
+// Distinct values with special cases (signed zero, infinity, NaN, subnormal) so that the
+// comparison really is bit for bit.
+double node_value(int field, GlobalId gid, int component) {
+  if (gid == 3 && component == 0) return -0.0;
+  if (gid == 5 && component == 1) return std::numeric_limits<double>::infinity();
+  if (gid == 7 && component == 2) return std::numeric_limits<double>::quiet_NaN();
+  if (gid == 11 && component == 0) return std::numeric_limits<double>::denorm_min() * (field + 1);
+  return std::sin(1.0 + 0.37 * static_cast<double>(gid) + 0.11 * component + 10.0 * field) *
+         std::pow(10.0, field - 2);
+}
+double joint_value(int field, GlobalId gid) {
+  return std::cos(0.5 + 0.13 * static_cast<double>(gid) + field) * 1e-3;
+}
+std::uint8_t history_byte(GlobalId gid, std::size_t b) {
+  return static_cast<std::uint8_t>((gid * 31 + static_cast<GlobalId>(b) * 7 + 1) & 0xff);
+}
+
+struct Scene {
+  std::int64_t n_nodes = 1000, n_joints = 300;
+  std::size_t history_bytes = 12;
+  int friction_per_writer = 3;
+};
+
+// The header every rank passes (the same everywhere).
+CheckpointHeader make_header(const Scene& scene) {
+  CheckpointHeader h;
+  h.n_nodes = scene.n_nodes;
+  h.n_tets = 4321;
+  h.n_joints = scene.n_joints;
+  h.reference_hash = 0xfedcba9876543210ULL;
+  h.doubles = {{"time", 1.25e-3}, {"dt", 1e-7}, {"energy_in", -3.5e4}, {"alpha", 0.1}};
+  h.integers = {
+      {"step", 12345}, {"detections", -7}, {"largest", std::numeric_limits<std::int64_t>::max()}};
+  return h;
+}
+
+void add_node(CheckpointRows& rows, GlobalId g) {
+  rows.node_gid.push_back(g);
+  for (int c = 0; c < 3; ++c) {
+    rows.node_x.push_back(node_value(0, g, c));
+    rows.node_v.push_back(node_value(1, g, c));
+    rows.node_x_at_detection.push_back(node_value(2, g, c));
+    rows.node_prescribed_velocity.push_back(node_value(3, g, c));
+  }
+}
+void add_joint(CheckpointRows& rows, GlobalId j) {
+  rows.joint_gid.push_back(j);
+  rows.joint_broken.push_back(static_cast<std::uint8_t>(j % 2));
+  rows.joint_mode.push_back(static_cast<std::uint8_t>(j % 3));
+  rows.joint_failure_time.push_back(j % 2 ? joint_value(0, j) : -1.0);
+  rows.joint_damage.push_back(joint_value(1, j));
+  for (std::size_t b = 0; b < rows.joint_history_bytes; ++b)
+    rows.joint_history.push_back(history_byte(j, b));
+}
+// Friction pairs of writer `w`: a deliberately not sorted, so the reader's sort is exercised.
+void add_friction(CheckpointRows& rows, const Scene& scene, int writer) {
+  for (int k = scene.friction_per_writer - 1; k >= 0; --k) {
+    const GlobalId a = 900 - 10 * writer - k, b = a + 1 + k;
+    rows.friction_a.push_back(a);
+    rows.friction_b.push_back(b);
+    for (int c = 0; c < 3; ++c) rows.friction_spring.push_back(1e-6 * (a + c) - 1e-7 * b);
+    rows.friction_stiffness.push_back(1e6 + 1000.0 * a + b);
+  }
+}
+
+// What `writer` of `writers` owns: nodes interleaved (gid % writers), joints by another pattern,
+// `owner_of` may leave some writers without rows.
+template <class NodeOwner, class JointOwner>
+CheckpointRows make_owned(const Scene& scene, int writer, NodeOwner node_owner,
+                          JointOwner joint_owner) {
+  CheckpointRows rows;
+  rows.joint_history_bytes = scene.history_bytes;
+  // Descending gid order, so the writer's own sort to file positions is exercised.
+  for (GlobalId g = scene.n_nodes - 1; g >= 0; --g)
+    if (node_owner(g) == writer) add_node(rows, g);
+  for (GlobalId j = 0; j < scene.n_joints; ++j)
+    if (joint_owner(j) == writer) add_joint(rows, j);
+  add_friction(rows, scene, writer);
+  return rows;
+}
+CheckpointRows interleaved(const Scene& scene, int writer, int writers) {
+  return make_owned(
+      scene, writer, [&](GlobalId g) { return static_cast<int>(g % writers); },
+      [&](GlobalId j) { return static_cast<int>((j / 7) % writers); });
+}
+
+// Everything, sorted as read_checkpoint returns it, for `writers` writers with friction.
+CheckpointRows expected_rows(const Scene& scene, int writers) {
+  CheckpointRows all;
+  all.joint_history_bytes = scene.history_bytes;
+  for (GlobalId g = 0; g < scene.n_nodes; ++g) add_node(all, g);
+  for (GlobalId j = 0; j < scene.n_joints; ++j) add_joint(all, j);
+  CheckpointRows pairs;
+  for (int w = 0; w < writers; ++w) add_friction(pairs, scene, w);
+  std::vector<std::size_t> order(pairs.friction_a.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+    return std::make_pair(pairs.friction_a[i], pairs.friction_b[i]) <
+           std::make_pair(pairs.friction_a[j], pairs.friction_b[j]);
+  });
+  for (std::size_t i : order) {
+    all.friction_a.push_back(pairs.friction_a[i]);
+    all.friction_b.push_back(pairs.friction_b[i]);
+    for (std::size_t c = 0; c < 3; ++c)
+      all.friction_spring.push_back(pairs.friction_spring[3 * i + c]);
+    all.friction_stiffness.push_back(pairs.friction_stiffness[i]);
+  }
+  return all;
+}
+
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+void check_rows_equal(const CheckpointRows& got, const CheckpointRows& want) {
+  CHECK(got.node_gid == want.node_gid);
+  CHECK(std::is_sorted(got.node_gid.begin(), got.node_gid.end()));
+  CHECK(same_bits(got.node_x, want.node_x));
+  CHECK(same_bits(got.node_v, want.node_v));
+  CHECK(same_bits(got.node_x_at_detection, want.node_x_at_detection));
+  CHECK(same_bits(got.node_prescribed_velocity, want.node_prescribed_velocity));
+  CHECK(got.joint_gid == want.joint_gid);
+  CHECK(std::is_sorted(got.joint_gid.begin(), got.joint_gid.end()));
+  CHECK(got.joint_broken == want.joint_broken);
+  CHECK(got.joint_mode == want.joint_mode);
+  CHECK(same_bits(got.joint_failure_time, want.joint_failure_time));
+  CHECK(same_bits(got.joint_damage, want.joint_damage));
+  CHECK(got.joint_history_bytes == want.joint_history_bytes);
+  CHECK(got.joint_history == want.joint_history);
+  CHECK(got.friction_a == want.friction_a);
+  CHECK(got.friction_b == want.friction_b);
+  CHECK(same_bits(got.friction_spring, want.friction_spring));
+  CHECK(same_bits(got.friction_stiffness, want.friction_stiffness));
+}
+
+void check_header_equal(const CheckpointHeader& got, const CheckpointHeader& want, int ranks) {
+  CHECK(got.n_nodes == want.n_nodes);
+  CHECK(got.n_tets == want.n_tets);
+  CHECK(got.n_joints == want.n_joints);
+  CHECK(got.reference_hash == want.reference_hash);
+  CHECK(got.ranks == ranks);
+  CHECK(got.integers == want.integers);
+  CHECK(got.doubles.size() == want.doubles.size());
+  for (std::size_t i = 0; i < std::min(got.doubles.size(), want.doubles.size()); ++i) {
+    CHECK(got.doubles[i].first == want.doubles[i].first);
+    CHECK(std::memcmp(&got.doubles[i].second, &want.doubles[i].second, sizeof(double)) == 0);
+  }
+}
+
+// Runs `body` and returns what this rank caught: "input:<message>", "internal:<message>",
+// "other" or "none".
+template <class Body>
+std::string caught(Body&& body) {
+  try {
+    body();
+    return "none";
+  } catch (const CollectiveInputError& e) {
+    return std::string("input:") + e.what();
+  } catch (const CollectiveInternalError& e) {
+    return std::string("internal:") + e.what();
+  } catch (...) {
+    return "other";
+  }
+}
+
+bool same_on_all_ranks(const Communicator& comm, const std::string& text) {
+  return comm.sum<std::int32_t>(comm.broadcast(text, 0) == text ? 0 : 1) == 0;
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+TEST_CASE("checkpoint: interleaved rows of every rank round-trip bit-exactly",
+          "[mpi][checkpoint]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const SharedTempDir dir(comm);
+  const Scene scene;
+  const std::string path = dir.file("state.h5");
+  const CheckpointHeader header = make_header(scene);
+  const CheckpointRows owned = interleaved(scene, comm.rank(), comm.size());
+
+  CHECK(caught([&] { write_checkpoint(path, comm, header, owned); }) == "none");
+  std::pair<CheckpointHeader, CheckpointRows> back;
+  CHECK(caught([&] { back = read_checkpoint(path, comm); }) == "none");
+  check_header_equal(back.first, header, comm.size());
+  check_rows_equal(back.second, expected_rows(scene, comm.size()));
+  CHECK(back.second.node_gid.size() == 1000);
+  CHECK(back.second.joint_gid.size() == 300);
+  CHECK(back.second.friction_a.size() == static_cast<std::size_t>(3 * comm.size()));
+}
+
+TEST_CASE("checkpoint: a rank without rows takes part; empty joint and friction tables",
+          "[mpi][checkpoint]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const SharedTempDir dir(comm);
+  const int last = comm.size() - 1;
+
+  SECTION("the last rank owns nothing (on one rank: it owns everything)") {
+    Scene scene;
+    scene.friction_per_writer = 0;
+    const int holders = std::max(1, comm.size() - 1);
+    CheckpointRows owned = make_owned(
+        scene, comm.rank(), [&](GlobalId g) { return static_cast<int>(g % holders); },
+        [&](GlobalId j) { return static_cast<int>((j * 5) % holders); });
+    // The ranks that hold rows also hold the friction pairs, except the idle last rank.
+    if (comm.size() == 1 || comm.rank() != last) {
+      Scene with_friction = scene;
+      with_friction.friction_per_writer = 2;
+      add_friction(owned, with_friction, comm.rank());
+    }
+    if (comm.size() > 1 && comm.rank() == last) {
+      CHECK(owned.node_gid.empty());
+      CHECK(owned.joint_gid.empty());
+      CHECK(owned.friction_a.empty());
+    }
+    const std::string path = dir.file("idle.h5");
+    CHECK(caught([&] { write_checkpoint(path, comm, make_header(scene), owned); }) == "none");
+    std::pair<CheckpointHeader, CheckpointRows> back;
+    CHECK(caught([&] { back = read_checkpoint(path, comm); }) == "none");
+    Scene expected_scene = scene;
+    expected_scene.friction_per_writer = 2;
+    check_rows_equal(back.second, expected_rows(expected_scene, holders));
+  }
+
+  SECTION("a scene without joints or friction: zero-size datasets") {
+    Scene scene;
+    scene.n_joints = 0;
+    scene.history_bytes = 0;
+    scene.friction_per_writer = 0;
+    const CheckpointRows owned = interleaved(scene, comm.rank(), comm.size());
+    CheckpointHeader header = make_header(scene);
+    header.doubles.clear();
+    header.integers.clear();
+    const std::string path = dir.file("no_joints.h5");
+    CHECK(caught([&] { write_checkpoint(path, comm, header, owned); }) == "none");
+    std::pair<CheckpointHeader, CheckpointRows> back;
+    CHECK(caught([&] { back = read_checkpoint(path, comm); }) == "none");
+    check_header_equal(back.first, header, comm.size());
+    check_rows_equal(back.second, expected_rows(scene, comm.size()));
+    CHECK(back.second.joint_gid.empty());
+    CHECK(back.second.joint_history.empty());
+    CHECK(back.second.friction_a.empty());
+    CHECK(back.second.node_gid.size() == 1000);
+  }
+
+  SECTION("no nodes at all") {
+    Scene scene;
+    scene.n_nodes = 0;
+    scene.n_joints = 0;
+    scene.history_bytes = 3;
+    scene.friction_per_writer = 0;
+    const CheckpointRows owned = interleaved(scene, comm.rank(), comm.size());
+    const std::string path = dir.file("empty.h5");
+    CHECK(caught([&] { write_checkpoint(path, comm, make_header(scene), owned); }) == "none");
+    std::pair<CheckpointHeader, CheckpointRows> back;
+    CHECK(caught([&] { back = read_checkpoint(path, comm); }) == "none");
+    CHECK(back.second.node_gid.empty());
+    CHECK(back.second.node_x.empty());
+    CHECK(back.second.joint_history_bytes == 3);
+    CHECK(back.first.n_tets == 4321);
+  }
+}
+
+TEST_CASE("checkpoint: a file written by one rank reads the same on all ranks",
+          "[mpi][checkpoint]") {
+  const Communicator world = Communicator::world();
+  INFO("rank " << world.rank() << " of " << world.size());
+  const SharedTempDir dir(world);
+  const Scene scene;
+  const CheckpointHeader header = make_header(scene);
+  const std::string by_one = dir.file("by_one.h5"), by_all = dir.file("by_all.h5");
+
+  // Rank 0 alone, on a communicator of its own, owning everything.
+  MPI_Comm solo = MPI_COMM_NULL;
+  MPI_Comm_split(MPI_COMM_WORLD, world.rank() == 0 ? 0 : MPI_UNDEFINED, 0, &solo);
+  if (world.rank() == 0) {
+    const Communicator one(solo);
+    CHECK(one.size() == 1);
+    CHECK(caught([&] { write_checkpoint(by_one, one, header, interleaved(scene, 0, 1)); }) ==
+          "none");
+    MPI_Comm_free(&solo);
+  }
+  world.barrier();
+  // All ranks, each owning its interleaved share (friction pairs differ: 3 per writer).
+  CHECK(caught([&] {
+          write_checkpoint(by_all, world, header, interleaved(scene, world.rank(), world.size()));
+        }) == "none");
+
+  std::pair<CheckpointHeader, CheckpointRows> one_writer, all_writers;
+  CHECK(caught([&] { one_writer = read_checkpoint(by_one, world); }) == "none");
+  CHECK(caught([&] { all_writers = read_checkpoint(by_all, world); }) == "none");
+  CHECK(one_writer.first.ranks == 1);
+  CHECK(all_writers.first.ranks == world.size());
+  check_header_equal(one_writer.first, header, 1);
+  check_rows_equal(one_writer.second, expected_rows(scene, 1));
+  // Node and joint rows do not depend on how many ranks wrote them.
+  CheckpointRows without_friction = all_writers.second;
+  without_friction.friction_a = one_writer.second.friction_a;
+  without_friction.friction_b = one_writer.second.friction_b;
+  without_friction.friction_spring = one_writer.second.friction_spring;
+  without_friction.friction_stiffness = one_writer.second.friction_stiffness;
+  check_rows_equal(without_friction, one_writer.second);
+}
+
+TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming the file",
+          "[mpi][checkpoint][failure]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const SharedTempDir dir(comm);
+  Scene scene;
+  scene.n_nodes = 40;
+  scene.n_joints = 10;
+  const CheckpointHeader header = make_header(scene);
+  const CheckpointRows owned = interleaved(scene, comm.rank(), comm.size());
+
+  auto read_error = [&](const std::string& path) {
+    const std::string result = caught([&] { read_checkpoint(path, comm); });
+    CHECK(same_on_all_ranks(comm, result));
+    CHECK(result.rfind("input:", 0) == 0);
+    CHECK(result.find("'" + path + "'") != std::string::npos);
+    return result;
+  };
+  // A good checkpoint, then altered by rank 0 with serial HDF5.
+  auto good_copy = [&](const std::string& name) {
+    const std::string path = dir.file(name);
+    CHECK(caught([&] { write_checkpoint(path, comm, header, owned); }) == "none");
+    return path;
+  };
+  auto alter = [&](const std::string& path, auto&& edit) {
+    if (comm.is_root()) {
+      const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+      CHECK(file >= 0);
+      edit(file);
+      CHECK(H5Fclose(file) >= 0);
+    }
+    comm.barrier();
+  };
+
+  SECTION("missing file") {
+    const std::string message = read_error(dir.file("nowhere.h5"));
+    CHECK(message.find("does not exist") != std::string::npos);
+  }
+  SECTION("a plain text file") {
+    const std::string path = dir.file("notes.txt");
+    if (comm.is_root()) std::ofstream(path) << "time = 1.0\nstep = 10\n";
+    comm.barrier();
+    const std::string message = read_error(path);
+    CHECK(message.find("not an HDF5 file") != std::string::npos);
+  }
+  SECTION("an HDF5 file that is not an fdem checkpoint") {
+    const std::string path = dir.file("other.h5");
+    if (comm.is_root()) {
+      const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+      CHECK(file >= 0);
+      CHECK(H5Fclose(file) >= 0);
+    }
+    comm.barrier();
+    const std::string message = read_error(path);
+    CHECK(message.find("not an fdem checkpoint") != std::string::npos);
+  }
+  SECTION("a dataset with rows missing") {
+    const std::string path = good_copy("short_x.h5");
+    alter(path, [](hid_t file) {
+      CHECK(H5Ldelete(file, "/nodes/x", H5P_DEFAULT) >= 0);
+      const hsize_t dims[2] = {39, 3};
+      const hid_t space = H5Screate_simple(2, dims, nullptr);
+      const hid_t dataset = H5Dcreate2(file, "/nodes/x", H5T_IEEE_F64LE, space, H5P_DEFAULT,
+                                       H5P_DEFAULT, H5P_DEFAULT);
+      CHECK(dataset >= 0);
+      H5Dclose(dataset);
+      H5Sclose(space);
+    });
+    const std::string message = read_error(path);
+    CHECK(message.find("/nodes/x") != std::string::npos);
+    CHECK(message.find("39 x 3") != std::string::npos);
+    CHECK(message.find("40 x 3") != std::string::npos);
+  }
+  SECTION("a missing dataset") {
+    const std::string path = good_copy("no_damage.h5");
+    alter(path, [](hid_t file) { CHECK(H5Ldelete(file, "/joints/damage", H5P_DEFAULT) >= 0); });
+    const std::string message = read_error(path);
+    CHECK(message.find("/joints/damage") != std::string::npos);
+  }
+  SECTION("another format version") {
+    const std::string path = good_copy("version2.h5");
+    alter(path, [](hid_t file) {
+      const hid_t attr = H5Aopen(file, "version", H5P_DEFAULT);
+      const std::int32_t two = 2;
+      CHECK(H5Awrite(attr, H5T_NATIVE_INT32, &two) >= 0);
+      H5Aclose(attr);
+    });
+    const std::string message = read_error(path);
+    CHECK(message.find("version 2") != std::string::npos);
+  }
+  SECTION("a file cut short") {
+    const std::string path = good_copy("cut.h5");
+    if (comm.is_root()) fs::resize_file(path, fs::file_size(path) / 2);
+    comm.barrier();
+    read_error(path);
+  }
+  SECTION("a write into a missing directory") {
+    const std::string path = dir.file("no/such/dir/state.h5");
+    const std::string result = caught([&] { write_checkpoint(path, comm, header, owned); });
+    CHECK(same_on_all_ranks(comm, result));
+    CHECK(result.rfind("input:", 0) == 0);
+    CHECK(result.find("'" + path + "'") != std::string::npos);
+  }
+  SECTION("rows that are not a partition are an internal error on every rank") {
+    CheckpointRows twice = owned;
+    if (comm.is_root()) add_node(twice, 1 % scene.n_nodes);  // gid 1 owned twice overall
+    const std::string path = dir.file("bad_rows.h5");
+    const std::string result = caught([&] { write_checkpoint(path, comm, header, twice); });
+    CHECK(same_on_all_ranks(comm, result));
+    CHECK(result.rfind("internal:", 0) == 0);
+    comm.barrier();
+    CHECK_FALSE(fs::exists(path));
+    CHECK_FALSE(fs::exists(path + ".tmp"));
+  }
+}
+
+TEST_CASE("checkpoint: written through a temporary name; other files untouched",
+          "[mpi][checkpoint]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const SharedTempDir dir(comm);
+  Scene scene;
+  scene.n_nodes = 60;
+  scene.n_joints = 20;
+  CheckpointHeader header = make_header(scene);
+  const CheckpointRows owned = interleaved(scene, comm.rank(), comm.size());
+  const std::string older = dir.file("step_100.h5"), newer = dir.file("step_200.h5");
+
+  CHECK(caught([&] { write_checkpoint(older, comm, header, owned); }) == "none");
+  const std::string older_bytes = comm.broadcast(file_bytes(older), 0);
+  CHECK(!older_bytes.empty());
+
+  header.integers[0].second = 200;
+  CHECK(caught([&] { write_checkpoint(newer, comm, header, owned); }) == "none");
+  CHECK(fs::exists(newer));
+  CHECK_FALSE(fs::exists(newer + ".tmp"));
+  CHECK_FALSE(fs::exists(older + ".tmp"));
+  CHECK(file_bytes(older) == older_bytes);
+
+  // Writing the same name again replaces it whole.
+  header.integers[0].second = 300;
+  CHECK(caught([&] { write_checkpoint(newer, comm, header, owned); }) == "none");
+  std::pair<CheckpointHeader, CheckpointRows> back;
+  CHECK(caught([&] { back = read_checkpoint(newer, comm); }) == "none");
+  CHECK(back.first.integers.at(0) == std::make_pair(std::string("step"), std::int64_t{300}));
+
+  // A write that fails (the temporary name is taken by a directory) leaves the file at the final
+  // name as it was.
+  const std::string newer_bytes = comm.broadcast(file_bytes(newer), 0);
+  if (comm.is_root()) fs::create_directory(newer + ".tmp");
+  comm.barrier();
+  header.integers[0].second = 400;
+  const std::string result = caught([&] { write_checkpoint(newer, comm, header, owned); });
+  CHECK(same_on_all_ranks(comm, result));
+  CHECK(result.rfind("input:", 0) == 0);
+  CHECK(result.find(newer) != std::string::npos);
+  comm.barrier();
+  CHECK(file_bytes(newer) == newer_bytes);
+  CHECK(caught([&] { back = read_checkpoint(newer, comm); }) == "none");
+  CHECK(back.first.integers.at(0).second == 300);
+}
