@@ -54,7 +54,7 @@ RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>&
       fields_(fields),
       rank_(rank),
       ranks_(ranks),
-      frames_(create_output_directory(directory), "frames") {
+      frames_(create_output_directory(directory), "frames", rank, ranks) {
   if (rank_ != 0) return;
   energy_.open(std::filesystem::path(directory) / "energy.csv");
   energy_ << "time,kinetic,strain,gravity,contact,joint,dissipated_fracture,dissipated_friction,"
@@ -103,26 +103,27 @@ std::vector<double> tet_damage(const Model& model) {
   return damage;
 }
 
-void RunFiles::write_frame(double time, const Model& model, const std::vector<FrameField>& extra) {
-  if (ranks_ > 1) return;  // PARALLEL-FRAMES: pieces per rank
-  const std::string relative = frames_.next_frame_path() + ".vtu";
+void RunFiles::write_frame(double time, const Model& model, const std::vector<FrameField>& extra,
+                           bool cracks) {
+  const std::string stem = frames_.next_frame_path();
   std::vector<FrameField> fields = extra;
   if (std::find(fields_.begin(), fields_.end(), "damage") != fields_.end())
     fields.push_back({"damage", 1, true, tet_damage(model)});
-  write_tet_frame((std::filesystem::path(directory_) / relative).string(), model, fields_, fields);
-  frames_.add_frame(time, relative);
-  if (model.joints.size() > 0) write_cracks(time, model);
+  write_parallel_tet_frame((std::filesystem::path(directory_) / stem).string(), model, fields_,
+                           fields, rank_, ranks_);
+  frames_.add_frame(time, frames_.frame_file(stem, "vtu"));
+  if (cracks) write_cracks(time, model);
 }
 
 void RunFiles::write_cracks(double time, const Model& model) {
-  if (!cracks_) cracks_ = std::make_unique<SeriesWriter>(directory_, "cracks");
+  if (!cracks_) cracks_ = std::make_unique<SeriesWriter>(directory_, "cracks", rank_, ranks_);
   const JointArrays& joints = model.joints;
   const double* x = model.nodes.x.data();
   std::vector<double> points;
   std::vector<std::int64_t> triangles;
   std::vector<double> mode, failure_time, opening;
   for (LocalIndex j = 0; j < joints.size(); ++j) {
-    if (!joints.broken[j]) continue;
+    if (!joints.broken[j] || !model.tets.is_owned(joints.tets[2 * j])) continue;
     const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
     double gap = 0.0;
     for (int i = 0; i < 3; ++i) {
@@ -134,17 +135,19 @@ void RunFiles::write_cracks(double time, const Model& model) {
     failure_time.push_back(joints.failure_time[j]);
     opening.push_back(gap);
   }
-  const std::string relative = cracks_->next_frame_path() + ".vtp";
-  write_triangle_frame((std::filesystem::path(directory_) / relative).string(), points, triangles,
+  const std::string stem = cracks_->next_frame_path();
+  write_parallel_triangle_frame((std::filesystem::path(directory_) / stem).string(), points,
+                                triangles,
                        {{"mode", 1, true, mode},
                         {"failure_time", 1, true, failure_time},
-                        {"opening", 1, true, opening}});
-  cracks_->add_frame(time, relative);
+                        {"opening", 1, true, opening}},
+                                rank_, ranks_);
+  cracks_->add_frame(time, cracks_->frame_file(stem, "vtp"));
 }
 
 void RunFiles::write_contacts(double time, const std::vector<ContactRecord>& records) {
-  if (ranks_ > 1) return;  // PARALLEL-FRAMES: pieces per rank
-  if (!contacts_) contacts_ = std::make_unique<SeriesWriter>(directory_, "contacts");
+  if (!contacts_)
+    contacts_ = std::make_unique<SeriesWriter>(directory_, "contacts", rank_, ranks_);
   std::vector<double> points, normal, tangential;
   for (const ContactRecord& r : records)
     for (int k = 0; k < 3; ++k) {
@@ -152,11 +155,12 @@ void RunFiles::write_contacts(double time, const std::vector<ContactRecord>& rec
       normal.push_back(r.normal_force[k]);
       tangential.push_back(r.tangential_force[k]);
     }
-  const std::string relative = contacts_->next_frame_path() + ".vtp";
-  write_point_frame(
-      (std::filesystem::path(directory_) / relative).string(), points,
-      {{"normal_force", 3, false, normal}, {"tangential_force", 3, false, tangential}});
-  contacts_->add_frame(time, relative);
+  const std::string stem = contacts_->next_frame_path();
+  write_parallel_point_frame(
+      (std::filesystem::path(directory_) / stem).string(), points,
+      {{"normal_force", 3, false, normal}, {"tangential_force", 3, false, tangential}}, rank_,
+      ranks_);
+  contacts_->add_frame(time, contacts_->frame_file(stem, "vtp"));
 }
 
 std::string summary_json(const RunReport& r, const Model& model, const std::string& scene_name) {

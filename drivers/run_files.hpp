@@ -28,7 +28,9 @@ class RunFiles {
   void write_bodies_rows(double time, const Model& model, const std::vector<PieceMotion>& motion);
   // A frame of the tets; with `damage` in the fields, the per-tet damage; in a model with joints
   // also a frame of the "cracks" series (broken joint faces).
-  void write_frame(double time, const Model& model, const std::vector<FrameField>& extra = {});
+  // `cracks`: the scene has joints (the same answer on every rank: each writes a piece).
+  void write_frame(double time, const Model& model, const std::vector<FrameField>& extra = {},
+                   bool cracks = false);
   // Broken joint faces as triangles (face A's current position) with mode (FailureMode code),
   // failure_time (s) and opening (mean gap |b_i − a_i|, m), as the "cracks" series.
   void write_cracks(double time, const Model& model);

@@ -488,7 +488,7 @@ void Simulation::write_outputs(bool force) {
       }
       sum_over_ranks = [this](std::vector<double>& v) { comm_->sum_in_place(v); };
     }
-    files_->write_frame(time_, model_);
+    files_->write_frame(time_, model_, {}, plan_.joints);
     if (contact_) files_->write_contacts(time_, contact_->records());
     files_->write_bodies_rows(time_, model_, piece_motions(model_, sum_over_ranks));
     if (scene_.output.every > 0)

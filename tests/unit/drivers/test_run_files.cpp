@@ -95,6 +95,8 @@ fdem::RunReport sample_report() {
   r.energy.external_work = 1.75;
   r.balance_error = 3.0e-4;
   r.state_hash = "0123456789abcdef";
+  r.nodes = 27;  // counts over all ranks (the model only gives the pieces)
+  r.elements = 48;
   r.stages = {{"internal_forces", 1.25, 1200}, {"joint_forces", 0.0, 0}, {"integrate", 0.5, 1200}};
   return r;
 }
@@ -150,6 +152,45 @@ TEST_CASE("summary_json holds every value of the report and the model counts", "
   CHECK(e["external_work"].num() == 1.75);
   CHECK(e["balance_error"].num() == 3.0e-4);
   CHECK(s["state_hash"].str() == "0123456789abcdef");
+  CHECK_FALSE(s.has("decomposition"));  // one rank
+}
+
+TEST_CASE("summary_json of an N-rank run reports the decomposition", "[cli]") {
+  fdem::RunReport r = sample_report();
+  r.ranks = 2;
+  r.parallel = true;
+  r.imbalance = 1.05;
+  r.max_imbalance = 1.25;
+  r.redistributions = 14;
+  r.rebalances = 2;
+  r.migrated_elements = 430;
+  r.halo_elements_max = 120;
+  r.ghost_nodes_max = 64;
+  r.ghost_nodes_mean = 60;
+  r.neighbours_max = 1;
+  r.communication_seconds = 0.5;
+  r.joints = 10;
+  r.broken_joints = 3;
+  r.broken_by_mode[0] = 2;
+  r.broken_by_mode[2] = 1;
+  const Json s = fdem_test::parse_json(fdem::summary_json(r, model_with_counts(0, 0, 3), "wall"));
+  CHECK(s["ranks"].num() == 2);
+  CHECK(s["elements"].num() == 48);
+  CHECK(s["joints"].num() == 10);
+  CHECK(s["broken_joints"].num() == 3);
+  CHECK(s["broken_by_mode"]["tension"].num() == 2);
+  CHECK(s["broken_by_mode"]["mixed"].num() == 1);
+  const Json& d = s["decomposition"];
+  CHECK(d["imbalance"].num() == 1.05);
+  CHECK(d["max_imbalance"].num() == 1.25);
+  CHECK(d["redistributions"].num() == 14);
+  CHECK(d["rebalances"].num() == 2);
+  CHECK(d["migrated_elements"].num() == 430);
+  CHECK(d["halo_elements_max"].num() == 120);
+  CHECK(d["ghost_nodes_max"].num() == 64);
+  CHECK(d["ghost_nodes_mean"].num() == 60);
+  CHECK(d["neighbours_max"].num() == 1);
+  CHECK(d["communication_seconds"].num() == 0.5);
 }
 
 TEST_CASE("summary_json of a failed run is valid JSON with the reason", "[cli]") {
@@ -203,7 +244,7 @@ TEST_CASE("RunFiles writes energy and body rows as they come, and frames", "[cli
   CHECK(energy[1] == std::vector<std::string>{"0.001", "1.25", "0.5", "-0.25", "0", "0", "0", "0",
                                               "0", "0.125", "1.375", "2.5e-07"});
 
-  files.write_bodies_rows(0.0, model);
+  files.write_bodies_rows(0.0, model, fdem::piece_motions(model));
   files.write_frame(0.0, model);
   // Translate by (0.1, −0.2, 0.3) m, rotate by 0.05 rad about z through the centroid (1, 0.5,
   // 0.5), and give every node the velocity (1, 2, 3) m/s.
@@ -215,7 +256,7 @@ TEST_CASE("RunFiles writes energy and body rows as they come, and frames", "[cli
     model.nodes.x[3 * n + 2] = model.nodes.x0[3 * n + 2] + 0.3;
     for (int k = 0; k < 3; ++k) model.nodes.v[3 * n + k] = k + 1.0;
   }
-  files.write_bodies_rows(0.5, model);
+  files.write_bodies_rows(0.5, model, fdem::piece_motions(model));
   files.write_frame(0.5, model);
 
   const auto bodies = read_csv(dir / "out/bodies.csv");
@@ -261,6 +302,7 @@ TEST_CASE("RunFiles writes energy and body rows as they come, and frames", "[cli
   }
 
   fdem::RunReport r = sample_report();
+  r.nodes = model.nodes.size();
   files.write_summary(r, model, "slab");
   const Json summary = fdem_test::parse_json(read_text(dir / "out/summary.json"));
   CHECK(summary["nodes"].num() == 12);
