@@ -6,6 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace fdem {
 
@@ -65,6 +69,59 @@ class EnergyLedger {
   }
 
   WorkAccumulator damping, friction, fracture, external, gravity;
+
+  // Restart: every value as (name, number), and back (`value` returns the saved number of a name).
+  std::vector<std::pair<std::string, double>> saved_state() const {
+    std::vector<std::pair<std::string, double>> out = {
+        {"kinetic", current_.kinetic},
+        {"strain", current_.strain},
+        {"gravity", current_.gravity},
+        {"contact", current_.contact},
+        {"joint", current_.joint},
+        {"dissipated_fracture", current_.dissipated_fracture},
+        {"dissipated_friction", current_.dissipated_friction},
+        {"dissipated_damping", current_.dissipated_damping},
+        {"external_work", current_.external_work},
+        {"initial_total", initial_total_},
+        {"peak_scale", peak_scale_},
+        {"has_initial", has_initial_ ? 1.0 : 0.0}};
+    const std::pair<const char*, const WorkAccumulator*> accumulators[] = {
+        {"damping", &damping},
+        {"friction", &friction},
+        {"fracture", &fracture},
+        {"external", &external},
+        {"gravity", &gravity}};
+    for (const auto& [name, a] : accumulators) {
+      out.emplace_back(std::string("work_") + name + "_through_previous", a->through_previous);
+      out.emplace_back(std::string("work_") + name + "_first_before", a->first_before);
+      out.emplace_back(std::string("work_") + name + "_started", a->started ? 1.0 : 0.0);
+    }
+    return out;
+  }
+  void restore(const std::function<double(const std::string&)>& value) {
+    current_.kinetic = value("kinetic");
+    current_.strain = value("strain");
+    current_.gravity = value("gravity");
+    current_.contact = value("contact");
+    current_.joint = value("joint");
+    current_.dissipated_fracture = value("dissipated_fracture");
+    current_.dissipated_friction = value("dissipated_friction");
+    current_.dissipated_damping = value("dissipated_damping");
+    current_.external_work = value("external_work");
+    initial_total_ = value("initial_total");
+    peak_scale_ = value("peak_scale");
+    has_initial_ = value("has_initial") != 0.0;
+    const std::pair<const char*, WorkAccumulator*> accumulators[] = {{"damping", &damping},
+                                                                     {"friction", &friction},
+                                                                     {"fracture", &fracture},
+                                                                     {"external", &external},
+                                                                     {"gravity", &gravity}};
+    for (const auto& [name, a] : accumulators) {
+      a->through_previous = value(std::string("work_") + name + "_through_previous");
+      a->first_before = value(std::string("work_") + name + "_first_before");
+      a->started = value(std::string("work_") + name + "_started") != 0.0;
+    }
+  }
 
  private:
   EnergyTerms current_;

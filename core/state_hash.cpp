@@ -31,6 +31,19 @@ std::uint64_t state_hash(const NodeArrays& nodes) {
   return h;
 }
 
+std::uint64_t reference_hash(const NodeArrays& nodes) {
+  std::vector<LocalIndex> order(nodes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](LocalIndex a, LocalIndex b) { return nodes.gid[a] < nodes.gid[b]; });
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (LocalIndex n : order) {
+    fnv_mix(h, &nodes.gid[n], sizeof(GlobalId));
+    fnv_mix(h, &nodes.x0[3 * n], 3 * sizeof(double));
+  }
+  return h;
+}
+
 std::string hash_to_hex(std::uint64_t hash) {
   static const char* digits = "0123456789abcdef";
   std::string s(16, '0');

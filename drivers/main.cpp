@@ -17,7 +17,8 @@ namespace {
 
 const char* usage =
     "usage:\n"
-    "  fdem run SCENE.yaml [-o OUTDIR] [--set key.path=value ...] [-q]\n"
+    "  fdem run SCENE.yaml [-o OUTDIR] [--set key.path=value ...] [--restart CHECKPOINT.h5] [-q]\n"
+    "  mpirun -np N fdem run SCENE.yaml ...   (N ranks; results identical to one rank)\n"
     "  fdem check SCENE.yaml [--set key.path=value ...]\n"
     "  fdem --version\n";
 
@@ -118,11 +119,9 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
       overrides.push_back(a.substr(6));
     else if (a == "-q" || a == "--quiet")
       options.quiet = true;
-    else if (a == "--restart") {
-      std::fprintf(stderr,
-                   "fdem: --restart: checkpoint/restart is not part of this version of fdem\n");
-      return 2;
-    } else if (!a.empty() && a[0] == '-') {
+    else if (a == "--restart")
+      options.restart_path = value("--restart");
+    else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "fdem: unknown option '%s'\n%s", a.c_str(), usage);
       return 2;
     } else if (scene_path.empty())

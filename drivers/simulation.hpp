@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +27,7 @@ struct RunOptions {
   std::string output_dir = "out";
   bool quiet = false;        // no progress line, no stage table
   bool write_output = true;  // VTK frames and CSV/JSON files
+  std::string restart_path;  // continue from this checkpoint (needs a communicator)
 };
 
 // Which stages the scene needs; the loop runs only these.
@@ -115,6 +117,8 @@ class Simulation {
   void redistribute();
   void rebind_stages(TravellingState& state, bool detected);
   void share_broken_joints();
+  void write_checkpoint();
+  void restore_checkpoint(const std::string& path);
   bool is_root() const;
   void write_outputs(bool force);
   void start_half_step(NodeArrays& nodes) const;
@@ -143,6 +147,10 @@ class Simulation {
   bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step
   bool halo_in_flight_ = false;                 // ghost exchange posted, not yet completed
   double reduction_seconds_ = 0.0;
+  double next_checkpoint_time_ = 0.0;
+  std::vector<std::string> checkpoints_;  // written so far; the last two are kept
+  long whole_nodes_ = 0, whole_tets_ = 0, whole_joints_ = 0;  // counts of the whole model
+  std::uint64_t reference_hash_ = 0;                          // of the whole model's x0
 };
 
 // Builds a Simulation from a scene file (meshes loaded or generated).
