@@ -1,0 +1,56 @@
+# Runs the fdem command on a scene with each rank count of RANKS and passes when every run
+# completes and summary.json's state_hash is the same in all of them.  With RESTART_RANKS, also
+# continues the first run's earliest checkpoint on each of those rank counts and requires the
+# same hash again (checkpoint-and-restart vs. uninterrupted).
+# -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list), RESTART_RANKS (list, optional)
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+
+function(run_fdem ranks out)
+  execute_process(COMMAND ${MPIEXEC} ${NP_FLAG} ${ranks} --oversubscribe ${FDEM} run ${SCENE}
+                          -o ${out} -q ${ARGN}
+                  RESULT_VARIABLE result OUTPUT_VARIABLE stdout ERROR_VARIABLE stderr)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "fdem on ${ranks} ranks (${ARGN}) exited with ${result}:\n${stdout}${stderr}")
+  endif()
+endfunction()
+
+function(read_hash out variable)
+  file(READ ${out}/summary.json summary)
+  string(REGEX MATCH "\"state_hash\": \"([0-9a-f]+)\"" _ "${summary}")
+  set(hash ${CMAKE_MATCH_1})
+  string(REGEX MATCH "\"migrated_elements\": ([0-9]+)" _ "${summary}")
+  message("${out}: state_hash ${hash}, migrated elements ${CMAKE_MATCH_1}")
+  set(${variable} ${hash} PARENT_SCOPE)
+endfunction()
+
+set(reference "")
+foreach(ranks ${RANKS})
+  run_fdem(${ranks} ${WORK}/ranks${ranks})
+  read_hash(${WORK}/ranks${ranks} hash)
+  if(reference STREQUAL "")
+    set(reference ${hash})
+    set(first_run ${WORK}/ranks${ranks})
+  elseif(NOT hash STREQUAL reference)
+    message(FATAL_ERROR "state_hash on ${ranks} ranks is ${hash}, expected ${reference}")
+  endif()
+endforeach()
+
+if(RESTART_RANKS)
+  file(GLOB checkpoints ${first_run}/checkpoint_*.h5)
+  list(SORT checkpoints)
+  list(LENGTH checkpoints count)
+  if(count EQUAL 0)
+    message(FATAL_ERROR "the first run wrote no checkpoint")
+  endif()
+  list(GET checkpoints 0 earliest)
+  foreach(ranks ${RESTART_RANKS})
+    run_fdem(${ranks} ${WORK}/restart${ranks} --restart ${earliest})
+    read_hash(${WORK}/restart${ranks} hash)
+    if(NOT hash STREQUAL reference)
+      message(FATAL_ERROR "restart from ${earliest} on ${ranks} ranks: state_hash ${hash}, "
+                          "uninterrupted ${reference}")
+    endif()
+  endforeach()
+endif()
+message("all runs: state_hash ${reference}")
