@@ -17,10 +17,10 @@ namespace {
 #define FDEM_INLINE_CALLEES
 #endif
 
-template <class Material>
+template <class Material, class Scatter>
 FDEM_INLINE_CALLEES inline void add_tet_force(const TetArrays& tets, LocalIndex t,
                                               const Material& material, NodeArrays& nodes,
-                                              InternalForceSummary& sum) {
+                                              InternalForceSummary& sum, Scatter&& scatter) {
   const double viscosity = tets.viscosity[t];
   const LocalIndex* corner_node = tets.nodes.data() + 4 * static_cast<std::size_t>(t);
   Vec3 x[4], v[4];
@@ -30,7 +30,7 @@ FDEM_INLINE_CALLEES inline void add_tet_force(const TetArrays& tets, LocalIndex 
     for (int c = 0; c < 4; ++c) v[c] = vec3_at(nodes.v.data(), corner_node[c]);
   const Eigen::Map<const Mat3> dm_inv(tets.dm_inv.data() + 9 * static_cast<std::size_t>(t));
   const TetForce out = tet_internal_force(x, v, dm_inv, tets.volume0[t], material, viscosity);
-  for (int c = 0; c < 4; ++c) vec3_at(nodes.f.data(), corner_node[c]) += out.force[c];
+  for (int c = 0; c < 4; ++c) scatter(c, corner_node[c], out.force[c]);
   if (tets.is_owned(t)) {  // halo tets are computed for their forces; their owner reports them
     sum.strain_energy += out.strain_energy;
     sum.damping_power += out.damping_power;
@@ -41,6 +41,15 @@ FDEM_INLINE_CALLEES inline void add_tet_force(const TetArrays& tets, LocalIndex 
   }
 }
 
+// Runs `body(material)` with the tet's material law as a value type.
+template <class Body>
+inline void with_material(const MaterialProperties& mat, Body&& body) {
+  if (mat.model == ElasticModel::neo_hookean)
+    body(NeoHookean{mat.lame});
+  else
+    body(StVenantKirchhoff{mat.lame});
+}
+
 }  // namespace
 
 InternalForceSummary compute_internal_forces(Model& model) {
@@ -48,14 +57,80 @@ InternalForceSummary compute_internal_forces(Model& model) {
   NodeArrays& nodes = model.nodes;
   std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
   InternalForceSummary sum;
+  double* f = nodes.f.data();
+  const auto add_to_node = [f](int, LocalIndex n, const Vec3& force) {
+    vec3_at(f, n) += force;
+  };
   // Tets in ascending global id: each node receives its contributions in that one order.
+  for (const LocalIndex t : model.tet_force_order)
+    with_material(model.materials[tets.material[t]], [&](const auto& material) {
+      add_tet_force(tets, t, material, nodes, sum, add_to_node);
+    });
+  return sum;
+}
+
+void build_internal_force_split(const Model& model, InternalForceSplit& split) {
+  const TetArrays& tets = model.tets;
+  const NodeArrays& nodes = model.nodes;
+  split.early.clear();
+  split.late.clear();
+  split.boundary_tets.clear();
+  split.boundary.assign(static_cast<std::size_t>(nodes.size()), 0);
   for (const LocalIndex t : model.tet_force_order) {
-    const MaterialProperties& mat = model.materials[tets.material[t]];
-    if (mat.model == ElasticModel::neo_hookean)
-      add_tet_force(tets, t, NeoHookean{mat.lame}, nodes, sum);
-    else
-      add_tet_force(tets, t, StVenantKirchhoff{mat.lame}, nodes, sum);
+    bool ghost = false;
+    for (int c = 0; c < 4; ++c) ghost = ghost || tets.nodes[4 * t + c] >= nodes.n_owned;
+    (ghost ? split.late : split.early).push_back(t);
+    if (ghost)
+      for (int c = 0; c < 4; ++c) split.boundary[tets.nodes[4 * t + c]] = 1;
   }
+  for (const LocalIndex t : model.tet_force_order) {
+    bool touches = false;
+    for (int c = 0; c < 4; ++c) touches = touches || split.boundary[tets.nodes[4 * t + c]];
+    if (touches) split.boundary_tets.push_back(t);
+  }
+  split.corner_force.assign(12 * static_cast<std::size_t>(tets.size()), 0.0);
+}
+
+InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& split,
+                                             const std::function<void()>& complete_halo) {
+  const TetArrays& tets = model.tets;
+  NodeArrays& nodes = model.nodes;
+  std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
+  InternalForceSummary sum;
+  double* f = nodes.f.data();
+  double* corner = split.corner_force.data();
+  const std::uint8_t* boundary = split.boundary.data();
+  LocalIndex t = 0;  // the tet being computed, for the scatters below
+  const auto early_scatter = [&](int c, LocalIndex n, const Vec3& force) {
+    if (boundary[n])
+      Eigen::Map<Vec3>(corner + 12 * static_cast<std::size_t>(t) + 3 * c) = force;
+    else
+      vec3_at(f, n) += force;
+  };
+  const auto late_scatter = [&](int c, LocalIndex, const Vec3& force) {
+    Eigen::Map<Vec3>(corner + 12 * static_cast<std::size_t>(t) + 3 * c) = force;
+  };
+  // Interior work while the ghost positions travel.
+  for (const LocalIndex e : split.early) {
+    t = e;
+    with_material(model.materials[tets.material[t]], [&](const auto& material) {
+      add_tet_force(tets, t, material, nodes, sum, early_scatter);
+    });
+  }
+  if (complete_halo) complete_halo();
+  for (const LocalIndex l : split.late) {
+    t = l;
+    with_material(model.materials[tets.material[t]], [&](const auto& material) {
+      add_tet_force(tets, t, material, nodes, sum, late_scatter);
+    });
+  }
+  // Boundary nodes: every contribution, in ascending tet gid.
+  for (const LocalIndex b : split.boundary_tets)
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = tets.nodes[4 * b + c];
+      if (boundary[n])
+        vec3_at(f, n) += Eigen::Map<const Vec3>(corner + 12 * static_cast<std::size_t>(b) + 3 * c);
+    }
   return sum;
 }
 

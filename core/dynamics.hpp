@@ -2,8 +2,8 @@
 // order, gravity, and the central-difference update with its energy bookkeeping.
 #pragma once
 
+#include <cstdint>
 #include <functional>
-
 #include <vector>
 
 #include "core/model.hpp"
@@ -20,6 +20,23 @@ struct InternalForceSummary {
 // Sets every node's force to the sum of its tets' internal forces, added in ascending tet global
 // id (model.tet_force_order) so the sum is the same whatever the local layout or rank.
 InternalForceSummary compute_internal_forces(Model& model);
+
+// Split phase for parallel runs: the tets that need no ghost node are computed while the ghost
+// exchange is in flight; `complete_halo` is called after them, then the tets with a ghost node.
+// Every node still receives its contributions in ascending tet gid: the sums of "boundary" nodes
+// (touched by a tet with a ghost node) wait in a per-corner buffer and are added in gid order at
+// the end, so the result is bit-identical to compute_internal_forces.
+struct InternalForceSplit {
+  std::vector<LocalIndex> early;          // active tets without a ghost node, ascending gid
+  std::vector<LocalIndex> late;           // active tets with a ghost node, ascending gid
+  std::vector<LocalIndex> boundary_tets;  // active tets touching a boundary node, ascending gid
+  std::vector<std::uint8_t> boundary;     // per node: its sum waits for the late tets
+  std::vector<double> corner_force;       // 12 per tet (N), scratch
+};
+// Call after every change of the local model (distribution).
+void build_internal_force_split(const Model& model, InternalForceSplit& split);
+InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& split,
+                                             const std::function<void()>& complete_halo);
 
 // Adds m·g to every node's force.
 void add_gravity(const Vec3& gravity, NodeArrays& nodes);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/dynamics.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
 #include "core/scene.hpp"
@@ -147,6 +148,7 @@ class Simulation {
   bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step
   bool halo_in_flight_ = false;                 // ghost exchange posted, not yet completed
   double reduction_seconds_ = 0.0;
+  InternalForceSplit split_;  // N ranks: interior tets computed while the ghost exchange travels
   double next_checkpoint_time_ = 0.0;
   std::vector<std::string> checkpoints_;  // written so far; the last two are kept
   long whole_nodes_ = 0, whole_tets_ = 0, whole_joints_ = 0;  // counts of the whole model
