@@ -125,10 +125,20 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
     if (joints_) whole.joint_history = joints_->history();
     DistributionSettings settings;
     settings.rebalance_threshold = scene_.parallel.rebalance_threshold;
+    // Blocks that touch at the start should share a rank: the first detection, on the whole
+    // model, gives the partitioner those pairs (one rank detects at the same positions in step 0).
+    std::vector<std::pair<LocalIndex, LocalIndex>> touching;
+    if (contact_) {
+      if (!contact_->detected()) {
+        contact_->detect(model_);
+        whole.x_at_detection = contact_->x_at_detection();
+      }
+      for (const CandidatePair& p : contact_->candidates()) touching.emplace_back(p.a, p.b);
+    }
     Model local;
     distribution_ = std::make_unique<Distribution>(*comm_, settings, model_, whole,
-                                                   contact_ ? contact_->buffer() : 0.0, local,
-                                                   local_state);
+                                                   contact_ ? contact_->buffer() : 0.0, touching,
+                                                   local, local_state);
     model_ = std::move(local);
     rebind_stages(local_state, contact_ && contact_->detected());
   }
@@ -175,14 +185,14 @@ void Simulation::write_checkpoint() {
     }
   }
   rows.joint_history_bytes = sizeof(JointHistory);
-  const JointArrays& joints = model_.joints;
-  for (LocalIndex j = 0; j < joints.size(); ++j) {
-    if (!model_.tets.is_owned(joints.tets[2 * j])) continue;
-    rows.joint_gid.push_back(joints.gid[j]);
-    rows.joint_broken.push_back(joints.broken[j]);
-    rows.joint_mode.push_back(joints.mode[j]);
-    rows.joint_failure_time.push_back(joints.failure_time[j]);
-    rows.joint_damage.push_back(joints.damage[j]);
+  const JointArrays& joint_rows = model_.joints;
+  for (LocalIndex j = 0; j < joint_rows.size(); ++j) {
+    if (!model_.tets.is_owned(joint_rows.tets[2 * j])) continue;
+    rows.joint_gid.push_back(joint_rows.gid[j]);
+    rows.joint_broken.push_back(joint_rows.broken[j]);
+    rows.joint_mode.push_back(joint_rows.mode[j]);
+    rows.joint_failure_time.push_back(joint_rows.failure_time[j]);
+    rows.joint_damage.push_back(joint_rows.damage[j]);
     const auto* bytes = reinterpret_cast<const std::uint8_t*>(&joints_->history()[j]);
     rows.joint_history.insert(rows.joint_history.end(), bytes, bytes + sizeof(JointHistory));
   }
@@ -253,23 +263,23 @@ void Simulation::restore_checkpoint(const std::string& path) {
       at_detection[3 * n + k] = rows.node_x_at_detection[3 * i + k];
     }
   }
-  JointArrays& joints = model_.joints;
-  std::vector<JointHistory> history(static_cast<std::size_t>(joints.size()));
+  JointArrays& joint_rows = model_.joints;
+  std::vector<JointHistory> history(static_cast<std::size_t>(joint_rows.size()));
   for (std::size_t i = 0; i < rows.joint_gid.size(); ++i) {
     const auto j = static_cast<std::size_t>(rows.joint_gid[i]);
-    joints.broken[j] = rows.joint_broken[i];
-    joints.mode[j] = rows.joint_mode[i];
-    joints.failure_time[j] = rows.joint_failure_time[i];
-    joints.damage[j] = rows.joint_damage[i];
+    joint_rows.broken[j] = rows.joint_broken[i];
+    joint_rows.mode[j] = rows.joint_mode[i];
+    joint_rows.failure_time[j] = rows.joint_failure_time[i];
+    joint_rows.damage[j] = rows.joint_damage[i];
     std::memcpy(&history[j], &rows.joint_history[i * sizeof(JointHistory)], sizeof(JointHistory));
   }
   if (joints_) joints_->rebind(model_, std::move(history));
   if (contact_) {
     // A tet's joint state: cracked once one of its joints broke, intact while it has joints.
     std::vector<std::uint8_t> joint_state = contact_->tet_joint_states();
-    for (LocalIndex j = 0; j < joints.size(); ++j)
-      if (joints.broken[j])
-        for (int side = 0; side < 2; ++side) joint_state[joints.tets[2 * j + side]] = 2;
+    for (LocalIndex j = 0; j < joint_rows.size(); ++j)
+      if (joint_rows.broken[j])
+        for (int side = 0; side < 2; ++side) joint_state[joint_rows.tets[2 * j + side]] = 2;
     std::vector<FrictionEntry> friction(rows.friction_a.size());
     for (std::size_t i = 0; i < friction.size(); ++i) {
       friction[i].a = rows.friction_a[i];
@@ -616,13 +626,13 @@ RunReport Simulation::report() const {
   // Counts of what this rank owns (joints: by their tet A), summed over the ranks below.
   std::vector<std::int64_t> counts = {model_.nodes.n_owned, 0, 0, 0, 0, 0, 0};
   for (LocalIndex t = 0; t < model_.tets.size(); ++t) counts[1] += model_.tets.is_owned(t);
-  const JointArrays& joints = model_.joints;
-  for (LocalIndex i = 0; i < joints.size(); ++i) {
-    if (!model_.tets.is_owned(joints.tets[2 * i])) continue;
+  const JointArrays& joint_rows = model_.joints;
+  for (LocalIndex i = 0; i < joint_rows.size(); ++i) {
+    if (!model_.tets.is_owned(joint_rows.tets[2 * i])) continue;
     ++counts[2];
-    if (!joints.broken[i]) continue;
+    if (!joint_rows.broken[i]) continue;
     ++counts[3];
-    const auto mode = static_cast<FailureMode>(joints.mode[i]);
+    const auto mode = static_cast<FailureMode>(joint_rows.mode[i]);
     ++counts[4 + (mode == FailureMode::tension ? 0 : mode == FailureMode::shear ? 1 : 2)];
   }
   if (distribution_) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <numeric>
@@ -84,11 +85,6 @@ void tet_box(const Model& model, LocalIndex t, double box[6]) {
   }
 }
 
-bool boxes_meet(const double* a, const double* b) {
-  for (int k = 0; k < 3; ++k)
-    if (a[k] > b[3 + k] || b[k] > a[3 + k]) return false;
-  return true;
-}
 
 // Packs the rows that travel with a set of tets: the tets, their nodes (once per block), the
 // joints whose first tet they are, and their friction pairs (pairs keyed by their first tet).
@@ -198,26 +194,61 @@ class RowPacker {
   std::vector<LocalIndex> joint_list_;
 };
 
-// Boxes (lo xyz, hi xyz per part) of the tets each part owns, grown by `margin`, and which parts'
-// boxes a tet meets.
-struct PartBoxes {
-  std::vector<double> box;  // 6 per part
-  std::vector<int> near;    // parts whose grown box meets this rank's region (candidates)
-
-  void grow(double margin) {
-    for (std::size_t p = 0; p < box.size() / 6; ++p)
-      for (int k = 0; k < 3; ++k) {
-        box[6 * p + k] -= margin;
-        box[6 * p + 3 + k] += margin;
-      }
+// Which ranks own tets near a point: a grid of cubes of side `margin`, each listing the ranks whose
+// owned tets' boxes touch it.  A tet goes to every rank listed in the cells its box grown by the
+// margin touches — a superset of "within the margin of a tet that rank owns", which is what a rank
+// must hold, and much tighter than one box per rank when parts are not boxes (METIS, separate
+// blocks).  Keys are hashed cell coordinates: a collision only adds a destination.
+class OwnerGrid {
+ public:
+  OwnerGrid(const double origin[3], double cell) : cell_(cell) {
+    std::copy_n(origin, 3, origin_);
   }
+  // Calls `visit(key)` for each cell a box (lo xyz, hi xyz) grown by `grow` touches.
+  template <class Visit>
+  void cells(const double* box, double grow, Visit&& visit) const {
+    std::int64_t first[3], last[3];
+    for (int k = 0; k < 3; ++k) {
+      first[k] = static_cast<std::int64_t>(std::floor((box[k] - grow - origin_[k]) / cell_));
+      last[k] = static_cast<std::int64_t>(std::floor((box[3 + k] + grow - origin_[k]) / cell_));
+    }
+    for (std::int64_t i = first[0]; i <= last[0]; ++i)
+      for (std::int64_t j = first[1]; j <= last[1]; ++j)
+        for (std::int64_t k = first[2]; k <= last[2]; ++k) visit(key(i, j, k));
+  }
+  void add(std::uint64_t key, std::int32_t rank) {
+    std::vector<std::int32_t>& ranks = owners_[key];
+    if (std::find(ranks.begin(), ranks.end(), rank) == ranks.end()) ranks.push_back(rank);
+  }
+  const std::vector<std::int32_t>* owners(std::uint64_t key) const {
+    const auto it = owners_.find(key);
+    return it == owners_.end() ? nullptr : &it->second;
+  }
+
+ private:
+  static std::uint64_t key(std::int64_t i, std::int64_t j, std::int64_t k) {
+    std::uint64_t h = static_cast<std::uint64_t>(i) * 0x9E3779B97F4A7C15ULL;
+    h ^= static_cast<std::uint64_t>(j) * 0xC2B2AE3D27D4EB4FULL + (h << 6) + (h >> 2);
+    h ^= static_cast<std::uint64_t>(k) * 0x165667B19E3779F9ULL + (h << 6) + (h >> 2);
+    return h;
+  }
+  double origin_[3];
+  double cell_;
+  std::unordered_map<std::uint64_t, std::vector<std::int32_t>> owners_;
+};
+
+struct CellOwner {
+  std::uint64_t key;
+  std::int32_t rank;
 };
 
 }  // namespace
 
 Distribution::Distribution(const Communicator& comm, DistributionSettings settings,
                            const Model& global, const TravellingState& global_state,
-                           double buffer, Model& local, TravellingState& local_state)
+                           double buffer,
+                           const std::vector<std::pair<LocalIndex, LocalIndex>>& neighbours,
+                           Model& local, TravellingState& local_state)
     : comm_(comm), settings_(settings), buffer_(buffer) {
   const auto start = std::chrono::steady_clock::now();
   const TetArrays& tets = global.tets;
@@ -240,7 +271,8 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     if (me == 0) {
       CostModel cost;
       cost.joint = settings_.joint_cost;
-      const ElementGraph graph = element_graph(global, cost);
+      const ElementGraph graph =
+          element_graph(global, cost, TetAdjacency::shared_face, neighbours);
       const std::vector<std::int32_t> parts = partition_metis(graph, ranks);
       for (std::int32_t v = 0; v < graph.n_vertices(); ++v)
         part_[static_cast<std::size_t>(graph.gid[v])] = parts[v];
@@ -251,36 +283,36 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     std::memcpy(part_.data(), encoded.data(), part_.size() * sizeof(std::int32_t));
   }
 
-  // This rank's tets: its own and every tet within the margin of their box.
-  std::vector<double> boxes(6 * static_cast<std::size_t>(ranks));
-  for (int p = 0; p < ranks; ++p)
-    for (int k = 0; k < 3; ++k) {
-      boxes[6 * p + k] = std::numeric_limits<double>::infinity();
-      boxes[6 * p + 3 + k] = -std::numeric_limits<double>::infinity();
-    }
-  double extent = 0.0;
+  // This rank's tets: its own and every tet within the margin of a tet it owns.
   std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
+  double extent = 0.0, origin[3] = {std::numeric_limits<double>::infinity(),
+                                    std::numeric_limits<double>::infinity(),
+                                    std::numeric_limits<double>::infinity()};
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
     tet_box(global, t, b);
-    const int p = part_[static_cast<std::size_t>(tets.gid[t])];
     for (int k = 0; k < 3; ++k) {
-      boxes[6 * p + k] = std::min(boxes[6 * p + k], b[k]);
-      boxes[6 * p + 3 + k] = std::max(boxes[6 * p + 3 + k], b[3 + k]);
       extent = std::max(extent, b[3 + k] - b[k]);
+      origin[k] = std::min(origin[k], b[k]);
     }
   }
   const double margin = 2.0 * extent + 2.0 * buffer_;
-  double* mine = &boxes[6 * static_cast<std::size_t>(me)];
-  for (int k = 0; k < 3; ++k) {
-    mine[k] -= margin;
-    mine[3 + k] += margin;
+  OwnerGrid grid(origin, margin);
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    const std::int32_t p = part_[static_cast<std::size_t>(tets.gid[t])];
+    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], 0.0,
+               [&](std::uint64_t key) { grid.add(key, p); });
   }
   std::vector<LocalIndex> selected;
-  for (LocalIndex t = 0; t < tets.size(); ++t)
-    if (part_[static_cast<std::size_t>(tets.gid[t])] == me ||
-        boxes_meet(&tet_boxes[6 * static_cast<std::size_t>(t)], mine))
-      selected.push_back(t);
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    bool mine = part_[static_cast<std::size_t>(tets.gid[t])] == me;
+    if (!mine)
+      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], margin, [&](std::uint64_t key) {
+        const std::vector<std::int32_t>* owners = grid.owners(key);
+        if (owners && std::find(owners->begin(), owners->end(), me) != owners->end()) mine = true;
+      });
+    if (mine) selected.push_back(t);
+  }
   has_joint_state_ = !global_state.tet_joint_state.empty();
   std::vector<char> rows;
   RowPacker(global, global_state).pack(selected, rows);
@@ -432,7 +464,7 @@ void Distribution::assemble(const std::vector<char>& rows, Model& model,
 void Distribution::redistribute(Model& model, TravellingState& state,
                                 const std::vector<std::int32_t>& pairs_per_tet) {
   const auto start = std::chrono::steady_clock::now();
-  const int ranks = comm_.size(), me = comm_.rank();
+  const int ranks = comm_.size();
   const TetArrays& tets = model.tets;
 
   // Owned cost: tets, their intact joints (half each side), contact pairs on their first tet.
@@ -487,54 +519,56 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     report_.migrated_tets += migrated;
   }
 
-  // Boxes of the tets each rank will own, and the margin around them.
-  std::vector<double> lo(3 * static_cast<std::size_t>(ranks), std::numeric_limits<double>::infinity());
-  std::vector<double> hi(3 * static_cast<std::size_t>(ranks), -std::numeric_limits<double>::infinity());
+  // The cells each rank's new owned tets touch (an allgather of cell keys), and the margin.
   std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
   double extent = 0.0;
+  std::vector<double> origin = {std::numeric_limits<double>::infinity(),
+                                std::numeric_limits<double>::infinity(),
+                                std::numeric_limits<double>::infinity()};
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
     tet_box(model, t, b);
     if (!tets.is_owned(t)) continue;
-    const int p = owner_of_tet(tets.gid[t]);
     for (int k = 0; k < 3; ++k) {
-      lo[3 * p + k] = std::min(lo[3 * p + k], b[k]);
-      hi[3 * p + k] = std::max(hi[3 * p + k], b[3 + k]);
       extent = std::max(extent, b[3 + k] - b[k]);
+      origin[k] = std::min(origin[k], b[k]);
     }
   }
-  comm_.min_in_place(lo);
-  comm_.max_in_place(hi);
+  comm_.min_in_place(origin);
   const double margin = 2.0 * comm_.max(extent) + 2.0 * buffer_;
-  std::vector<double> boxes(6 * static_cast<std::size_t>(ranks));
-  for (int p = 0; p < ranks; ++p)
-    for (int k = 0; k < 3; ++k) {
-      boxes[6 * p + k] = lo[3 * p + k] - margin;
-      boxes[6 * p + 3 + k] = hi[3 * p + k] + margin;
+  OwnerGrid grid(origin.data(), margin);
+  std::vector<CellOwner> mine;
+  {
+    std::unordered_map<std::uint64_t, std::vector<std::int32_t>> seen;
+    for (LocalIndex t = 0; t < tets.size(); ++t) {
+      if (!tets.is_owned(t)) continue;
+      const std::int32_t p = owner_of_tet(tets.gid[t]);
+      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], 0.0, [&](std::uint64_t key) {
+        std::vector<std::int32_t>& owners_here = seen[key];
+        if (std::find(owners_here.begin(), owners_here.end(), p) == owners_here.end()) {
+          owners_here.push_back(p);
+          mine.push_back({key, p});
+        }
+      });
     }
-  // Ranks whose grown box meets the box of what this rank owns now: the only possible receivers.
-  double region[6] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-                      std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
-                      -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-  for (LocalIndex t = 0; t < tets.size(); ++t)
-    if (tets.is_owned(t))
-      for (int k = 0; k < 3; ++k) {
-        region[k] = std::min(region[k], tet_boxes[6 * t + k]);
-        region[3 + k] = std::max(region[3 + k], tet_boxes[6 * t + 3 + k]);
-      }
-  std::vector<int> near;
-  for (int p = 0; p < ranks; ++p)
-    if (boxes_meet(region, &boxes[6 * static_cast<std::size_t>(p)])) near.push_back(p);
+  }
+  for (const CellOwner& c : comm_.allgatherv(mine)) grid.add(c.key, c.rank);
 
   std::vector<std::vector<LocalIndex>> lists(static_cast<std::size_t>(ranks));
+  std::vector<int> sent_to(static_cast<std::size_t>(ranks), -1);
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     if (!tets.is_owned(t)) continue;
     const int owner = owner_of_tet(tets.gid[t]);
     lists[owner].push_back(t);
-    for (int p : near)
-      if (p != owner && boxes_meet(&tet_boxes[6 * static_cast<std::size_t>(t)],
-                                   &boxes[6 * static_cast<std::size_t>(p)]))
-        lists[p].push_back(t);
+    sent_to[owner] = t;
+    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], margin, [&](std::uint64_t key) {
+      if (const std::vector<std::int32_t>* owners = grid.owners(key))
+        for (const std::int32_t p : *owners)
+          if (sent_to[p] != t) {
+            sent_to[p] = t;
+            lists[p].push_back(t);
+          }
+    });
   }
   RowPacker packer(model, state);
   std::vector<char> send;

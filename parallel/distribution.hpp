@@ -59,9 +59,12 @@ class Distribution {
  public:
   // Collective.  Every rank passes the same whole model (built from the scene) and the contact
   // buffer (m, 0 without contact).  Partitions it with METIS on the element graph (rank 0,
-  // broadcast), and returns through `local`/`local_state` this rank's part with its halo.
+  // broadcast; edges: shared faces, intact joints, `neighbours`), and returns through `local`/`local_state` this rank's part with its halo.
+  // `neighbours`: pairs of tets (indices of `global`) to keep together besides the mesh and joints
+  // — the contact candidates at the start, so that blocks resting on each other share a rank.
   Distribution(const Communicator& comm, DistributionSettings settings, const Model& global,
-               const TravellingState& global_state, double buffer, Model& local,
+               const TravellingState& global_state, double buffer,
+               const std::vector<std::pair<LocalIndex, LocalIndex>>& neighbours, Model& local,
                TravellingState& local_state);
 
   // Collective, at a contact-detection cycle: measures the owned cost (`pairs_per_tet`: contact
