@@ -113,8 +113,8 @@ struct Model {
   std::vector<PieceInfo> pieces;
   std::vector<std::string> body_names;
   std::vector<bool> body_fixed;
-  // Local tets in ascending global id: the order in which element forces are added to nodes, so a
-  // node's force is the same sum in the same order on any rank and in any local layout.
+  // Local active tets in ascending global id: the order in which element forces are added to
+  // nodes, so a node's force is the same sum in the same order on any rank and in any layout.
   std::vector<LocalIndex> tet_force_order;
   Vec3 gravity = Vec3::Zero();
   JointArrays joints;

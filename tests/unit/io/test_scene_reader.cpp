@@ -202,6 +202,8 @@ TEST_CASE("omitted optional keys take the documented defaults", "[io]") {
   CHECK(s.output.every == 0.0);
   CHECK(s.output.fields == std::vector<std::string>{"displacement", "velocity", "stress"});
   CHECK(s.contact_buffer < 0.0);  // automatic
+  CHECK(s.parallel.rebalance_threshold == 1.10);
+  CHECK(s.parallel.redistribute_every == 0);
 
   SECTION("'auto' spelled out is the same as omitted") {
     const fdem::Scene a = fdem::parse_scene(
@@ -305,6 +307,20 @@ TEST_CASE("missing required keys name the parent's line and the missing key", "[
     CHECK_THAT(msg, StartsWith("scene.yaml"));
     CHECK_THAT(msg, Contains("expected a mapping (key: value pairs)"));
   }
+}
+
+TEST_CASE("the parallel block reads its two keys and rejects others", "[io]") {
+  const fdem::Scene s = fdem::parse_scene(
+      join_lines(minimal_lines()) + "parallel: {rebalance_threshold: 1.25, redistribute_every: 40}\n",
+      "scene.yaml");
+  CHECK(s.parallel.rebalance_threshold == 1.25);
+  CHECK(s.parallel.redistribute_every == 40);
+  const std::string typo =
+      input_error(join_lines(minimal_lines()) + "parallel: {rebalance_treshold: 1.2}\n");
+  CHECK_THAT(typo, Contains("parallel.rebalance_treshold") && Contains("rebalance_threshold"));
+  const std::string negative =
+      input_error(join_lines(minimal_lines()) + "parallel: {redistribute_every: -5}\n");
+  CHECK_THAT(negative, Contains("parallel.redistribute_every") && Contains(">= 0"));
 }
 
 TEST_CASE("impossible values are rejected with the valid range", "[io]") {
