@@ -132,9 +132,8 @@ bool tets_farther_than(const Model& model, const double* positions, LocalIndex a
 bool ContactStage::detection_due(const Model& model) const {
   const NodeArrays& nodes = model.nodes;
   return !detected_ ||
-         detection_needed(max_node_displacement(nodes.x.data(), x_at_detection_.data(),
-                                                nodes.n_owned),
-                          buffer_);
+         detection_needed(
+             max_node_displacement(nodes.x.data(), x_at_detection_.data(), nodes.n_owned), buffer_);
 }
 
 bool ContactStage::detect_if_needed(const Model& model) {
@@ -203,9 +202,9 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
                           const std::vector<FrictionEntry>& friction, bool detected) {
   const TetArrays& tets = model.tets;
   FDEM_VERIFY(x_at_detection.size() == model.nodes.x.size(), "positions at detection per node");
-  FDEM_VERIFY(tet_joint_state.empty() ||
-                  tet_joint_state.size() == static_cast<std::size_t>(tets.size()),
-              "joint state per tet");
+  FDEM_VERIFY(
+      tet_joint_state.empty() || tet_joint_state.size() == static_cast<std::size_t>(tets.size()),
+      "joint state per tet");
   std::vector<std::pair<LocalIndex, LocalIndex>> bonds;
   for (LocalIndex j = 0; j < model.joints.size(); ++j)
     if (!model.joints.broken[j])

@@ -58,9 +58,7 @@ InternalForceSummary compute_internal_forces(Model& model) {
   std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
   InternalForceSummary sum;
   double* f = nodes.f.data();
-  const auto add_to_node = [f](int, LocalIndex n, const Vec3& force) {
-    vec3_at(f, n) += force;
-  };
+  const auto add_to_node = [f](int, LocalIndex n, const Vec3& force) { vec3_at(f, n) += force; };
   // Tets in ascending global id: each node receives its contributions in that one order.
   for (const LocalIndex t : model.tet_force_order)
     with_material(model.materials[tets.material[t]], [&](const auto& material) {

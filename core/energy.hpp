@@ -85,12 +85,11 @@ class EnergyLedger {
         {"initial_total", initial_total_},
         {"peak_scale", peak_scale_},
         {"has_initial", has_initial_ ? 1.0 : 0.0}};
-    const std::pair<const char*, const WorkAccumulator*> accumulators[] = {
-        {"damping", &damping},
-        {"friction", &friction},
-        {"fracture", &fracture},
-        {"external", &external},
-        {"gravity", &gravity}};
+    const std::pair<const char*, const WorkAccumulator*> accumulators[] = {{"damping", &damping},
+                                                                           {"friction", &friction},
+                                                                           {"fracture", &fracture},
+                                                                           {"external", &external},
+                                                                           {"gravity", &gravity}};
     for (const auto& [name, a] : accumulators) {
       out.emplace_back(std::string("work_") + name + "_through_previous", a->through_previous);
       out.emplace_back(std::string("work_") + name + "_first_before", a->first_before);

@@ -48,8 +48,8 @@ std::ostream& operator<<(std::ostream& out, JsonNumber n) {
 }
 }  // namespace
 
-RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>& fields,
-                   int rank, int ranks)
+RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>& fields, int rank,
+                   int ranks)
     : directory_(directory),
       fields_(fields),
       rank_(rank),
@@ -138,16 +138,15 @@ void RunFiles::write_cracks(double time, const Model& model) {
   const std::string stem = cracks_->next_frame_path();
   write_parallel_triangle_frame((std::filesystem::path(directory_) / stem).string(), points,
                                 triangles,
-                       {{"mode", 1, true, mode},
-                        {"failure_time", 1, true, failure_time},
-                        {"opening", 1, true, opening}},
+                                {{"mode", 1, true, mode},
+                                 {"failure_time", 1, true, failure_time},
+                                 {"opening", 1, true, opening}},
                                 rank_, ranks_);
   cracks_->add_frame(time, cracks_->frame_file(stem, "vtp"));
 }
 
 void RunFiles::write_contacts(double time, const std::vector<ContactRecord>& records) {
-  if (!contacts_)
-    contacts_ = std::make_unique<SeriesWriter>(directory_, "contacts", rank_, ranks_);
+  if (!contacts_) contacts_ = std::make_unique<SeriesWriter>(directory_, "contacts", rank_, ranks_);
   std::vector<double> points, normal, tangential;
   for (const ContactRecord& r : records)
     for (int k = 0; k < 3; ++k) {

@@ -1,24 +1,24 @@
 #include "drivers/simulation.hpp"
 
 #include <cmath>
-#include <functional>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <map>
+#include <functional>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "contact/contact_stage.hpp"
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
 #include "core/model_builder.hpp"
-#include "fracture/joint_kernels.hpp"
 #include "core/state_hash.hpp"
 #include "core/time_step.hpp"
 #include "drivers/loads.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/run_files.hpp"
+#include "fracture/joint_kernels.hpp"
 #include "fracture/joint_stage.hpp"
 #include "parallel/checkpoint.hpp"
 #include "parallel/communicator.hpp"
@@ -62,11 +62,13 @@ std::vector<std::string> StagePlan::describe() const {
 }
 
 Simulation::Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm)
-    : scene_(std::move(scene)), model_(std::move(model)), options_(std::move(options)), comm_(comm) {
-  const char* names[n_stages] = {"internal_forces", "joint_forces",   "fracture",
-                                 "contact_detection", "contact_forces", "external_forces",
-                                 "integrate",       "halo_update",    "redistribution",
-                                 "output"};
+    : scene_(std::move(scene)),
+      model_(std::move(model)),
+      options_(std::move(options)),
+      comm_(comm) {
+  const char* names[n_stages] = {
+      "internal_forces", "joint_forces", "fracture",    "contact_detection", "contact_forces",
+      "external_forces", "integrate",    "halo_update", "redistribution",    "output"};
   for (int s = 0; s < n_stages; ++s) clocks_[s].name = names[s];
   loads_ = std::make_unique<LoadSchedule>(scene_, model_);
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
@@ -306,7 +308,9 @@ void Simulation::restore_checkpoint(const std::string& path) {
   ledger_.restore([&](const std::string& name) { return number("ledger_" + name); });
 }
 
-bool Simulation::is_root() const { return !comm_ || comm_->rank() == 0; }
+bool Simulation::is_root() const {
+  return !comm_ || comm_->rank() == 0;
+}
 
 void Simulation::rebind_stages(TravellingState& state, bool detected) {
   if (contact_)
@@ -496,12 +500,12 @@ void Simulation::step() {
                                  motion.finite ? 0.0 : 1.0};
     comm_->sum_in_place(terms);
     int i = 0;
-    for (double* v : {&forces.strain_energy, &forces.damping_power, &j.stored_energy,
-                      &j.fracture_dissipated, &j.friction_dissipated, &c.damping_dissipated,
-                      &c.energy, &c.friction_spring_energy, &c.friction_work_before,
-                      &c.friction_work_after, &motion.kinetic_energy,
-                      &motion.kinetic_energy_half_step, &motion.constraint_work_before,
-                      &motion.constraint_work_after})
+    for (double* v :
+         {&forces.strain_energy, &forces.damping_power, &j.stored_energy, &j.fracture_dissipated,
+          &j.friction_dissipated, &c.damping_dissipated, &c.energy, &c.friction_spring_energy,
+          &c.friction_work_before, &c.friction_work_after, &motion.kinetic_energy,
+          &motion.kinetic_energy_half_step, &motion.constraint_work_before,
+          &motion.constraint_work_after})
       *v = terms[i++];
     motion.momentum_before = Vec3(terms[14], terms[15], terms[16]);
     motion.momentum_after = Vec3(terms[17], terms[18], terms[19]);
@@ -650,7 +654,8 @@ RunReport Simulation::report() const {
     r.ghost_nodes_max = d.ghost_nodes_max;
     r.ghost_nodes_mean = d.ghost_nodes_sum / comm_->size();
     r.neighbours_max = d.neighbours_max;
-    r.communication_seconds = clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;
+    r.communication_seconds =
+        clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;
   } else {
     r.state_hash = hash_to_hex(state_hash(model_.nodes));
     r.fragments = count_fragments(model_);

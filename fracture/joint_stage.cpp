@@ -64,7 +64,7 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
     if (joints.broken[j]) continue;
     const LocalIndex tet_a = joints.tets[2 * j], tet_b = joints.tets[2 * j + 1];
     if (!tets.is_active(tet_a) && !tets.is_active(tet_b)) continue;  // other ranks compute it
-    const double share = tets.is_owned(tet_a) ? 1.0 : 0.0;  // the owner of A reports it
+    const double share = tets.is_owned(tet_a) ? 1.0 : 0.0;           // the owner of A reports it
     const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
     Vec3 x[6];
     for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[i]);
@@ -84,9 +84,10 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
     }
   }
   // Count the ones this rank reports; the others learn of them through mark_broken.
-  newly_broken_.erase(std::remove_if(newly_broken_.begin(), newly_broken_.end(),
-                                     [&](LocalIndex j) { return !tets.is_owned(joints.tets[2 * j]); }),
-                      newly_broken_.end());
+  newly_broken_.erase(
+      std::remove_if(newly_broken_.begin(), newly_broken_.end(),
+                     [&](LocalIndex j) { return !tets.is_owned(joints.tets[2 * j]); }),
+      newly_broken_.end());
   broken_ += static_cast<LocalIndex>(newly_broken_.size());
   out.newly_broken = static_cast<LocalIndex>(newly_broken_.size());
   out.broken = broken_;

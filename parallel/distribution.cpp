@@ -85,7 +85,6 @@ void tet_box(const Model& model, LocalIndex t, double box[6]) {
   }
 }
 
-
 // Packs the rows that travel with a set of tets: the tets, their nodes (once per block), the
 // joints whose first tet they are, and their friction pairs (pairs keyed by their first tet).
 class RowPacker {
@@ -119,9 +118,9 @@ class RowPacker {
       for (std::int64_t k = joint_offsets_[t]; k < joint_offsets_[t + 1]; ++k)
         joint_list.push_back(joint_list_[k]);
       const GlobalId g = tets.gid[t];
-      auto it = std::lower_bound(
-          state_.friction.begin(), state_.friction.end(), g,
-          [](const FrictionEntry& e, GlobalId value) { return e.a < value; });
+      auto it =
+          std::lower_bound(state_.friction.begin(), state_.friction.end(), g,
+                           [](const FrictionEntry& e, GlobalId value) { return e.a < value; });
       for (; it != state_.friction.end() && it->a == g; ++it) friction_list.push_back(&*it);
     }
     BlockHeader header;
@@ -201,9 +200,7 @@ class RowPacker {
 // blocks).  Keys are hashed cell coordinates: a collision only adds a destination.
 class OwnerGrid {
  public:
-  OwnerGrid(const double origin[3], double cell) : cell_(cell) {
-    std::copy_n(origin, 3, origin_);
-  }
+  OwnerGrid(const double origin[3], double cell) : cell_(cell) { std::copy_n(origin, 3, origin_); }
   // Calls `visit(key)` for each cell a box (lo xyz, hi xyz) grown by `grow` touches.
   template <class Visit>
   void cells(const double* box, double grow, Visit&& visit) const {
@@ -245,8 +242,7 @@ struct CellOwner {
 }  // namespace
 
 Distribution::Distribution(const Communicator& comm, DistributionSettings settings,
-                           const Model& global, const TravellingState& global_state,
-                           double buffer,
+                           const Model& global, const TravellingState& global_state, double buffer,
                            const std::vector<std::pair<LocalIndex, LocalIndex>>& neighbours,
                            Model& local, TravellingState& local_state)
     : comm_(comm), settings_(settings), buffer_(buffer) {
@@ -255,9 +251,11 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   const int ranks = comm_.size(), me = comm_.rank();
   // Node → its smallest tet gid: fixed for the whole run (fracture breaks joints, never tets).
   GlobalId max_node = -1, max_tet = -1;
-  for (LocalIndex n = 0; n < global.nodes.size(); ++n) max_node = std::max(max_node, global.nodes.gid[n]);
+  for (LocalIndex n = 0; n < global.nodes.size(); ++n)
+    max_node = std::max(max_node, global.nodes.gid[n]);
   for (LocalIndex t = 0; t < tets.size(); ++t) max_tet = std::max(max_tet, tets.gid[t]);
-  node_first_tet_.assign(static_cast<std::size_t>(max_node + 1), std::numeric_limits<GlobalId>::max());
+  node_first_tet_.assign(static_cast<std::size_t>(max_node + 1),
+                         std::numeric_limits<GlobalId>::max());
   for (LocalIndex t = 0; t < tets.size(); ++t)
     for (int c = 0; c < 4; ++c) {
       GlobalId& first = node_first_tet_[global.nodes.gid[tets.nodes[4 * t + c]]];
@@ -271,8 +269,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     if (me == 0) {
       CostModel cost;
       cost.joint = settings_.joint_cost;
-      const ElementGraph graph =
-          element_graph(global, cost, TetAdjacency::shared_face, neighbours);
+      const ElementGraph graph = element_graph(global, cost, TetAdjacency::shared_face, neighbours);
       const std::vector<std::int32_t> parts = partition_metis(graph, ranks);
       for (std::int32_t v = 0; v < graph.n_vertices(); ++v)
         part_[static_cast<std::size_t>(graph.gid[v])] = parts[v];
@@ -326,7 +323,8 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   build_exchange(local);
   report_.cycles = 1;
   update_report(local);
-  report_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report_.seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void Distribution::assemble(const std::vector<char>& rows, Model& model,
@@ -341,7 +339,8 @@ void Distribution::assemble(const std::vector<char>& rows, Model& model,
     for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
     for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
     for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
-    for (std::int64_t i = 0; i < header.friction; ++i) friction_rows.push_back(take<FrictionRow>(p));
+    for (std::int64_t i = 0; i < header.friction; ++i)
+      friction_rows.push_back(take<FrictionRow>(p));
   }
   const auto by_gid = [](const auto& a, const auto& b) { return a.gid < b.gid; };
   const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
@@ -599,7 +598,8 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   build_exchange(model);
   ++report_.cycles;
   update_report(model);
-  report_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report_.seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void Distribution::build_exchange(const Model& model) {
@@ -669,8 +669,8 @@ void Distribution::start_halo_exchange(const NodeArrays& nodes) {
         for (int k = 0; k < 3; ++k) *out++ = nodes.v[3 * n + k];
       }
       requests_.emplace_back();
-      MPI_Isend(nb.send_buffer.data(), static_cast<int>(nb.send_buffer.size()), MPI_DOUBLE,
-                nb.rank, tag, comm_.handle(), &requests_.back());
+      MPI_Isend(nb.send_buffer.data(), static_cast<int>(nb.send_buffer.size()), MPI_DOUBLE, nb.rank,
+                tag, comm_.handle(), &requests_.back());
     }
   halo_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

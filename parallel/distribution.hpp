@@ -42,26 +42,27 @@ struct DistributionSettings {
 
 // What the last (re)distribution did, the same on every rank.
 struct DistributionReport {
-  long cycles = 0;                    // redistributions so far (the first is the initial one)
-  long rebalances = 0;                // of which re-partitioned
-  long migrated_tets = 0;             // tets that changed owner, summed over all cycles
-  double imbalance = 1.0;             // max/mean owned cost after the last cycle
-  double imbalance_before = 1.0;      // ... before its re-partition
-  double max_imbalance = 1.0;         // largest imbalance seen at a cycle (before re-partition)
+  long cycles = 0;                // redistributions so far (the first is the initial one)
+  long rebalances = 0;            // of which re-partitioned
+  long migrated_tets = 0;         // tets that changed owner, summed over all cycles
+  double imbalance = 1.0;         // max/mean owned cost after the last cycle
+  double imbalance_before = 1.0;  // ... before its re-partition
+  double max_imbalance = 1.0;     // largest imbalance seen at a cycle (before re-partition)
   long owned_tets_min = 0, owned_tets_max = 0;
   long halo_tets_min = 0, halo_tets_max = 0, halo_tets_sum = 0;
   long ghost_nodes_min = 0, ghost_nodes_max = 0, ghost_nodes_sum = 0;
-  long neighbours_max = 0;            // ranks a rank exchanges ghosts with
-  double seconds = 0.0;               // wall time spent redistributing (this rank)
+  long neighbours_max = 0;  // ranks a rank exchanges ghosts with
+  double seconds = 0.0;     // wall time spent redistributing (this rank)
 };
 
 class Distribution {
  public:
   // Collective.  Every rank passes the same whole model (built from the scene) and the contact
   // buffer (m, 0 without contact).  Partitions it with METIS on the element graph (rank 0,
-  // broadcast; edges: shared faces, intact joints, `neighbours`), and returns through `local`/`local_state` this rank's part with its halo.
-  // `neighbours`: pairs of tets (indices of `global`) to keep together besides the mesh and joints
-  // — the contact candidates at the start, so that blocks resting on each other share a rank.
+  // broadcast; edges: shared faces, intact joints, `neighbours`), and returns through
+  // `local`/`local_state` this rank's part with its halo. `neighbours`: pairs of tets (indices of
+  // `global`) to keep together besides the mesh and joints — the contact candidates at the start,
+  // so that blocks resting on each other share a rank.
   Distribution(const Communicator& comm, DistributionSettings settings, const Model& global,
                const TravellingState& global_state, double buffer,
                const std::vector<std::pair<LocalIndex, LocalIndex>>& neighbours, Model& local,
@@ -99,8 +100,8 @@ class Distribution {
   Communicator comm_;
   DistributionSettings settings_;
   double buffer_ = 0.0;
-  std::vector<std::int32_t> part_;          // by tet gid: owning rank
-  std::vector<GlobalId> node_first_tet_;    // by node gid: smallest tet gid holding it (static)
+  std::vector<std::int32_t> part_;        // by tet gid: owning rank
+  std::vector<GlobalId> node_first_tet_;  // by node gid: smallest tet gid holding it (static)
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
   DistributionReport report_;

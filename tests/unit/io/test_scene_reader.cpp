@@ -310,9 +310,10 @@ TEST_CASE("missing required keys name the parent's line and the missing key", "[
 }
 
 TEST_CASE("the parallel block reads its two keys and rejects others", "[io]") {
-  const fdem::Scene s = fdem::parse_scene(
-      join_lines(minimal_lines()) + "parallel: {rebalance_threshold: 1.25, redistribute_every: 40}\n",
-      "scene.yaml");
+  const fdem::Scene s =
+      fdem::parse_scene(join_lines(minimal_lines()) +
+                            "parallel: {rebalance_threshold: 1.25, redistribute_every: 40}\n",
+                        "scene.yaml");
   CHECK(s.parallel.rebalance_threshold == 1.25);
   CHECK(s.parallel.redistribute_every == 40);
   const std::string typo =
