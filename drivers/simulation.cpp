@@ -341,7 +341,7 @@ void Simulation::redistribute() {
 
 // Joints break where they are computed; the owner of tet A tells every rank, so that every copy
 // of the joint and every copy of its tets' contact state changes at the same step as on one rank.
-void Simulation::share_broken_joints() {
+bool Simulation::share_broken_joints(bool detection_due) {
   struct Broken {
     GlobalId joint, tet_a, tet_b;
     double time;
@@ -352,7 +352,10 @@ void Simulation::share_broken_joints() {
     mine.push_back({model_.joints.gid[b], model_.tets.gid[model_.joints.tets[2 * b]],
                     model_.tets.gid[model_.joints.tets[2 * b + 1]], model_.joints.failure_time[b],
                     model_.joints.mode[b]});
-  if (comm_->sum(static_cast<std::int64_t>(mine.size())) == 0) return;
+  // One reduction: joints broken anywhere, and ranks whose nodes call for contact detection.
+  std::vector<std::int64_t> counts = {static_cast<std::int64_t>(mine.size()), detection_due};
+  comm_->sum_in_place(counts);
+  if (counts[0] == 0) return counts[1] > 0;
   const std::vector<Broken> all = comm_->allgatherv(mine);
   const auto local_tet = [&](GlobalId gid) -> LocalIndex {  // local tets are in ascending gid
     const auto it = std::lower_bound(model_.tets.gid.begin(), model_.tets.gid.end(), gid);
@@ -367,6 +370,7 @@ void Simulation::share_broken_joints() {
                            static_cast<std::uint8_t>(b.mode));
     if (contact_) contact_->release_bond(local_tet(b.tet_a), local_tet(b.tet_b));
   }
+  return true;  // released bonds: every rank re-detects, as one rank does
 }
 
 Simulation::~Simulation() = default;
@@ -418,6 +422,7 @@ void Simulation::step() {
 
   // 2 joint forces: cohesive joints in ascending joint gid
   JointStepSummary j;
+  bool detection_due = false;  // N ranks: whether any rank needs contact detection this step
   if (plan_.joints) {
     {
       Timed timed(clocks_[joints]);
@@ -426,7 +431,7 @@ void Simulation::step() {
     // 3 fracture: the tets of newly broken joints become contact partners
     Timed timed(clocks_[fracture]);
     if (distribution_)
-      share_broken_joints();
+      detection_due = share_broken_joints(contact_ && contact_->detection_due(model_));
     else if (j.newly_broken > 0 && contact_)
       for (LocalIndex b : joints_->newly_broken())
         contact_->release_bond(model_.joints.tets[2 * b], model_.joints.tets[2 * b + 1]);
@@ -436,7 +441,9 @@ void Simulation::step() {
   if (plan_.contact) {
     Timed timed(clocks_[detection]);
     if (distribution_) {
-      if (comm_->max(static_cast<std::int32_t>(contact_->detection_due(model_))) > 0) {
+      if (!plan_.joints)  // with joints, stage 3's reduction has answered already
+        detection_due = comm_->max(static_cast<std::int32_t>(contact_->detection_due(model_))) > 0;
+      if (detection_due) {
         contact_->detect(model_);
         redistribute_pending_ = true;
       }
@@ -474,6 +481,7 @@ void Simulation::step() {
     halo_in_flight_ = true;
   }
 
+  double bad_tet_ranks = 0.0;  // N ranks: ranks holding an inverted or NaN tet
   // The energy terms of every rank (each counts what it owns) in one reduction.
   if (distribution_) {
     const auto start = std::chrono::steady_clock::now();
@@ -497,7 +505,8 @@ void Simulation::step() {
                                  motion.momentum_after.x(),
                                  motion.momentum_after.y(),
                                  motion.momentum_after.z(),
-                                 motion.finite ? 0.0 : 1.0};
+                                 motion.finite ? 0.0 : 1.0,
+                                 forces.min_jacobian > 0.0 ? 0.0 : 1.0};
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
@@ -510,6 +519,7 @@ void Simulation::step() {
     motion.momentum_before = Vec3(terms[14], terms[15], terms[16]);
     motion.momentum_after = Vec3(terms[17], terms[18], terms[19]);
     motion.finite = terms[20] == 0.0;
+    bad_tet_ranks = terms[21];
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -544,7 +554,10 @@ void Simulation::step() {
       std::max({energy_input_, std::abs(ledger_.initial_total()), std::abs(energy.external_work),
                 std::abs(ledger_.external.through_previous), std::abs(energy.gravity),
                 std::abs(ledger_.gravity.through_previous), energy_floor_});
-  if (distribution_)  // a failure on any rank stops every rank with its message
+  // An inverted or NaN tet is seen by the ranks that hold it: when any rank has one (counted in
+  // the reduction above), the check runs collectively and every rank stops with that rank's
+  // message.  The other checks use reduced values, so every rank decides alike without one.
+  if (distribution_ && bad_tet_ranks > 0)
     comm_->run_collectively([&] { check_state(forces, motion.finite); });
   else
     check_state(forces, motion.finite);

@@ -117,7 +117,7 @@ class Simulation {
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
   void redistribute();
   void rebind_stages(TravellingState& state, bool detected);
-  void share_broken_joints();
+  bool share_broken_joints(bool detection_due);
   void write_checkpoint();
   void restore_checkpoint(const std::string& path);
   bool is_root() const;
