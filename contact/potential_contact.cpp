@@ -302,12 +302,20 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
       weight_c[a] += vol_integral[0][i][a];
       weight_t[a] += vol_integral[0][i][4 + a];
     }
+  // The overlap lies inside both tets, so its centroid's barycentric weights are in [0, 1] and
+  // sum to 1.  For a round-off sliver (touching coplanar faces, overlap ~1e-50 m^3) the moment
+  // ratios are noise (seen: weights ~3e14, a "centroid" 5e13 m away); clamping keeps the
+  // velocity interpolation and the force spreading of friction and dashpot bounded.  Exact
+  // overlaps are unchanged.
+  const auto clamp_weights = [](const double (&raw)[4], double (&out)[4]) {
+    double sum = 0.0;
+    for (int a = 0; a < 4; ++a) sum += (out[a] = std::max(raw[a], 0.0));
+    for (int a = 0; a < 4; ++a) out[a] = sum > 0.0 ? out[a] / sum : 0.25;
+  };
+  clamp_weights(weight_c, r.centroid_weights_contactor);
+  clamp_weights(weight_t, r.centroid_weights_target);
   Vec3 centroid = Vec3::Zero();
-  for (int a = 0; a < 4; ++a) {
-    r.centroid_weights_contactor[a] = weight_c[a] / volume[0];
-    r.centroid_weights_target[a] = weight_t[a] / volume[0];
-    centroid += r.centroid_weights_contactor[a] * frame.local[0][a];
-  }
+  for (int a = 0; a < 4; ++a) centroid += r.centroid_weights_contactor[a] * frame.local[0][a];
   r.centroid = frame.origin + centroid;
   const Vec3 resultant =
       r.force_contactor[0] + r.force_contactor[1] + r.force_contactor[2] + r.force_contactor[3];
