@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Renders one characteristic frame of each example run to docs/pictures/<example>.png (1200x800)
 # with ParaView's pvbatch and scripts/render_frame.py:
-#   tower-projectile        the moment the struck block has left the pier (velocity)
-#   mortared-wall-push      the last frame, broken mortar joints (cracks.pvd) over displacement
-#   cantilever-sag          the lowest point of the first swing (displacement)
+#   tower-projectile        the moment the struck block has left the pier (speed)
+#   mortared-wall-push      the last frame, broken mortar joints (cracks.pvd, by failure mode) over
+#                           displacement
+#   cantilever-sag          the lowest point of the first swing (von Mises stress)
 #   brazilian-disc          the last frame, the split plane (cracks.pvd) over damage
-#   arch-acceleration       collapse onset: the crown voussoir first faster than 0.2 m/s (velocity)
-#   dry-stone-wall-seismic  the peak of the table's acceleration record (velocity; contact forces)
+#   arch-acceleration       collapse onset: a voussoir first faster than 0.5 m/s after 0.3 s (speed)
+#   dry-stone-wall-seismic  the peak of the table's acceleration record (contact normal forces)
 # The frame of each is found from the run's own bodies.csv (or the input record), so a changed
 # scene still gets its characteristic moment.
 #
@@ -130,8 +131,9 @@ render() {  # render RUNDIR EXAMPLE PNG ARGS...
   # (about one start in four, "bad X server connection"); a retry connects.
   for attempt in 1 2 3 4 5 6; do
     [[ -z "$xvfb_pid" ]] || kill -0 "$xvfb_pid" 2>/dev/null || echo "render-pictures.sh: Xvfb $DISPLAY has stopped" >&2
-    if "${launcher[@]}" --force-offscreen-rendering "$root/scripts/render_frame.py" \
-         "$run/frames.pvd" "$png" --title "$title" "$@" >"$png.log" 2>&1 && [[ -s "$png" ]]; then
+    # (In a subshell, so that the shell's note of a crashed pvbatch goes to the log too.)
+    if ("${launcher[@]}" --force-offscreen-rendering "$root/scripts/render_frame.py" \
+          "$run/frames.pvd" "$png" --title "$title" "$@") >"$png.log" 2>&1 && [[ -s "$png" ]]; then
       grep -v '^$' "$png.log" | tail -n 1
       rm -f "$png.log"
       return 0
@@ -160,8 +162,9 @@ for run in "${dirs[@]}"; do
         --field velocity --field-title "speed (m/s)" --edges --view 1 2 -0.6 --zoom 1.4 --focus 0 0 1.0 || status=1 ;;
     mortared-wall-push)
       render "$run" "$example" "$png" --index -1 --field displacement \
-        --field-title "displacement (m)" --opacity 0.35 --overlay "$run/cracks.pvd" \
-        --overlay-width 4 --view 0.15 1 -0.5 --zoom 1.3 || status=1 ;;
+        --field-title "displacement (m)" --opacity 0.35 --overlay "$run/cracks.pvd:mode" \
+        --overlay-title "crack mode (1 tension, 3-4 mixed)" --overlay-width 4 \
+        --view 0.15 1 -0.5 --zoom 1.1 || status=1 ;;
     cantilever-sag)
       # shellcheck disable=SC2046
       render "$run" "$example" "$png" $(time_args "$(time_of lowest "$run" beam)") \
@@ -173,14 +176,15 @@ for run in "${dirs[@]}"; do
         --overlay-width 2 --view 0 0 -1 --up 0 1 0 --zoom 1.1 || status=1 ;;
     arch-acceleration)
       # shellcheck disable=SC2046
-      render "$run" "$example" "$png" $(time_args "$(time_of faster "$run" arch 0.2 0.3)") \
-        --field velocity --field-title "speed (m/s)" --edges --view 0 1 0 --zoom 1.2 || status=1 ;;
+      render "$run" "$example" "$png" $(time_args "$(time_of faster "$run" arch 0.5 0.3)") \
+        --field velocity --field-title "speed (m/s)" --edges --view 0 1 0 --zoom 1.35 || status=1 ;;
     dry-stone-wall-seismic)
       # shellcheck disable=SC2046
       render "$run" "$example" "$png" \
         $(time_args "$(time_of peak-record "$run" "$root/examples/records/synthetic-sweep.csv")") \
-        --field velocity --component X --field-title "velocity x (m/s)" --edges \
-        --view 0.5 1 -0.3 --zoom 1.2 || status=1 ;;
+        --field none --edges --opacity 0.35 --overlay "$run/contacts.pvd:normal_force" \
+        --overlay-points 0.02 --overlay-title "contact normal force (N)" --view 0.5 1 -0.3 \
+        --zoom 1.2 || status=1 ;;
     *) echo "render-pictures.sh: no picture recipe for '$example' ($run)" >&2; status=1 ;;
   esac
 done

@@ -38,7 +38,8 @@ def parse_args(argv):
     which = p.add_mutually_exclusive_group()
     which.add_argument("--time", type=float, help="simulated time of the frame (nearest frame)")
     which.add_argument("--index", type=int, help="frame number, negative from the end")
-    p.add_argument("--field", default="displacement", help="array to colour by")
+    p.add_argument("--field", default="displacement",
+                   help="array to colour by; none: one solid colour (with a coloured overlay)")
     p.add_argument("--component", default="Magnitude",
                    help="Magnitude, X, Y, Z or a component number (vectors and tensors)")
     p.add_argument("--range", type=float, nargs=2, metavar=("MIN", "MAX"),
@@ -49,6 +50,7 @@ def parse_args(argv):
     p.add_argument("--overlay", action="append", default=[], metavar="SERIES[:FIELD]",
                    help="another series (cracks.pvd, contacts.pvd) shown at the same time, in "
                         "--overlay-color or coloured by FIELD; may repeat")
+    p.add_argument("--overlay-title", help="scalar bar title of a coloured overlay")
     p.add_argument("--overlay-color", type=float, nargs=3, default=[0.85, 0.1, 0.1],
                    metavar=("R", "G", "B"))
     p.add_argument("--overlay-width", type=float, default=3.0,
@@ -129,64 +131,8 @@ def data_range(source, assoc, name, index, time):
     return array.GetComponentRange(index)
 
 
-def main(argv):
-    args = parse_args(argv)
-    view = GetActiveViewOrCreate("RenderView")
-    view.ViewSize = args.size
-    view.OrientationAxesVisibility = 1
-    view.Background = [1.0, 1.0, 1.0]
-    try:  # ParaView >= 5.10 uses the palette unless told to use the view's own background
-        view.UseColorPaletteForBackground = 0
-    except AttributeError:
-        pass
-
-    reader = open_series(args.input)
-    time = frame_time(reader, args)
-    if time is not None:
-        # The animation time, not only the view's: the camera fit uses the bounds at that time.
-        scene = GetAnimationScene()
-        scene.UpdateAnimationUsingDataTimeSteps()
-        scene.AnimationTime = time
-        view.ViewTime = time
-    UpdatePipeline(time=time, proxy=reader)
-    assoc, n_components = association_of(reader, args.field)
-    component, index = component_spec(args.component, n_components)
-
-    display = Show(reader, view)
-    display.Representation = "Surface With Edges" if args.edges else "Surface"
-    display.EdgeColor = [0.25, 0.25, 0.25]
-    display.Opacity = args.opacity
-    if component is None:
-        ColorBy(display, (assoc, args.field))
-    else:
-        ColorBy(display, (assoc, args.field, component))
-    lut = GetColorTransferFunction(args.field)
-    lut.ApplyPreset(args.colormap, True)
-    low, high = args.range if args.range else data_range(reader, assoc, args.field, index, time)
-    if high <= low:  # a uniform field: widen so the bar is readable
-        high = low + (abs(low) * 1e-3 or 1e-12)
-    if args.log_scale:
-        low = max(low, high * 1e-4)
-        lut.UseLogScale = 1
-    lut.RescaleTransferFunction(low, high)
-    GetOpacityTransferFunction(args.field).RescaleTransferFunction(low, high)
-    try:
-        lut.AutomaticRescaleRangeMode = "Never"
-    except AttributeError:
-        pass
-    display.SetScalarBarVisibility(view, True)
-    bar = GetScalarBar(lut, view)
-    bar.Title = args.field_title or (args.field if component is None
-                                     else f"{args.field} ({component.lower()})")
-    bar.ComponentTitle = ""
-    bar.TitleColor = bar.LabelColor = [0.1, 0.1, 0.1]
-    bar.TitleFontSize = 18
-    bar.LabelFontSize = 15
-    bar.ScalarBarLength = 0.4
-    bar.WindowLocation = "Any Location"
-    bar.Position = [0.89, 0.08]
-    bar.RangeLabelFormat = "%-#.3g"
-
+def add_overlays(args, view, time, bar_position):
+    """Shows the --overlay series at the same time."""
     for spec in args.overlay:
         path, _, field = spec.partition(":")
         if not os.path.exists(path):
@@ -200,26 +146,38 @@ def main(argv):
             shown.ScaleFactor = args.overlay_points
             shown.GlyphMode = "All Points"
         od = Show(shown, view)
-        od.Representation = "Surface With Edges"
+        od.Representation = "Surface" if args.overlay_points > 0 else "Surface With Edges"
         od.LineWidth = args.overlay_width
         od.EdgeColor = args.overlay_color
         if field:
-            o_assoc, _ = association_of(overlay, field)
-            ColorBy(od, (o_assoc, field))
+            o_assoc, o_components = association_of(overlay, field)
+            if o_components == 1:
+                ColorBy(od, (o_assoc, field))
+            else:
+                ColorBy(od, (o_assoc, field, "Magnitude"))
             o_lut = GetColorTransferFunction(field)
             o_lut.ApplyPreset("Inferno (matplotlib)", True)
+            o_low, o_high = data_range(overlay, o_assoc, field, 0 if o_components == 1 else -1,
+                                       time)
+            o_lut.RescaleTransferFunction(o_low, max(o_high, o_low + 1e-12))
             od.SetScalarBarVisibility(view, True)
             o_bar = GetScalarBar(o_lut, view)
-            o_bar.Title = field
+            o_bar.Title = args.overlay_title or field
             o_bar.ComponentTitle = ""
             o_bar.TitleColor = o_bar.LabelColor = [0.1, 0.1, 0.1]
             o_bar.WindowLocation = "Any Location"
-            o_bar.Position = [0.02, 0.08]
+            o_bar.Position = bar_position
             o_bar.ScalarBarLength = 0.3
+            o_bar.TitleFontSize = 16
+            o_bar.LabelFontSize = 14
+            o_bar.RangeLabelFormat = "%-#.3g"
         else:
             od.ColorArrayName = ["POINTS", ""]  # one solid colour
             od.AmbientColor = od.DiffuseColor = args.overlay_color
 
+
+def finish(args, reader, view, time, what):
+    """Title, camera, picture."""
     run = os.path.basename(os.path.dirname(os.path.abspath(args.input)))
     title = args.title if args.title is not None else run
     if time is not None:
@@ -254,8 +212,75 @@ def main(argv):
     Render(view)
     os.makedirs(os.path.dirname(os.path.abspath(args.png)), exist_ok=True)
     SaveScreenshot(args.png, view, ImageResolution=args.size, TransparentBackground=0)
-    print(f"{args.png}: {args.input} at t = {time}, {args.field} "
-          f"{'' if component is None else component} in [{low:.4g}, {high:.4g}]")
+    print(f"{args.png}: {args.input} at t = {time}, {what}")
+
+
+def main(argv):
+    args = parse_args(argv)
+    view = GetActiveViewOrCreate("RenderView")
+    view.ViewSize = args.size
+    view.OrientationAxesVisibility = 1
+    view.Background = [1.0, 1.0, 1.0]
+    try:  # ParaView >= 5.10 uses the palette unless told to use the view's own background
+        view.UseColorPaletteForBackground = 0
+    except AttributeError:
+        pass
+
+    reader = open_series(args.input)
+    time = frame_time(reader, args)
+    if time is not None:
+        # The animation time, not only the view's: the camera fit uses the bounds at that time.
+        scene = GetAnimationScene()
+        scene.UpdateAnimationUsingDataTimeSteps()
+        scene.AnimationTime = time
+        view.ViewTime = time
+    UpdatePipeline(time=time, proxy=reader)
+    display = Show(reader, view)
+    display.Representation = "Surface With Edges" if args.edges else "Surface"
+    display.EdgeColor = [0.25, 0.25, 0.25]
+    display.Opacity = args.opacity
+    if args.field == "none":  # one solid colour; an overlay carries the field
+        display.ColorArrayName = ["POINTS", ""]
+        display.AmbientColor = display.DiffuseColor = [0.82, 0.80, 0.76]
+        add_overlays(args, view, time, bar_position=[0.89, 0.08])
+        finish(args, reader, view, time, "solid")
+        return
+    assoc, n_components = association_of(reader, args.field)
+    component, index = component_spec(args.component, n_components)
+    if component is None:
+        ColorBy(display, (assoc, args.field))
+    else:
+        ColorBy(display, (assoc, args.field, component))
+    lut = GetColorTransferFunction(args.field)
+    lut.ApplyPreset(args.colormap, True)
+    low, high = args.range if args.range else data_range(reader, assoc, args.field, index, time)
+    if high <= low:  # a uniform field: widen so the bar is readable
+        high = low + (abs(low) * 1e-3 or 1e-12)
+    if args.log_scale:
+        low = max(low, high * 1e-4)
+        lut.UseLogScale = 1
+    lut.RescaleTransferFunction(low, high)
+    GetOpacityTransferFunction(args.field).RescaleTransferFunction(low, high)
+    try:
+        lut.AutomaticRescaleRangeMode = "Never"
+    except AttributeError:
+        pass
+    display.SetScalarBarVisibility(view, True)
+    bar = GetScalarBar(lut, view)
+    bar.Title = args.field_title or (args.field if component is None
+                                     else f"{args.field} ({component.lower()})")
+    bar.ComponentTitle = ""
+    bar.TitleColor = bar.LabelColor = [0.1, 0.1, 0.1]
+    bar.TitleFontSize = 18
+    bar.LabelFontSize = 15
+    bar.ScalarBarLength = 0.4
+    bar.WindowLocation = "Any Location"
+    bar.Position = [0.89, 0.08]
+    bar.RangeLabelFormat = "%-#.3g"
+
+    add_overlays(args, view, time, bar_position=[0.78, 0.08])
+    finish(args, reader, view, time, f"{args.field} {'' if component is None else component} "
+           f"in [{low:.4g}, {high:.4g}]")
 
 
 if __name__ == "__main__":
