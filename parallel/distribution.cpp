@@ -85,6 +85,49 @@ void tet_box(const Model& model, LocalIndex t, double box[6]) {
   }
 }
 
+// Reach of each tet (m): the largest extent among the tets that share a node with it or are
+// bonded to it by a joint, itself included.  An active tet of a rank (one touching a node the
+// rank owns) lies within the reach of a tet the rank owns, so a contact partner of it lies within
+// reach + 2 × buffer of that tet — that is how far a rank's holding must extend around each tet it
+// owns.  Needs every such neighbour to be held, which the owner of a tet always does.
+std::vector<double> tet_reach(const Model& model, const std::vector<double>& tet_boxes) {
+  const TetArrays& tets = model.tets;
+  std::vector<double> extent(static_cast<std::size_t>(tets.size()));
+  std::vector<double> node_extent(static_cast<std::size_t>(model.nodes.size()), 0.0);
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    const double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
+    extent[t] = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    for (int c = 0; c < 4; ++c) {
+      double& e = node_extent[tets.nodes[4 * static_cast<std::size_t>(t) + c]];
+      e = std::max(e, extent[t]);
+    }
+  }
+  std::vector<double> reach(extent);
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    for (int c = 0; c < 4; ++c)
+      reach[t] = std::max(reach[t], node_extent[tets.nodes[4 * static_cast<std::size_t>(t) + c]]);
+  for (LocalIndex j = 0; j < model.joints.size(); ++j) {
+    const LocalIndex a = model.joints.tets[2 * j], b = model.joints.tets[2 * j + 1];
+    reach[a] = std::max(reach[a], extent[b]);
+    reach[b] = std::max(reach[b], extent[a]);
+  }
+  return reach;
+}
+
+// Largest gap (m) across an intact joint: how far apart bonded tets can be.
+double largest_joint_gap(const Model& model) {
+  const JointArrays& joints = model.joints;
+  double gap = 0.0;
+  for (LocalIndex j = 0; j < joints.size(); ++j) {
+    if (joints.broken[j]) continue;
+    for (int i = 0; i < 3; ++i)
+      gap = std::max(gap, (vec3_at(model.nodes.x.data(), joints.nodes[6 * j + 3 + i]) -
+                           vec3_at(model.nodes.x.data(), joints.nodes[6 * j + i]))
+                              .norm());
+  }
+  return gap;
+}
+
 // Packs the rows that travel with a set of tets: the tets, their nodes (once per block), the
 // joints whose first tet they are, and their friction pairs (pairs keyed by their first tet).
 class RowPacker {
@@ -193,11 +236,14 @@ class RowPacker {
   std::vector<LocalIndex> joint_list_;
 };
 
-// Which ranks own tets near a point: a grid of cubes of side `margin`, each listing the ranks whose
-// owned tets' boxes touch it.  A tet goes to every rank listed in the cells its box grown by the
-// margin touches — a superset of "within the margin of a tet that rank owns", which is what a rank
-// must hold, and much tighter than one box per rank when parts are not boxes (METIS, separate
-// blocks).  Keys are hashed cell coordinates: a collision only adds a destination.
+// Which ranks own tets near a point: a grid of cubes (side 2 × the mean tet extent + the growth
+// below), each listing the ranks whose owned tets' boxes grown by their reach touch it.  A tet goes
+// to every rank listed in the cells its box grown by 2.5 × buffer (+ the largest joint gap)
+// touches: a superset of "within reach + 2 × buffer of a tet that rank owns" (a pair detected
+// before the next redistribution is within one buffer then, and each tet moves at most buffer/2
+// until then), which is what a rank must hold, and much tighter than one box per rank when parts
+// are not boxes (METIS, separate blocks) or than one margin for all when a few elements are large
+// (a coarse base).  Keys are hashed cell coordinates: a collision only adds a destination.
 class OwnerGrid {
  public:
   OwnerGrid(const double origin[3], double cell) : cell_(cell) { std::copy_n(origin, 3, origin_); }
@@ -280,31 +326,31 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     std::memcpy(part_.data(), encoded.data(), part_.size() * sizeof(std::int32_t));
   }
 
-  // This rank's tets: its own and every tet within the margin of a tet it owns.
+  // This rank's tets: its own, and every tet whose box grown by 2.5 × buffer (+ the largest joint
+  // gap) meets the box of a tet it owns grown by that tet's reach.
   std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
-  double extent = 0.0, origin[3] = {std::numeric_limits<double>::infinity(),
-                                    std::numeric_limits<double>::infinity(),
-                                    std::numeric_limits<double>::infinity()};
+  double extent_sum = 0.0, origin[3] = {std::numeric_limits<double>::infinity(),
+                                        std::numeric_limits<double>::infinity(),
+                                        std::numeric_limits<double>::infinity()};
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
     tet_box(global, t, b);
-    for (int k = 0; k < 3; ++k) {
-      extent = std::max(extent, b[3 + k] - b[k]);
-      origin[k] = std::min(origin[k], b[k]);
-    }
+    extent_sum += std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    for (int k = 0; k < 3; ++k) origin[k] = std::min(origin[k], b[k]);
   }
-  const double margin = 2.0 * extent + 2.0 * buffer_;
-  OwnerGrid grid(origin, margin);
+  const std::vector<double> reach = tet_reach(global, tet_boxes);
+  const double grow = 2.5 * buffer_ + largest_joint_gap(global);
+  OwnerGrid grid(origin, 2.0 * extent_sum / std::max<LocalIndex>(tets.size(), 1) + grow);
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     const std::int32_t p = part_[static_cast<std::size_t>(tets.gid[t])];
-    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], 0.0,
+    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], reach[t],
                [&](std::uint64_t key) { grid.add(key, p); });
   }
   std::vector<LocalIndex> selected;
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     bool mine = part_[static_cast<std::size_t>(tets.gid[t])] == me;
     if (!mine)
-      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], margin, [&](std::uint64_t key) {
+      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], grow, [&](std::uint64_t key) {
         const std::vector<std::int32_t>* owners = grid.owners(key);
         if (owners && std::find(owners->begin(), owners->end(), me) != owners->end()) mine = true;
       });
@@ -518,9 +564,9 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     report_.migrated_tets += migrated;
   }
 
-  // The cells each rank's new owned tets touch (an allgather of cell keys), and the margin.
+  // The cells each rank's new owned tets reach (an allgather of cell keys), as at the start.
   std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
-  double extent = 0.0;
+  std::vector<double> sums = {0.0, 0.0};  // Σ extent, count of owned tets
   std::vector<double> origin = {std::numeric_limits<double>::infinity(),
                                 std::numeric_limits<double>::infinity(),
                                 std::numeric_limits<double>::infinity()};
@@ -528,21 +574,22 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
     tet_box(model, t, b);
     if (!tets.is_owned(t)) continue;
-    for (int k = 0; k < 3; ++k) {
-      extent = std::max(extent, b[3 + k] - b[k]);
-      origin[k] = std::min(origin[k], b[k]);
-    }
+    sums[0] += std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    sums[1] += 1.0;
+    for (int k = 0; k < 3; ++k) origin[k] = std::min(origin[k], b[k]);
   }
   comm_.min_in_place(origin);
-  const double margin = 2.0 * comm_.max(extent) + 2.0 * buffer_;
-  OwnerGrid grid(origin.data(), margin);
+  comm_.sum_in_place(sums);
+  const std::vector<double> reach = tet_reach(model, tet_boxes);
+  const double grow = 2.5 * buffer_ + comm_.max(largest_joint_gap(model));
+  OwnerGrid grid(origin.data(), 2.0 * sums[0] / std::max(sums[1], 1.0) + grow);
   std::vector<CellOwner> mine;
   {
     std::unordered_map<std::uint64_t, std::vector<std::int32_t>> seen;
     for (LocalIndex t = 0; t < tets.size(); ++t) {
       if (!tets.is_owned(t)) continue;
       const std::int32_t p = owner_of_tet(tets.gid[t]);
-      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], 0.0, [&](std::uint64_t key) {
+      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], reach[t], [&](std::uint64_t key) {
         std::vector<std::int32_t>& owners_here = seen[key];
         if (std::find(owners_here.begin(), owners_here.end(), p) == owners_here.end()) {
           owners_here.push_back(p);
@@ -560,7 +607,7 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     const int owner = owner_of_tet(tets.gid[t]);
     lists[owner].push_back(t);
     sent_to[owner] = t;
-    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], margin, [&](std::uint64_t key) {
+    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], grow, [&](std::uint64_t key) {
       if (const std::vector<std::int32_t>* owners = grid.owners(key))
         for (const std::int32_t p : *owners)
           if (sent_to[p] != t) {
