@@ -177,7 +177,7 @@ for run in "${dirs[@]}"; do
     arch-acceleration)
       # shellcheck disable=SC2046
       render "$run" "$example" "$png" $(time_args "$(time_of faster "$run" arch 0.5 0.3)") \
-        --field velocity --field-title "speed (m/s)" --edges --view 0 1 0 --zoom 1.35 || status=1 ;;
+        --field velocity --field-title "speed (m/s)" --edges --view 0 1 0 --zoom 1.25 || status=1 ;;
     dry-stone-wall-seismic)
       # shellcheck disable=SC2046
       render "$run" "$example" "$png" \
