@@ -169,7 +169,7 @@ for run in "${dirs[@]}"; do
       # shellcheck disable=SC2046
       render "$run" "$example" "$png" $(time_args "$(time_of lowest "$run" beam)") \
         --field von_mises --field-title "von Mises stress (Pa)" --view 0.35 1 -0.25 \
-        --zoom 1.1 || status=1 ;;
+        --zoom 0.85 || status=1 ;;
     brazilian-disc)
       render "$run" "$example" "$png" --index -1 --field damage --range 0 1 \
         --field-title "joint damage" --opacity 0.45 --overlay "$run/cracks.pvd" \

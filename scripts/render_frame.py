@@ -189,17 +189,27 @@ def finish(args, reader, view, time, what):
     ld.Color = [0.1, 0.1, 0.1]
 
     # Camera: along --view, fitted to the scene, then zoomed and panned.
+    # Fitted by hand to the mesh as it is at the shown time (ParaView's ResetCamera may use the
+    # bounds of another frame): the bounding sphere fills the smaller of the two view angles.
     norm = math.sqrt(sum(c * c for c in args.view)) or 1.0
     direction = [c / norm for c in args.view]
-    view.CameraFocalPoint = [0.0, 0.0, 0.0]
-    view.CameraPosition = [-c for c in direction]
-    view.CameraViewUp = args.up
-    view.CameraParallelProjection = 1 if args.parallel else 0
-    # Fit to the mesh as it is at the shown time (ResetCamera alone may use the first frame's).
     reader.UpdatePipeline(time)
     bounds = reader.GetDataInformation().GetBounds()
-    view.ResetCamera(*bounds)
-    Render(view)  # the reset happens here; zoom and pan after it
+    centre = [(bounds[2 * i] + bounds[2 * i + 1]) / 2 for i in range(3)]
+    radius = 0.5 * math.sqrt(sum((bounds[2 * i + 1] - bounds[2 * i]) ** 2 for i in range(3)))
+    radius = radius or 1.0
+    view_angle = 30.0  # degrees, vertical (ParaView's default)
+    aspect = args.size[0] / args.size[1]
+    half = math.radians(view_angle / 2)
+    half = min(half, math.atan(math.tan(half) * aspect))
+    distance = radius / math.sin(half)
+    view.CameraViewAngle = view_angle
+    view.CameraFocalPoint = centre
+    view.CameraPosition = [c - distance * d for c, d in zip(centre, direction)]
+    view.CameraViewUp = args.up
+    view.CameraParallelProjection = 1 if args.parallel else 0
+    view.CameraParallelScale = radius
+    Render(view)
     camera = view.GetActiveCamera()
     if args.focus:
         shift = [f - c for f, c in zip(args.focus, camera.GetFocalPoint())]
