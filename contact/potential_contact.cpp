@@ -307,7 +307,7 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   // ratios are noise (seen: weights ~3e14, a "centroid" 5e13 m away); clamping keeps the
   // velocity interpolation and the force spreading of friction and dashpot bounded.  Exact
   // overlaps are unchanged.
-  const auto clamp_weights = [](const double (&raw)[4], double (&out)[4]) {
+  const auto clamp_weights = [](const double(&raw)[4], double(&out)[4]) {
     double sum = 0.0;
     for (int a = 0; a < 4; ++a) sum += (out[a] = std::max(raw[a], 0.0));
     for (int a = 0; a < 4; ++a) out[a] = sum > 0.0 ? out[a] / sum : 0.25;
