@@ -95,19 +95,8 @@ if [[ -z "$fdem" ]]; then
 fi
 [[ -x "$fdem" ]] || { echo "bench-scaling.sh: no fdem binary at $fdem" >&2; exit 2; }
 
-export OMPI_ALLOW_RUN_AS_ROOT="${OMPI_ALLOW_RUN_AS_ROOT:-1}"
-export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="${OMPI_ALLOW_RUN_AS_ROOT_CONFIRM:-1}"
-cores="$(nproc 2>/dev/null || echo 1)"
-launch() {  # launch N -> the launcher words for N ranks
-  local n="$1"
-  if [[ -z "$launcher" ]]; then
-    if ((n > cores)); then echo "mpiexec --oversubscribe -n $n"; else echo "mpiexec -n $n"; fi
-  elif [[ "$launcher" == *"{n}"* ]]; then
-    echo "${launcher//\{n\}/$n}"
-  else
-    echo "$launcher -n $n"
-  fi
-}
+# shellcheck source=lib-mpi.sh
+source "$root/scripts/lib-mpi.sh"
 
 mkdir -p "$out/scenes" "$out/runs"
 out="$(cd "$out" && pwd)"
