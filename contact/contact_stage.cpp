@@ -296,7 +296,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   out.candidate_pairs = static_cast<LocalIndex>(pairs_.size());  // held here, not unique
   out.friction_dissipated = released_spring_energy_;
   released_spring_energy_ = 0.0;
-  for (const CandidatePair& pair : pairs_) {
+  overlapping_.assign(pairs_.size(), 0);
+  for (std::size_t index = 0; index < pairs_.size(); ++index) {
+    const CandidatePair& pair = pairs_[index];
     TetCorners a, b;
     for (int c = 0; c < 4; ++c) {
       a.x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * pair.a + c]);
@@ -320,6 +322,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       }
       continue;
     }
+    overlapping_[index] = 1;
     out.active_pairs += share > 0.0 ? 1 : 0;
     out.energy += share * r.energy;
     for (int c = 0; c < 4; ++c) {
@@ -327,6 +330,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += r.force_target[c];
     }
     Vec3 va[4], vb[4];
+    for (int c = 0; c < 4; ++c) va[c] = vb[c] = Vec3::Zero();
     const double xi = std::max(damping_ratio_[ma], damping_ratio_[mb]);
     if (mu > 0.0 || xi > 0.0)
       for (int c = 0; c < 4; ++c) {

@@ -92,6 +92,9 @@ class ContactStage {
   double buffer() const { return buffer_; }
   long detections() const { return detections_; }
   const std::vector<CandidatePair>& candidates() const { return pairs_; }
+  // Per candidate pair: whether it overlapped at the last add_forces (it then costs the full
+  // overlap integration, ~60× a tet's internal force; a separated pair is rejected early).
+  const std::vector<std::uint8_t>& overlapping() const { return overlapping_; }
   const std::vector<ContactRecord>& records() const { return records_; }
 
  private:
@@ -104,6 +107,7 @@ class ContactStage {
   NbsDetector detector_;
   std::vector<double> lo_, hi_, x_at_detection_;
   std::vector<CandidatePair> pairs_;
+  std::vector<std::uint8_t> overlapping_;
   std::vector<ContactRecord> records_;
   // Friction history per pair, keyed by the two tets' global ids; kept across re-detection.
   struct PairFriction {

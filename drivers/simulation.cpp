@@ -323,18 +323,26 @@ void Simulation::rebind_stages(TravellingState& state, bool detected) {
 
 void Simulation::redistribute() {
   TravellingState state;
-  std::vector<std::int32_t> pairs_per_tet;
+  std::vector<double> contact_cost;  // per local tet, in units of one tet's internal force
   if (contact_) {
     state.x_at_detection = contact_->x_at_detection();
     state.tet_joint_state = contact_->tet_joint_states();
     state.friction = contact_->friction_entries();
-    pairs_per_tet.assign(static_cast<std::size_t>(model_.tets.size()), 0);
-    for (const CandidatePair& p : contact_->candidates()) ++pairs_per_tet[p.a];
+    // Relative costs from bench_contact_pair and bench_internal_forces (docs/benchmarks.md): a
+    // tet's internal force ~36 ns, a separated candidate pair rejected in ~85 ns (≈ 3 tets), an
+    // overlapping pair 1.5–2.6 µs (≈ 60 tets).
+    constexpr double candidate_cost = 3.0, overlap_cost = 60.0;
+    contact_cost.assign(static_cast<std::size_t>(model_.tets.size()), 0.0);
+    const std::vector<CandidatePair>& pairs = contact_->candidates();
+    const std::vector<std::uint8_t>& overlapping = contact_->overlapping();
+    for (std::size_t i = 0; i < pairs.size(); ++i)
+      contact_cost[pairs[i].a] +=
+          candidate_cost + (i < overlapping.size() && overlapping[i] ? overlap_cost : 0.0);
   } else {
     state.x_at_detection = model_.nodes.x;
   }
   if (joints_) state.joint_history = joints_->history();
-  distribution_->redistribute(model_, state, pairs_per_tet);
+  distribution_->redistribute(model_, state, contact_cost);
   rebind_stages(state, contact_ && contact_->detected());
   redistribute_pending_ = false;
 }

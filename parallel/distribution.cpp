@@ -507,7 +507,7 @@ void Distribution::assemble(const std::vector<char>& rows, Model& model,
 }
 
 void Distribution::redistribute(Model& model, TravellingState& state,
-                                const std::vector<std::int32_t>& pairs_per_tet) {
+                                const std::vector<double>& contact_cost) {
   const auto start = std::chrono::steady_clock::now();
   const int ranks = comm_.size();
   const TetArrays& tets = model.tets;
@@ -515,8 +515,7 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   // Owned cost: tets, their intact joints (half each side), contact pairs on their first tet.
   std::vector<double> cost(static_cast<std::size_t>(tets.size()), 0.0);
   for (LocalIndex t = 0; t < tets.size(); ++t)
-    if (tets.is_owned(t))
-      cost[t] = 1.0 + (pairs_per_tet.empty() ? 0.0 : settings_.pair_cost * pairs_per_tet[t]);
+    if (tets.is_owned(t)) cost[t] = 1.0 + (contact_cost.empty() ? 0.0 : contact_cost[t]);
   for (LocalIndex j = 0; j < model.joints.size(); ++j)
     if (!model.joints.broken[j])
       for (int side = 0; side < 2; ++side) {

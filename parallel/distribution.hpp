@@ -36,7 +36,6 @@ struct TravellingState {
 
 struct DistributionSettings {
   double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this
-  double pair_cost = 10.0;            // cost of a contact candidate pair (a tet costs 1)
   double joint_cost = 1.0;            // cost of an intact joint
 };
 
@@ -68,11 +67,11 @@ class Distribution {
                const std::vector<std::pair<LocalIndex, LocalIndex>>& neighbours, Model& local,
                TravellingState& local_state);
 
-  // Collective, at a contact-detection cycle: measures the owned cost (`pairs_per_tet`: contact
-  // candidate pairs per local tet, counted on the pair's first tet), re-partitions when the
+  // Collective, at a contact-detection cycle: measures the owned cost (a tet costs 1; plus
+  // `contact_cost`: the cost of the contact pairs whose first tet it is, in the same unit, or
+  // empty), re-partitions when the
   // imbalance exceeds the threshold, migrates, and rebuilds the halo and the ghost exchange.
-  void redistribute(Model& model, TravellingState& state,
-                    const std::vector<std::int32_t>& pairs_per_tet);
+  void redistribute(Model& model, TravellingState& state, const std::vector<double>& contact_cost);
 
   // Split-phase ghost exchange of positions and velocities: start() after integration posts the
   // sends and receives, finish() completes them and writes the ghost entries.

@@ -183,17 +183,32 @@ void bisect(const RcbInput& in, std::vector<std::int64_t>& order, std::size_t be
     for (std::size_t i = begin; i < end; ++i) parts[order[i]] = first_part;
     return;
   }
-  // Longest extent of the centroids' box (min/max: order-free); ties → lowest axis.
+  // Cut across the axis along which the weight is most spread out (largest weighted variance of
+  // the centroids): a light, wide base under a heavy, tall stack is cut across the stack, not
+  // along the base.  The range is in a canonical order (gid at the top, (coordinate, gid) below),
+  // so the sums, and the axis, are the same whatever order the elements came in.  Without weight:
+  // the longest extent.  Ties → lowest axis.
+  double sum_w = 0.0, sum_wx[3] = {0.0, 0.0, 0.0}, sum_wxx[3] = {0.0, 0.0, 0.0};
   double lo[3], hi[3];
   for (int a = 0; a < 3; ++a) lo[a] = hi[a] = in.centroids[3 * order[begin] + a];
-  for (std::size_t i = begin; i < end; ++i)
+  for (std::size_t i = begin; i < end; ++i) {
+    const double w = in.weights[order[i]];
+    sum_w += w;
     for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], in.centroids[3 * order[i] + a]);
-      hi[a] = std::max(hi[a], in.centroids[3 * order[i] + a]);
+      const double x = in.centroids[3 * order[i] + a];
+      sum_wx[a] += w * x;
+      sum_wxx[a] += w * x * x;
+      lo[a] = std::min(lo[a], x);
+      hi[a] = std::max(hi[a], x);
     }
+  }
+  double spread[3];
+  for (int a = 0; a < 3; ++a)
+    spread[a] = sum_w > 0.0 ? sum_wxx[a] / sum_w - (sum_wx[a] / sum_w) * (sum_wx[a] / sum_w)
+                            : hi[a] - lo[a];
   int axis = 0;
   for (int a = 1; a < 3; ++a)
-    if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    if (spread[a] > spread[axis]) axis = a;
   // (coordinate, gid) is a total order, so the sorted range is canonical and so are the sums.
   std::sort(order.begin() + static_cast<std::ptrdiff_t>(begin),
             order.begin() + static_cast<std::ptrdiff_t>(end), [&](std::int64_t p, std::int64_t q) {
@@ -234,6 +249,8 @@ std::vector<std::int32_t> partition_rcb(const std::vector<double>& centroids,
   std::vector<std::int32_t> parts(n, 0);
   std::vector<std::int64_t> order(n);
   std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::int64_t p, std::int64_t q) { return gids[p] < gids[q]; });
   bisect(RcbInput{centroids.data(), weights.data(), gids.data()}, order, 0, n, 0, n_parts, parts);
   return parts;
 }

@@ -66,8 +66,9 @@ std::vector<std::int32_t> partition_metis(const ElementGraph& graph, int n_parts
 
 // Weighted recursive coordinate bisection: `centroids` 3 per element, `weights` ≥ 0 and `gids`
 // one per element, any n_parts ≥ 1.  Each cut splits the weight of a box in the ratio of the parts
-// on either side (⌊k/2⌋ : ⌈k/2⌉), across the box's longest extent; elements are ordered by
-// (coordinate, gid), so the result for each gid is the same whatever order the elements come in.
+// on either side (⌊k/2⌋ : ⌈k/2⌉), across the axis of largest weighted variance of the centroids
+// (longest extent without weight); elements are ordered by gid, then by (coordinate, gid), so the
+// result for each gid is the same whatever order the elements come in.
 // Returns the part per element (input order).
 std::vector<std::int32_t> partition_rcb(const std::vector<double>& centroids,
                                         const std::vector<double>& weights,

@@ -349,3 +349,33 @@ TEST_CASE("halo of METIS parts: face graph against node graph, joints in the hal
   // split nodes: a tet's nodes are its own, so no tet is in the other part's halo
   CHECK(h.halo_tets[0] + h.halo_tets[1] == 0);
 }
+
+TEST_CASE("RCB cuts across the axis where the weight spreads most, not the longest extent",
+          "[parallel]") {
+  // A light base 3 m wide (x) under a heavy stack 2 m tall (z): the box is longest in x, but the
+  // weight spreads along z, so the cut must separate the lower stack from the upper stack.
+  std::vector<double> centroids, weights;
+  std::vector<fdem::GlobalId> gids;
+  for (int i = 0; i < 100; ++i) {  // base
+    centroids.insert(centroids.end(), {-1.5 + 3.0 * (i + 0.5) / 100.0, 0.0, 0.0});
+    weights.push_back(1.0);
+    gids.push_back(i);
+  }
+  for (int i = 0; i < 100; ++i) {  // stack
+    centroids.insert(centroids.end(), {(i % 2 ? 0.1 : -0.1), 0.0, 0.1 + 1.9 * (i + 0.5) / 100.0});
+    weights.push_back(50.0);
+    gids.push_back(100 + i);
+  }
+  const std::vector<std::int32_t> parts = fdem::partition_rcb(centroids, weights, gids, 2);
+  double highest_low = -1e9, lowest_high = 1e9;
+  for (int i = 100; i < 200; ++i) {
+    const double z = centroids[3 * i + 2];
+    const int low_part = parts[100];  // the bottom of the stack
+    if (parts[i] == low_part)
+      highest_low = std::max(highest_low, z);
+    else
+      lowest_high = std::min(lowest_high, z);
+  }
+  CHECK(highest_low < lowest_high);  // a horizontal cut through the stack
+  CHECK(fdem::imbalance(weights, parts, 2) < 1.05);
+}
