@@ -664,6 +664,7 @@ RunReport Simulation::report() const {
     comm_->sum_in_place(counts);
     r.ranks = comm_->size();
     r.state_hash = hash_to_hex(global_state_hash(model_.nodes, *comm_));
+    r.fragments = global_fragment_count(model_, *comm_);
     const DistributionReport& d = distribution_->report();
     r.parallel = true;
     r.imbalance = d.imbalance;

@@ -63,7 +63,7 @@ struct RunReport {
   int ranks = 1;
   long nodes = 0, elements = 0, pieces = 0, joints = 0, broken_joints = 0;
   long broken_by_mode[3] = {0, 0, 0};  // tension, shear, mixed
-  long fragments = -1;                 // discrete elements now (−1: not counted on N ranks)
+  long fragments = -1;                 // discrete elements now (−1: not counted)
   // Decomposition (N ranks): imbalance = max/mean owned cost, halo and migration sizes.
   bool parallel = false;
   double imbalance = 1.0, max_imbalance = 1.0;

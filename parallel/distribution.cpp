@@ -784,4 +784,52 @@ std::uint64_t global_state_hash(const NodeArrays& nodes, const Communicator& com
   return state_hash(whole);
 }
 
+std::int64_t global_fragment_count(const Model& model, const Communicator& comm) {
+  // Links between node gids: the corners of each owned tet, and across each intact joint owned by
+  // its tet A (a node of A to a node of B).
+  struct Link {
+    GlobalId a, b;
+  };
+  std::vector<Link> links;
+  std::vector<GlobalId> tet_nodes;  // one node gid per owned tet, to count its component
+  const TetArrays& tets = model.tets;
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    if (!tets.is_owned(t)) continue;
+    const GlobalId first = model.nodes.gid[tets.nodes[4 * t]];
+    tet_nodes.push_back(first);
+    for (int c = 1; c < 4; ++c) links.push_back({first, model.nodes.gid[tets.nodes[4 * t + c]]});
+  }
+  const JointArrays& joints = model.joints;
+  std::int64_t joint_count = 0;
+  for (LocalIndex j = 0; j < joints.size(); ++j) {
+    if (!tets.is_owned(joints.tets[2 * j])) continue;
+    ++joint_count;
+    if (!joints.broken[j])
+      links.push_back(
+          {model.nodes.gid[joints.nodes[6 * j]], model.nodes.gid[joints.nodes[6 * j + 3]]});
+  }
+  // Without joints the pieces at t = 0 are the components, as on one rank.
+  if (comm.sum(joint_count) == 0) return static_cast<std::int64_t>(model.pieces.size());
+  const std::vector<Link> all_links = comm.allgatherv(links);
+  const std::vector<GlobalId> all_tet_nodes = comm.allgatherv(tet_nodes);
+  GlobalId largest = -1;
+  for (const Link& l : all_links) largest = std::max({largest, l.a, l.b});
+  for (GlobalId n : all_tet_nodes) largest = std::max(largest, n);
+  std::vector<GlobalId> parent(static_cast<std::size_t>(largest + 1));
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](GlobalId i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const Link& l : all_links) {
+    const GlobalId a = find(l.a), b = find(l.b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+  std::vector<GlobalId> roots;
+  roots.reserve(all_tet_nodes.size());
+  for (GlobalId n : all_tet_nodes) roots.push_back(find(n));
+  std::sort(roots.begin(), roots.end());
+  return static_cast<std::int64_t>(std::unique(roots.begin(), roots.end()) - roots.begin());
+}
+
 }  // namespace fdem

@@ -112,4 +112,8 @@ class Distribution {
 // holding every node computes.
 std::uint64_t global_state_hash(const NodeArrays& nodes, const Communicator& comm);
 
+// Collective: count_fragments (core/model.hpp) of the whole model — connected components of tets
+// linked by a shared node or an intact joint — from each rank's owned tets and joints.
+std::int64_t global_fragment_count(const Model& model, const Communicator& comm);
+
 }  // namespace fdem
