@@ -27,6 +27,7 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   piece_fixed_.resize(model.pieces.size());
   for (std::size_t p = 0; p < model.pieces.size(); ++p)
     piece_fixed_[p] = model.body_fixed[model.pieces[p].body];
+  x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
     compute_boxes(model, model.nodes.x.data());
@@ -285,7 +286,6 @@ void ContactStage::release_bond(LocalIndex a, LocalIndex b) {
       if (bonds_[4 * static_cast<std::size_t>(t) + k] == other)
         bonds_[4 * static_cast<std::size_t>(t) + k] = -1;
   }
-  detected_ = false;
 }
 
 ContactForceSummary ContactStage::add_forces(Model& model, double dt) {

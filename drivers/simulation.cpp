@@ -117,26 +117,17 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   // N ranks: everything above came from the whole model (the same on every rank); now keep this
   // rank's part and halo.
   if (comm_ && comm_->size() > 1) {
-    TravellingState whole, local_state;
-    whole.x_at_detection = contact_ ? contact_->x_at_detection() : model_.nodes.x;
-    if (whole.x_at_detection.empty()) whole.x_at_detection = model_.nodes.x;
-    if (contact_) {
-      whole.tet_joint_state = contact_->tet_joint_states();
-      whole.friction = contact_->friction_entries();
-    }
-    if (joints_) whole.joint_history = joints_->history();
     DistributionSettings settings;
     settings.rebalance_threshold = scene_.parallel.rebalance_threshold;
     // Blocks that touch at the start should share a rank: the first detection, on the whole
     // model, gives the partitioner those pairs (one rank detects at the same positions in step 0).
     std::vector<std::pair<LocalIndex, LocalIndex>> touching;
     if (contact_) {
-      if (!contact_->detected()) {
-        contact_->detect(model_);
-        whole.x_at_detection = contact_->x_at_detection();
-      }
+      if (!contact_->detected()) contact_->detect(model_);
       for (const CandidatePair& p : contact_->candidates()) touching.emplace_back(p.a, p.b);
     }
+    const TravellingState whole = travelling_state();
+    TravellingState local_state;
     Model local;
     distribution_ = std::make_unique<Distribution>(*comm_, settings, model_, whole,
                                                    contact_ ? contact_->buffer() : 0.0, touching,
@@ -175,8 +166,7 @@ void Simulation::write_checkpoint() {
 
   CheckpointRows rows;
   const NodeArrays& nodes = model_.nodes;
-  const std::vector<double>& at_detection =
-      contact_ && !contact_->x_at_detection().empty() ? contact_->x_at_detection() : nodes.x;
+  const std::vector<double>& at_detection = contact_ ? contact_->x_at_detection() : nodes.x;
   for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
     rows.node_gid.push_back(nodes.gid[n]);
     for (int k = 0; k < 3; ++k) {
@@ -321,13 +311,24 @@ void Simulation::rebind_stages(TravellingState& state, bool detected) {
   build_internal_force_split(model_, split_);
 }
 
-void Simulation::redistribute() {
+// The stage state that moves with the local entries when the model is (re)distributed.
+TravellingState Simulation::travelling_state() const {
   TravellingState state;
-  std::vector<double> contact_cost;  // per local tet, in units of one tet's internal force
   if (contact_) {
     state.x_at_detection = contact_->x_at_detection();
     state.tet_joint_state = contact_->tet_joint_states();
     state.friction = contact_->friction_entries();
+  } else {
+    state.x_at_detection = model_.nodes.x;
+  }
+  if (joints_) state.joint_history = joints_->history();
+  return state;
+}
+
+void Simulation::redistribute() {
+  TravellingState state = travelling_state();
+  std::vector<double> contact_cost;  // per local tet, in units of one tet's internal force
+  if (contact_) {
     // Relative costs from bench_contact_pair and bench_internal_forces (docs/benchmarks.md): a
     // tet's internal force ~36 ns, a separated candidate pair rejected in ~85 ns (≈ 3 tets), an
     // overlapping pair 1.5–2.6 µs (≈ 60 tets).
@@ -338,10 +339,7 @@ void Simulation::redistribute() {
     for (std::size_t i = 0; i < pairs.size(); ++i)
       contact_cost[pairs[i].a] +=
           candidate_cost + (i < overlapping.size() && overlapping[i] ? overlap_cost : 0.0);
-  } else {
-    state.x_at_detection = model_.nodes.x;
   }
-  if (joints_) state.joint_history = joints_->history();
   distribution_->redistribute(model_, state, contact_cost);
   rebind_stages(state, contact_ && contact_->detected());
   redistribute_pending_ = false;
@@ -361,7 +359,8 @@ bool Simulation::share_broken_joints(bool detection_due) {
                     model_.tets.gid[model_.joints.tets[2 * b + 1]], model_.joints.failure_time[b],
                     model_.joints.mode[b]});
   // One reduction: joints broken anywhere, and ranks whose nodes call for contact detection.
-  std::vector<std::int64_t> counts = {static_cast<std::int64_t>(mine.size()), detection_due};
+  std::vector<std::int64_t>& counts = reduced_counts_;  // kept: no allocation per step
+  counts.assign({static_cast<std::int64_t>(mine.size()), detection_due});
   comm_->sum_in_place(counts);
   if (counts[0] == 0) return counts[1] > 0;
   const std::vector<Broken> all = comm_->allgatherv(mine);
@@ -493,28 +492,29 @@ void Simulation::step() {
   // The energy terms of every rank (each counts what it owns) in one reduction.
   if (distribution_) {
     const auto start = std::chrono::steady_clock::now();
-    std::vector<double> terms = {forces.strain_energy,
-                                 forces.damping_power,
-                                 j.stored_energy,
-                                 j.fracture_dissipated,
-                                 j.friction_dissipated,
-                                 c.damping_dissipated,
-                                 c.energy,
-                                 c.friction_spring_energy,
-                                 c.friction_work_before,
-                                 c.friction_work_after,
-                                 motion.kinetic_energy,
-                                 motion.kinetic_energy_half_step,
-                                 motion.constraint_work_before,
-                                 motion.constraint_work_after,
-                                 motion.momentum_before.x(),
-                                 motion.momentum_before.y(),
-                                 motion.momentum_before.z(),
-                                 motion.momentum_after.x(),
-                                 motion.momentum_after.y(),
-                                 motion.momentum_after.z(),
-                                 motion.finite ? 0.0 : 1.0,
-                                 forces.min_jacobian > 0.0 ? 0.0 : 1.0};
+    std::vector<double>& terms = reduced_terms_;  // kept: no allocation per step
+    terms.assign({forces.strain_energy,
+                  forces.damping_power,
+                  j.stored_energy,
+                  j.fracture_dissipated,
+                  j.friction_dissipated,
+                  c.damping_dissipated,
+                  c.energy,
+                  c.friction_spring_energy,
+                  c.friction_work_before,
+                  c.friction_work_after,
+                  motion.kinetic_energy,
+                  motion.kinetic_energy_half_step,
+                  motion.constraint_work_before,
+                  motion.constraint_work_after,
+                  motion.momentum_before.x(),
+                  motion.momentum_before.y(),
+                  motion.momentum_before.z(),
+                  motion.momentum_after.x(),
+                  motion.momentum_after.y(),
+                  motion.momentum_after.z(),
+                  motion.finite ? 0.0 : 1.0,
+                  forces.min_jacobian > 0.0 ? 0.0 : 1.0});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :

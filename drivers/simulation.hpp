@@ -116,6 +116,7 @@ class Simulation {
   };
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
   void redistribute();
+  TravellingState travelling_state() const;
   void rebind_stages(TravellingState& state, bool detected);
   bool share_broken_joints(bool detection_due);
   void write_checkpoint();
@@ -148,6 +149,8 @@ class Simulation {
   bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step
   bool halo_in_flight_ = false;                 // ghost exchange posted, not yet completed
   double reduction_seconds_ = 0.0;
+  std::vector<double> reduced_terms_;         // scratch of the per-step energy reduction
+  std::vector<std::int64_t> reduced_counts_;  // scratch of the broken-joint/detection reduction
   InternalForceSplit split_;  // N ranks: interior tets computed while the ghost exchange travels
   double next_checkpoint_time_ = 0.0;
   std::vector<std::string> checkpoints_;  // written so far; the last two are kept

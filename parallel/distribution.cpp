@@ -1,7 +1,6 @@
 #include "parallel/distribution.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -292,7 +291,6 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
                            const std::vector<std::pair<LocalIndex, LocalIndex>>& neighbours,
                            Model& local, TravellingState& local_state)
     : comm_(comm), settings_(settings), buffer_(buffer) {
-  const auto start = std::chrono::steady_clock::now();
   const TetArrays& tets = global.tets;
   const int ranks = comm_.size(), me = comm_.rank();
   // Node → its smallest tet gid: fixed for the whole run (fracture breaks joints, never tets).
@@ -326,39 +324,10 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     std::memcpy(part_.data(), encoded.data(), part_.size() * sizeof(std::int32_t));
   }
 
-  // This rank's tets: its own, and every tet whose box grown by 2.5 × buffer (+ the largest joint
-  // gap) meets the box of a tet it owns grown by that tet's reach.
-  std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
-  double extent_sum = 0.0, origin[3] = {std::numeric_limits<double>::infinity(),
-                                        std::numeric_limits<double>::infinity(),
-                                        std::numeric_limits<double>::infinity()};
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
-    double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
-    tet_box(global, t, b);
-    extent_sum += std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
-    for (int k = 0; k < 3; ++k) origin[k] = std::min(origin[k], b[k]);
-  }
-  const std::vector<double> reach = tet_reach(global, tet_boxes);
-  const double grow = 2.5 * buffer_ + largest_joint_gap(global);
-  OwnerGrid grid(origin, 2.0 * extent_sum / std::max<LocalIndex>(tets.size(), 1) + grow);
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
-    const std::int32_t p = part_[static_cast<std::size_t>(tets.gid[t])];
-    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], reach[t],
-               [&](std::uint64_t key) { grid.add(key, p); });
-  }
-  std::vector<LocalIndex> selected;
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
-    bool mine = part_[static_cast<std::size_t>(tets.gid[t])] == me;
-    if (!mine)
-      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], grow, [&](std::uint64_t key) {
-        const std::vector<std::int32_t>* owners = grid.owners(key);
-        if (owners && std::find(owners->begin(), owners->end(), me) != owners->end()) mine = true;
-      });
-    if (mine) selected.push_back(t);
-  }
+  // This rank's tets: its own and every tet near them (destinations(), all tets known here).
   has_joint_state_ = !global_state.tet_joint_state.empty();
   std::vector<char> rows;
-  RowPacker(global, global_state).pack(selected, rows);
+  RowPacker(global, global_state).pack(destinations(global, true)[me], rows);
   local.materials = global.materials;
   local.pieces = global.pieces;
   local.body_names = global.body_names;
@@ -369,8 +338,6 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   build_exchange(local);
   report_.cycles = 1;
   update_report(local);
-  report_.seconds +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void Distribution::assemble(const std::vector<char>& rows, Model& model,
@@ -506,9 +473,70 @@ void Distribution::assemble(const std::vector<char>& rows, Model& model,
             });
 }
 
+std::vector<std::vector<LocalIndex>> Distribution::destinations(const Model& model,
+                                                                bool whole) const {
+  // Senders: the tets this rank owns, or (at the start, every rank holding the whole model) all.
+  const TetArrays& tets = model.tets;
+  const auto sends = [&](LocalIndex t) { return whole || tets.is_owned(t); };
+  std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
+  std::vector<double> sums = {0.0, 0.0};  // Σ extent, count of sending tets
+  std::vector<double> origin(3, std::numeric_limits<double>::infinity());
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
+    tet_box(model, t, b);
+    if (!sends(t)) continue;
+    sums[0] += std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    sums[1] += 1.0;
+    for (int k = 0; k < 3; ++k) origin[k] = std::min(origin[k], b[k]);
+  }
+  double joint_gap = largest_joint_gap(model);
+  if (!whole) {
+    comm_.min_in_place(origin);
+    comm_.sum_in_place(sums);
+    joint_gap = comm_.max(joint_gap);
+  }
+  const std::vector<double> reach = tet_reach(model, tet_boxes);
+  const double grow = 2.5 * buffer_ + joint_gap;
+  OwnerGrid grid(origin.data(), 2.0 * sums[0] / std::max(sums[1], 1.0) + grow);
+  // Claims: the cells within reach of each tet, for its (new) owner; exchanged unless all known.
+  std::vector<CellOwner> claims;
+  {
+    std::unordered_map<std::uint64_t, std::vector<std::int32_t>> seen;
+    for (LocalIndex t = 0; t < tets.size(); ++t) {
+      if (!sends(t)) continue;
+      const std::int32_t p = owner_of_tet(tets.gid[t]);
+      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], reach[t], [&](std::uint64_t key) {
+        std::vector<std::int32_t>& owners_here = seen[key];
+        if (std::find(owners_here.begin(), owners_here.end(), p) == owners_here.end()) {
+          owners_here.push_back(p);
+          claims.push_back({key, p});
+        }
+      });
+    }
+  }
+  for (const CellOwner& c : whole ? claims : comm_.allgatherv(claims)) grid.add(c.key, c.rank);
+
+  std::vector<std::vector<LocalIndex>> lists(static_cast<std::size_t>(comm_.size()));
+  std::vector<LocalIndex> sent_to(static_cast<std::size_t>(comm_.size()), -1);
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    if (!sends(t)) continue;
+    const int owner = owner_of_tet(tets.gid[t]);
+    lists[owner].push_back(t);
+    sent_to[owner] = t;
+    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], grow, [&](std::uint64_t key) {
+      if (const std::vector<std::int32_t>* owners = grid.owners(key))
+        for (const std::int32_t p : *owners)
+          if (sent_to[p] != t) {
+            sent_to[p] = t;
+            lists[p].push_back(t);
+          }
+    });
+  }
+  return lists;
+}
+
 void Distribution::redistribute(Model& model, TravellingState& state,
                                 const std::vector<double>& contact_cost) {
-  const auto start = std::chrono::steady_clock::now();
   const int ranks = comm_.size();
   const TetArrays& tets = model.tets;
 
@@ -563,58 +591,7 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     report_.migrated_tets += migrated;
   }
 
-  // The cells each rank's new owned tets reach (an allgather of cell keys), as at the start.
-  std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
-  std::vector<double> sums = {0.0, 0.0};  // Σ extent, count of owned tets
-  std::vector<double> origin = {std::numeric_limits<double>::infinity(),
-                                std::numeric_limits<double>::infinity(),
-                                std::numeric_limits<double>::infinity()};
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
-    double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
-    tet_box(model, t, b);
-    if (!tets.is_owned(t)) continue;
-    sums[0] += std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
-    sums[1] += 1.0;
-    for (int k = 0; k < 3; ++k) origin[k] = std::min(origin[k], b[k]);
-  }
-  comm_.min_in_place(origin);
-  comm_.sum_in_place(sums);
-  const std::vector<double> reach = tet_reach(model, tet_boxes);
-  const double grow = 2.5 * buffer_ + comm_.max(largest_joint_gap(model));
-  OwnerGrid grid(origin.data(), 2.0 * sums[0] / std::max(sums[1], 1.0) + grow);
-  std::vector<CellOwner> mine;
-  {
-    std::unordered_map<std::uint64_t, std::vector<std::int32_t>> seen;
-    for (LocalIndex t = 0; t < tets.size(); ++t) {
-      if (!tets.is_owned(t)) continue;
-      const std::int32_t p = owner_of_tet(tets.gid[t]);
-      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], reach[t], [&](std::uint64_t key) {
-        std::vector<std::int32_t>& owners_here = seen[key];
-        if (std::find(owners_here.begin(), owners_here.end(), p) == owners_here.end()) {
-          owners_here.push_back(p);
-          mine.push_back({key, p});
-        }
-      });
-    }
-  }
-  for (const CellOwner& c : comm_.allgatherv(mine)) grid.add(c.key, c.rank);
-
-  std::vector<std::vector<LocalIndex>> lists(static_cast<std::size_t>(ranks));
-  std::vector<int> sent_to(static_cast<std::size_t>(ranks), -1);
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
-    if (!tets.is_owned(t)) continue;
-    const int owner = owner_of_tet(tets.gid[t]);
-    lists[owner].push_back(t);
-    sent_to[owner] = t;
-    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], grow, [&](std::uint64_t key) {
-      if (const std::vector<std::int32_t>* owners = grid.owners(key))
-        for (const std::int32_t p : *owners)
-          if (sent_to[p] != t) {
-            sent_to[p] = t;
-            lists[p].push_back(t);
-          }
-    });
-  }
+  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
   RowPacker packer(model, state);
   std::vector<char> send;
   std::vector<int> send_counts(ranks, 0), send_offsets(ranks, 0);
@@ -644,8 +621,6 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   build_exchange(model);
   ++report_.cycles;
   update_report(model);
-  report_.seconds +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void Distribution::build_exchange(const Model& model) {
@@ -698,7 +673,6 @@ void Distribution::build_exchange(const Model& model) {
 }
 
 void Distribution::start_halo_exchange(const NodeArrays& nodes) {
-  const auto start = std::chrono::steady_clock::now();
   requests_.clear();
   constexpr int tag = 8;  // stage 8 of the step
   for (Neighbour& nb : neighbours_)
@@ -718,11 +692,9 @@ void Distribution::start_halo_exchange(const NodeArrays& nodes) {
       MPI_Isend(nb.send_buffer.data(), static_cast<int>(nb.send_buffer.size()), MPI_DOUBLE, nb.rank,
                 tag, comm_.handle(), &requests_.back());
     }
-  halo_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void Distribution::finish_halo_exchange(NodeArrays& nodes) {
-  const auto start = std::chrono::steady_clock::now();
   if (!requests_.empty())
     MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE);
   requests_.clear();
@@ -733,7 +705,6 @@ void Distribution::finish_halo_exchange(NodeArrays& nodes) {
       for (int k = 0; k < 3; ++k) nodes.v[3 * n + k] = *in++;
     }
   }
-  halo_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void Distribution::update_report(const Model& model) {

@@ -51,7 +51,6 @@ struct DistributionReport {
   long halo_tets_min = 0, halo_tets_max = 0, halo_tets_sum = 0;
   long ghost_nodes_min = 0, ghost_nodes_max = 0, ghost_nodes_sum = 0;
   long neighbours_max = 0;  // ranks a rank exchanges ghosts with
-  double seconds = 0.0;     // wall time spent redistributing (this rank)
 };
 
 class Distribution {
@@ -83,8 +82,6 @@ class Distribution {
     return part_[static_cast<std::size_t>(node_first_tet_[static_cast<std::size_t>(node)])];
   }
   const DistributionReport& report() const { return report_; }
-  const Communicator& comm() const { return comm_; }
-  double halo_seconds() const { return halo_seconds_; }
 
  private:
   struct Neighbour {
@@ -94,6 +91,11 @@ class Distribution {
   };
   void assemble(const std::vector<char>& rows, Model& model, TravellingState& state) const;
   void build_exchange(const Model& model);
+  // Per rank, the local tets to send it: each sending tet to its owner and to every rank that
+  // claimed a cell its box grown by 2.5 buffers (+ the widest joint gap) touches; a rank claims
+  // the cells within reach of each tet it will own.  `whole`: every rank holds the whole model
+  // (the start) and all tets send, without exchanging claims; else the owned tets send.
+  std::vector<std::vector<LocalIndex>> destinations(const Model& model, bool whole) const;
   void update_report(const Model& model);
 
   Communicator comm_;
@@ -104,7 +106,6 @@ class Distribution {
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
   DistributionReport report_;
-  double halo_seconds_ = 0.0;
   bool has_joint_state_ = false;  // the scene has joints: tets carry their joint state
 };
 
