@@ -79,24 +79,10 @@ pick() {  # pick SPEC SCENE DEFAULT
   echo "$value"
 }
 
-# The fdem binary: build it if needed (Release).
-build="${BUILD_DIR:-$root/build}"
-[[ "$build" == /* ]] || build="$PWD/$build"
-if [[ -z "$fdem" ]]; then
-  fdem="$build/drivers/fdem"
-  if [[ ! -x "$fdem" && "$build" == "$root/build" ]]; then
-    "$root/scripts/build.sh"
-  else
-    [[ -f "$build/CMakeCache.txt" ]] || cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-    cmake --build "$build" --target fdem -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
-  fi
-  type="$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$build/CMakeCache.txt" 2>/dev/null || true)"
-  [[ "$type" == Release ]] || echo "bench-scaling.sh: warning: $build is a '$type' build, not Release" >&2
-fi
-[[ -x "$fdem" ]] || { echo "bench-scaling.sh: no fdem binary at $fdem" >&2; exit 2; }
 
-# shellcheck source=lib-mpi.sh
-source "$root/scripts/lib-mpi.sh"
+# shellcheck source=lib-bench.sh
+source "$root/scripts/lib-bench.sh"
+ensure_fdem
 
 mkdir -p "$out/scenes" "$out/runs"
 out="$(cd "$out" && pwd)"

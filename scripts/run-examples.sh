@@ -70,22 +70,10 @@ else
   for name in $all_examples; do [[ -n "$(scene_of "$name")" ]] && examples+=("$name"); done
 fi
 
-# The fdem binary: build it if needed (Release, target fdem only).
-build="${BUILD_DIR:-$root/build}"
-[[ "$build" == /* ]] || build="$PWD/$build"
-if [[ -z "$fdem" ]]; then
-  fdem="$build/drivers/fdem"
-  if [[ ! -x "$fdem" && "$build" == "$root/build" ]]; then
-    "$root/scripts/build.sh"
-  else
-    [[ -f "$build/CMakeCache.txt" ]] || cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-    cmake --build "$build" --target fdem -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
-  fi
-fi
-[[ -x "$fdem" ]] || { echo "run-examples.sh: no fdem binary at $fdem" >&2; exit 2; }
 
-# shellcheck source=lib-mpi.sh
-source "$root/scripts/lib-mpi.sh"
+# shellcheck source=lib-bench.sh
+source "$root/scripts/lib-bench.sh"
+ensure_fdem
 loadavg() { cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo '? ? ?'; }
 
 mkdir -p "$out"
