@@ -30,10 +30,12 @@
 #include "core/model_builder.hpp"
 #include "core/tet_kernels.hpp"
 #include "drivers/mesh_generators.hpp"
+#include "drivers/scene_builders.hpp"
 #include "drivers/simulation.hpp"
 #include "fracture/joint_stage.hpp"
 
 using namespace fdem;
+using namespace fdem::builders;
 
 namespace {
 
@@ -82,19 +84,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 // ------------------------------------------------------------------------------------------------
-// Scene helpers (as tests/verification/scene_helpers.hpp; benchmarks do not include test code)
+// Scene helpers: drivers/scene_builders.hpp (shared with the verification tests), and these
 // ------------------------------------------------------------------------------------------------
-
-MaterialSpec elastic_material(double density, double young, double poisson,
-                              ElasticModel model = ElasticModel::neo_hookean) {
-  MaterialSpec m;
-  m.name = "material";
-  m.density = density;
-  m.elastic.model = model;
-  m.elastic.young = young;
-  m.elastic.poisson = poisson;
-  return m;
-}
 
 void set_penalty(MaterialSpec& m, double penalty_ratio) {
   if (penalty_ratio <= 0) return;  // automatic (10 E)
@@ -102,79 +93,14 @@ void set_penalty(MaterialSpec& m, double penalty_ratio) {
   m.contact.penalty = penalty_ratio * m.elastic.young;
 }
 
-BodySpec box_body(const std::string& name, const Vec3& lo, const Vec3& hi, int nx, int ny, int nz,
-                  int material = 0) {
-  BodySpec b;
-  b.name = name;
-  b.material = material;
-  b.mesh.kind = MeshSpec::Kind::box;
-  b.mesh.box.min = lo;
-  b.mesh.box.max = hi;
-  b.mesh.box.cells[0] = nx;
-  b.mesh.box.cells[1] = ny;
-  b.mesh.box.cells[2] = nz;
-  return b;
-}
-
 Scene basic_scene(double end_time, double dt_fraction) {
-  Scene s;
-  s.name = "verification";
-  s.source_path = "verification";
-  s.time.end = end_time;
+  Scene s = builders::basic_scene(end_time);
   s.time.safety = dt_fraction;
   return s;
 }
 
-RunOptions quiet() {
-  RunOptions options;
-  options.quiet = true;
-  options.write_output = false;
-  return options;
-}
-
-std::unique_ptr<Simulation> quiet_simulation(const Scene& scene) {
-  return make_simulation(scene, quiet());
-}
-
 int cells_for(double length, double h) {
   return std::max(1, int(std::lround(length / h)));
-}
-
-LoadSpec load_on_region(const Vec3& lo, const Vec3& hi, const Vec3& v, unsigned mask = 7) {
-  LoadSpec l;
-  l.region = RegionSpec{lo, hi};
-  l.velocity = v;
-  l.dof_mask = mask;
-  return l;
-}
-
-LoadSpec load_on_body(int body, const Vec3& v, unsigned mask = 7) {
-  LoadSpec l;
-  l.bodies = {body};
-  l.velocity = v;
-  l.dof_mask = mask;
-  return l;
-}
-
-// Σ −f over the prescribed nodes of one body: the force the loading device applies (N).
-Vec3 reaction_on_body(const Model& model, int body) {
-  Vec3 r = Vec3::Zero();
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces[model.nodes.piece[n]].body == body && model.nodes.constrained[n])
-      r -= vec3_at(model.nodes.f.data(), n);
-  return r;
-}
-
-void set_body_velocity(Model& model, int body, const Vec3& v) {
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces[model.nodes.piece[n]].body == body)
-      vec3_at(model.nodes.prescribed_velocity.data(), n) = v;
-}
-
-LocalIndex broken_joints(const Model& model) {
-  LocalIndex n = 0;
-  for (auto b : model.joints.broken) n += b;
-  return n;
 }
 
 // Mean of coordinate k of the nodes of `body` whose reference coordinate k equals `at` (m).
@@ -326,7 +252,7 @@ std::vector<Measure> tet_tet_impact(const Setting& s) {
     std::vector<BodyMesh> meshes = {
         single_tet(Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(0, 2, 0), Vec3(0, 0, 2)),
         single_tet(Vec3(a, a, a), Vec3(a - 2, a, a), Vec3(a, a - 2, a), Vec3(a, a, a - 2))};
-    Simulation sim(scene, build_model(scene, meshes), quiet());
+    Simulation sim(scene, build_model(scene, meshes), quiet_options());
     sim.step();
     const Vec3 p0 = linear_momentum(sim.model().nodes);
     double worst_energy = 0, worst_momentum = 0;

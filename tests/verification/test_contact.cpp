@@ -25,9 +25,7 @@ BodyMesh single_tet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) 
 
 std::unique_ptr<Simulation> simulation_from(const Scene& scene,
                                             const std::vector<BodyMesh>& meshes) {
-  RunOptions options;
-  options.quiet = true;
-  options.write_output = false;
+  const RunOptions options = quiet_options();
   return std::make_unique<Simulation>(scene, build_model(scene, meshes), options);
 }
 

@@ -25,46 +25,6 @@ FractureSpec rock_fracture() {
   return f;
 }
 
-LoadSpec load_on_body(int body, const Vec3& v, unsigned mask = 7) {
-  LoadSpec l;
-  l.bodies = {body};
-  l.velocity = v;
-  l.dof_mask = mask;
-  return l;
-}
-
-LoadSpec load_on_region(const Vec3& lo, const Vec3& hi, const Vec3& v, unsigned mask = 7) {
-  LoadSpec l;
-  l.region = RegionSpec{lo, hi};
-  l.velocity = v;
-  l.dof_mask = mask;
-  return l;
-}
-
-// Σ −f over the prescribed nodes of one body: the force the loading device applies (N).  Valid
-// after step() while the prescribed velocity is constant (reaction = −f).
-Vec3 reaction_on_body(const Model& model, int body) {
-  Vec3 r = Vec3::Zero();
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces[model.nodes.piece[n]].body == body && model.nodes.constrained[n])
-      r -= vec3_at(model.nodes.f.data(), n);
-  return r;
-}
-
-// New prescribed velocity of a body's nodes.  The integrator applies it in the next step and books
-// the kinetic energy change as the reactions' work (that step's reaction holds the impulse).
-void set_body_velocity(Model& model, int body, const Vec3& v) {
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces[model.nodes.piece[n]].body == body)
-      vec3_at(model.nodes.prescribed_velocity.data(), n) = v;
-}
-
-LocalIndex broken_joints(const Model& model) {
-  LocalIndex n = 0;
-  for (auto b : model.joints.broken) n += b;
-  return n;
-}
-
 // Two blocks [0, L]×[0, w]² and [L, 2L]×[0, w]² joined by an interface at x = L.
 Scene two_block_scene(double L, double w, int cells_x, int cells_yz, const FractureSpec& f,
                       double end_time) {

@@ -34,9 +34,7 @@ std::unique_ptr<Simulation> distorted_simulation(unsigned seed, double distortio
       for (int k = 0; k < 3; ++k) mesh.coords[3 * n + k] += distortion * h * u(rng);
   }
   Model model = build_model(scene, {mesh});
-  RunOptions options;
-  options.quiet = true;
-  options.write_output = false;
+  const RunOptions options = quiet_options();
   auto sim = std::make_unique<Simulation>(scene, std::move(model), options);
   // Seed every mode with a small random velocity.
   std::normal_distribution<double> g(0.0, 1e-3);

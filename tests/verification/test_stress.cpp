@@ -179,9 +179,7 @@ TEST_CASE("sliver and near-flat tetrahedra in a mesh: the automatic step keeps t
   // The node moves along x to 0.75 − 2.5e-4: nearly onto the plane x = 0.75 of the next cell's
   // nodes, which flattens the tets it shares with them.
   mesh.coords[3 * centre] = 0.75 - 2.5e-4;
-  RunOptions options;
-  options.quiet = true;
-  options.write_output = false;
+  const RunOptions options = quiet_options();
   Simulation plain(scene, build_model(scene, {box_mesh(scene.bodies[0].mesh.box)}), options);
   Simulation sim(scene, build_model(scene, {mesh}), options);
   std::mt19937 rng(3);
@@ -228,9 +226,7 @@ TEST_CASE("thousands of contacts on one element: a big tet under a layer of smal
       cube.max = cube.min + Vec3(a, a, a);
       append_piece(layer, box_mesh(cube));
     }
-  RunOptions options;
-  options.quiet = true;
-  options.write_output = false;
+  const RunOptions options = quiet_options();
   Simulation sim(scene, build_model(scene, {base, layer}), options);
   REQUIRE(sim.model().pieces.size() == 1 + n * n);
   const auto start = std::chrono::steady_clock::now();

@@ -1,0 +1,102 @@
+// Builders for scenes made in code instead of YAML: materials, box bodies, loads, a quiet
+// simulation, and what verification problems read back (reactions, broken joints).  Used by the
+// verification tests and by the verification benchmark, so both build the same problems.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "core/model_builder.hpp"
+#include "drivers/mesh_generators.hpp"
+#include "drivers/simulation.hpp"
+
+namespace fdem::builders {
+
+inline MaterialSpec elastic_material(double density, double young, double poisson,
+                                     ElasticModel model = ElasticModel::neo_hookean) {
+  MaterialSpec m;
+  m.name = "material";
+  m.density = density;
+  m.elastic.model = model;
+  m.elastic.young = young;
+  m.elastic.poisson = poisson;
+  return m;
+}
+
+inline BodySpec box_body(const std::string& name, const Vec3& lo, const Vec3& hi, int nx, int ny,
+                         int nz, int material = 0) {
+  BodySpec b;
+  b.name = name;
+  b.material = material;
+  b.mesh.kind = MeshSpec::Kind::box;
+  b.mesh.box.min = lo;
+  b.mesh.box.max = hi;
+  b.mesh.box.cells[0] = nx;
+  b.mesh.box.cells[1] = ny;
+  b.mesh.box.cells[2] = nz;
+  return b;
+}
+
+inline Scene basic_scene(double end_time) {
+  Scene s;
+  s.name = "verification";
+  s.source_path = "verification";
+  s.time.end = end_time;
+  return s;
+}
+
+// Run options without progress output or files.
+inline RunOptions quiet_options() {
+  RunOptions options;
+  options.quiet = true;
+  options.write_output = false;
+  return options;
+}
+
+// A simulation without output files.
+inline std::unique_ptr<Simulation> quiet_simulation(const Scene& scene) {
+  return make_simulation(scene, quiet_options());
+}
+
+// Prescribed velocity (components in `mask`) on the nodes of a body or of a region.
+inline LoadSpec load_on_body(int body, const Vec3& v, unsigned mask = 7) {
+  LoadSpec l;
+  l.bodies = {body};
+  l.velocity = v;
+  l.dof_mask = mask;
+  return l;
+}
+
+inline LoadSpec load_on_region(const Vec3& lo, const Vec3& hi, const Vec3& v, unsigned mask = 7) {
+  LoadSpec l;
+  l.region = RegionSpec{lo, hi};
+  l.velocity = v;
+  l.dof_mask = mask;
+  return l;
+}
+
+// Σ −f over the prescribed nodes of one body: the force the loading device applies (N).  Valid
+// after step() while the prescribed velocity is constant (reaction = −f).
+inline Vec3 reaction_on_body(const Model& model, int body) {
+  Vec3 r = Vec3::Zero();
+  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
+    if (model.pieces[model.nodes.piece[n]].body == body && model.nodes.constrained[n])
+      r -= vec3_at(model.nodes.f.data(), n);
+  return r;
+}
+
+// New prescribed velocity of a body's nodes.  The integrator applies it in the next step and books
+// the kinetic energy change as the reactions' work (that step's reaction holds the impulse).
+inline void set_body_velocity(Model& model, int body, const Vec3& v) {
+  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
+    if (model.pieces[model.nodes.piece[n]].body == body)
+      vec3_at(model.nodes.prescribed_velocity.data(), n) = v;
+}
+
+inline LocalIndex broken_joints(const Model& model) {
+  LocalIndex n = 0;
+  for (auto b : model.joints.broken) n += b;
+  return n;
+}
+
+}  // namespace fdem::builders
