@@ -138,6 +138,7 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
   }
   try {
     fdem::Scene scene;
+    fdem::mark_phase(fdem::CommPhase::startup);
     world.run_collectively([&] { scene = fdem::read_scene(scene_path, overrides); });
     if (command == "check") return world.rank() == 0 ? check(scene) : 0;
     if (world.rank() != 0) options.quiet = true;

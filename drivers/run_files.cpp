@@ -193,6 +193,10 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
       << ", \"ghost_nodes_mean\": " << r.ghost_nodes_mean
       << ", \"neighbours_max\": " << r.neighbours_max
       << ", \"communication_seconds\": " << JsonNumber{r.communication_seconds} << "},\n";
+  j << "  \"memory\": {\"startup_peak_rss_kib_max\": " << r.startup_peak_rss_kib_max
+    << ", \"startup_peak_rss_kib_mean\": " << r.startup_peak_rss_kib_mean
+    << ", \"run_peak_rss_kib_max\": " << r.run_peak_rss_kib_max
+    << ", \"run_peak_rss_kib_mean\": " << r.run_peak_rss_kib_mean << "},\n";
   j << "  \"stages\": {";
   bool first = true;
   for (const auto& s : r.stages) {

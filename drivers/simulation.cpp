@@ -17,6 +17,7 @@
 #include "core/time_step.hpp"
 #include "drivers/loads.hpp"
 #include "drivers/mesh_generators.hpp"
+#include "drivers/process_memory.hpp"
 #include "drivers/run_files.hpp"
 #include "fracture/joint_kernels.hpp"
 #include "fracture/joint_stage.hpp"
@@ -113,7 +114,11 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   reference_hash_ = reference_hash(model_.nodes);
   next_checkpoint_time_ = scene_.output.checkpoint_every;
   // A restart overwrites the state of the whole model (and of the stages) with the checkpoint's.
-  if (!options_.restart_path.empty()) restore_checkpoint(options_.restart_path);
+  if (!options_.restart_path.empty()) {
+    mark_phase(CommPhase::restart);
+    restore_checkpoint(options_.restart_path);
+    mark_phase(CommPhase::startup);
+  }
   // N ranks: everything above came from the whole model (the same on every rank); now keep this
   // rank's part and halo.
   if (comm_ && comm_->size() > 1) {
@@ -135,6 +140,10 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
     model_ = std::move(local);
     rebind_stages(local_state, contact_ && contact_->detected());
   }
+  // Start-up is over: note its peak, give freed buffers back, and count the step loop afresh.
+  startup_peak_rss_kib_ = peak_rss_kib();
+  release_free_memory();
+  reset_peak_rss();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -340,9 +349,11 @@ void Simulation::redistribute() {
       contact_cost[pairs[i].a] +=
           candidate_cost + (i < overlapping.size() && overlapping[i] ? overlap_cost : 0.0);
   }
+  mark_phase(CommPhase::redistribution);
   distribution_->redistribute(model_, state, contact_cost);
   rebind_stages(state, contact_ && contact_->detected());
   redistribute_pending_ = false;
+  mark_phase(CommPhase::step);
 }
 
 // Joints break where they are computed; the owner of tet A tells every rank, so that every copy
@@ -660,7 +671,17 @@ RunReport Simulation::report() const {
     const auto mode = static_cast<FailureMode>(joint_rows.mode[i]);
     ++counts[4 + (mode == FailureMode::tension ? 0 : mode == FailureMode::shear ? 1 : 2)];
   }
+  std::vector<std::int64_t> memory = {startup_peak_rss_kib_, peak_rss_kib()};
+  r.startup_peak_rss_kib_max = r.startup_peak_rss_kib_mean = memory[0];
+  r.run_peak_rss_kib_max = r.run_peak_rss_kib_mean = memory[1];
   if (distribution_) {
+    std::vector<std::int64_t> largest = memory;
+    comm_->max_in_place(largest);
+    comm_->sum_in_place(memory);
+    r.startup_peak_rss_kib_max = largest[0];
+    r.run_peak_rss_kib_max = largest[1];
+    r.startup_peak_rss_kib_mean = memory[0] / comm_->size();
+    r.run_peak_rss_kib_mean = memory[1] / comm_->size();
     comm_->sum_in_place(counts);
     r.ranks = comm_->size();
     r.state_hash = hash_to_hex(global_state_hash(model_.nodes, *comm_));
@@ -693,6 +714,7 @@ RunReport Simulation::report() const {
 void Simulation::write_outputs(bool force) {
   if (!files_) return;
   Timed timed(clocks_[output]);
+  mark_phase(CommPhase::output);
   // Energy rows refer to t_n = time_ − dt (the state the ledger recorded).
   const double energy_time = steps_ > 0 ? time_ - dt_ : 0.0;
   const double energy_every =
@@ -724,8 +746,10 @@ void Simulation::write_outputs(bool force) {
   const double every = scene_.output.checkpoint_every;
   if (comm_ && every > 0 && steps_ > 0 && time_ >= next_checkpoint_time_ - 1e-12 * dt_) {
     while (next_checkpoint_time_ <= time_ + 1e-12 * dt_) next_checkpoint_time_ += every;
+    mark_phase(CommPhase::checkpoint);
     write_checkpoint();
   }
+  mark_phase(CommPhase::step);
 }
 
 RunReport Simulation::run() {
@@ -764,10 +788,12 @@ RunReport Simulation::run() {
         if (steps_ == total_steps) std::fprintf(stderr, "\n");
       }
     }
+    mark_phase(CommPhase::finish);
     result = report();
     result.status = "completed";
   } catch (const NumericalFailure& failure) {
     if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+    mark_phase(CommPhase::finish);
     result = report();
     result.status = "failed";
     result.reason = failure.what();

@@ -70,6 +70,10 @@ struct RunReport {
   long redistributions = 0, rebalances = 0, migrated_elements = 0;
   long halo_elements_max = 0, ghost_nodes_max = 0, ghost_nodes_mean = 0, neighbours_max = 0;
   double communication_seconds = 0.0;  // halo exchange + redistribution + reductions (rank 0)
+  // Peak resident set size per rank (KiB, largest and mean over ranks): start-up (scene, model,
+  // distribution) and the step loop after it (counted afresh once start-up memory is freed).
+  long startup_peak_rss_kib_max = 0, startup_peak_rss_kib_mean = 0;
+  long run_peak_rss_kib_max = 0, run_peak_rss_kib_mean = 0;
 };
 
 class Simulation {
@@ -156,6 +160,7 @@ class Simulation {
   std::vector<std::string> checkpoints_;  // written so far; the last two are kept
   long whole_nodes_ = 0, whole_tets_ = 0, whole_joints_ = 0;  // counts of the whole model
   std::uint64_t reference_hash_ = 0;                          // of the whole model's x0
+  long startup_peak_rss_kib_ = 0;                             // this rank, end of start-up
 };
 
 // Builds a Simulation from a scene file (meshes loaded or generated).

@@ -160,4 +160,10 @@ void abort_all_ranks(const std::string& message, int code) {
   std::_Exit(code == 0 ? 1 : code);
 }
 
+void mark_phase(CommPhase phase) {
+  int initialised = 0;
+  MPI_Initialized(&initialised);
+  if (initialised) MPI_Pcontrol(100 + static_cast<int>(phase));
+}
+
 }  // namespace fdem

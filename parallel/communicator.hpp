@@ -129,6 +129,20 @@ constexpr bool reducible() {
 int checked_count(std::size_t n, int scale);  // n·scale as an MPI count, or an internal error
 }  // namespace detail
 
+// Phases of a run, marked for profiling tools with MPI_Pcontrol(100 + phase) (a no-op without
+// one): the communication-budget test's PMPI interposer (tests/mpi/comm_budget) counts the bytes
+// each rank receives per phase.
+enum class CommPhase : int {
+  startup = 1,         // reading the scene, building and distributing the model
+  step = 2,            // halo exchange and the per-step reductions
+  redistribution = 3,  // re-partition and migration at detection cycles
+  output = 4,          // frames, CSV rows
+  checkpoint = 5,      // writing a checkpoint
+  restart = 6,         // reading a checkpoint
+  finish = 7,          // the end-of-run report (counts, state hash, fragments)
+};
+void mark_phase(CommPhase phase);
+
 // A communicator value (does not own the MPI_Comm).  All members except rank/size are
 // collective: every rank of the communicator must call them in the same order.
 class Communicator {
