@@ -3,6 +3,8 @@
 // shapes, initial velocities and kinematic constraints.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,25 @@ struct BodyMesh {
   std::vector<LocalIndex> tets;           // 4 per tet, 0-based
   std::vector<std::int64_t> source_tags;  // element tag in the source file (for messages), or empty
   std::string source;                     // "box generator", a file name, ...
+};
+
+// A part of a body's mesh generated on its own (distributed start-up, parallel/distributed_build):
+// local node numbers, each with its number in the whole body mesh; the chunk's tets are the
+// whole mesh's tets [first_tet, first_tet + n) with the same corners in the same order, so the
+// chunks of a body together give exactly the mesh the whole generator gives.
+struct MeshChunk {
+  BodyMesh mesh;
+  std::vector<std::int64_t> node_id;  // per chunk node: its number in the whole body mesh
+  std::int64_t first_tet = 0;         // whole-mesh index of the chunk's first tet
+  std::int32_t piece = 0;             // the connected piece of the body the chunk lies in
+};
+
+// How a body's mesh splits into chunks, without generating it.
+struct BodyChunks {
+  std::int64_t n_nodes = 0;               // nodes of the whole body mesh
+  std::int32_t n_pieces = 0;              // connected pieces (numbered as connected_pieces does)
+  std::vector<std::int64_t> chunk_tets;   // tets of each chunk, in whole-mesh tet order
+  std::function<MeshChunk(std::int64_t chunk)> generate;
 };
 
 // Connected pieces of a tet mesh (tets sharing a node belong together): piece index per tet.

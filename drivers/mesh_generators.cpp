@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -86,9 +87,32 @@ BodyMesh unit_box(const Vec3& lo, const Vec3& size, int cx, int cy, int cz) {
   return box_mesh(box);
 }
 
-}  // namespace
+// One unit of a generated multi-unit mesh (a brick, a block, a voussoir): its box cells, which
+// give its node and tet counts without making it, and how to make it.
+struct MeshUnit {
+  int cells[3];
+  std::function<BodyMesh()> make;
+  std::int64_t n_nodes() const {
+    return std::int64_t{cells[0] + 1} * (cells[1] + 1) * (cells[2] + 1);
+  }
+  std::int64_t n_tets() const { return std::int64_t{6} * cells[0] * cells[1] * cells[2]; }
+};
 
-BodyMesh wall_mesh(const WallMeshSpec& wall) {
+MeshUnit box_unit(const Vec3& lo, const Vec3& size, int cx, int cy, int cz) {
+  return {{cx, cy, cz}, [=] { return unit_box(lo, size, cx, cy, cz); }};
+}
+
+MeshUnit mapped_unit(const int cells[3], std::function<Vec3(double, double, double)> map) {
+  MeshUnit unit{{cells[0], cells[1], cells[2]}, {}};
+  const int c[3] = {cells[0], cells[1], cells[2]};
+  unit.make = [c0 = c[0], c1 = c[1], c2 = c[2], map = std::move(map)] {
+    const int n[3] = {c0, c1, c2};
+    return mapped_box_mesh(n, map);
+  };
+  return unit;
+}
+
+std::vector<MeshUnit> wall_units(const WallMeshSpec& wall) {
   const double lx = wall.unit.x(), g = wall.mortar_gap;
   const int n = wall.units_per_course;
   const bool running = wall.bond == WallMeshSpec::Bond::running;
@@ -97,44 +121,42 @@ BodyMesh wall_mesh(const WallMeshSpec& wall) {
     throw InputError(
         "wall generator: needs unit sizes > 0, courses >= 1, units per course >= 1, "
         "0 <= mortar gap (< unit length for running bond) and an even cells[0] for running bond");
-  BodyMesh mesh;
+  std::vector<MeshUnit> units;
   const Vec3 size = wall.unit;
   const Vec3 half(0.5 * (lx - g), size.y(), size.z());
+  const int* c = wall.cells;
   for (int course = 0; course < wall.courses; ++course) {
     const double z = wall.origin.z() + course * (size.z() + g);
     const Vec3 start(wall.origin.x(), wall.origin.y(), z);
     if (!running || course % 2 == 0) {
       for (int i = 0; i < n; ++i)
-        append_piece(mesh, unit_box(start + Vec3(i * (lx + g), 0, 0), size, wall.cells[0],
-                                    wall.cells[1], wall.cells[2]));
+        units.push_back(box_unit(start + Vec3(i * (lx + g), 0, 0), size, c[0], c[1], c[2]));
       continue;
     }
     // Running bond: alternate courses start and end with a half unit (joints offset by half).
-    const int half_cells = wall.cells[0] / 2;
-    append_piece(mesh, unit_box(start, half, half_cells, wall.cells[1], wall.cells[2]));
+    const int half_cells = c[0] / 2;
+    units.push_back(box_unit(start, half, half_cells, c[1], c[2]));
     const double first = half.x() + g;
     for (int i = 0; i + 1 < n; ++i)
-      append_piece(mesh, unit_box(start + Vec3(first + i * (lx + g), 0, 0), size, wall.cells[0],
-                                  wall.cells[1], wall.cells[2]));
-    append_piece(mesh, unit_box(start + Vec3(first + (n - 1) * (lx + g), 0, 0), half, half_cells,
-                                wall.cells[1], wall.cells[2]));
+      units.push_back(
+          box_unit(start + Vec3(first + i * (lx + g), 0, 0), size, c[0], c[1], c[2]));
+    units.push_back(box_unit(start + Vec3(first + (n - 1) * (lx + g), 0, 0), half, half_cells,
+                             c[1], c[2]));
   }
-  mesh.source = std::string(running ? "running" : "stack") + " bond wall generator";
-  return mesh;
+  return units;
 }
 
-BodyMesh tower_mesh(const TowerMeshSpec& tower) {
+std::vector<MeshUnit> tower_units(const TowerMeshSpec& tower) {
   if (!(tower.block.minCoeff() > 0.0) || tower.blocks < 1)
     throw InputError("tower generator: needs block sizes > 0 and blocks >= 1");
-  BodyMesh mesh;
+  std::vector<MeshUnit> units;
   for (int i = 0; i < tower.blocks; ++i)
-    append_piece(mesh, unit_box(tower.origin + Vec3(0, 0, i * tower.block.z()), tower.block,
-                                tower.cells[0], tower.cells[1], tower.cells[2]));
-  mesh.source = "tower generator";
-  return mesh;
+    units.push_back(box_unit(tower.origin + Vec3(0, 0, i * tower.block.z()), tower.block,
+                             tower.cells[0], tower.cells[1], tower.cells[2]));
+  return units;
 }
 
-BodyMesh arch_mesh(const ArchMeshSpec& arch) {
+std::vector<MeshUnit> arch_units(const ArchMeshSpec& arch) {
   const double R = arch.radius, t = arch.thickness, alpha = arch.half_angle;
   const int n = arch.voussoirs;
   if (!(R > 0.0) || !(t > 0.0) || !(arch.depth > 0.0) || n < 1 || !(alpha > 0.0) ||
@@ -144,18 +166,18 @@ BodyMesh arch_mesh(const ArchMeshSpec& arch) {
         "arch generator: needs radius, thickness, depth > 0, voussoirs >= 1, a half angle in (0, "
         "90] degrees and abutment width and height > 0");
   const Vec3 o = arch.origin;
+  const double depth = arch.depth;
   // Joint angles from the right springing (π/2 − α) to the left one (π/2 + α), one table so
   // both voussoirs at a joint use the same angle.
   std::vector<double> theta(n + 1);
   for (int k = 0; k <= n; ++k) theta[k] = 0.5 * M_PI - alpha + 2.0 * alpha * k / n;
-  BodyMesh mesh;
+  std::vector<MeshUnit> units;
   for (int k = 0; k < n; ++k) {
     const double a = theta[k], b = theta[k + 1];
-    append_piece(mesh, mapped_box_mesh(arch.cells, [&](double u, double v, double w) {
-                   const double r = R + u * t, angle = (1.0 - v) * a + v * b;
-                   return Vec3(o.x() + r * std::cos(angle), o.y() + w * arch.depth,
-                               o.z() + r * std::sin(angle));
-                 }));
+    units.push_back(mapped_unit(arch.cells, [=](double u, double v, double w) {
+      const double r = R + u * t, angle = (1.0 - v) * a + v * b;
+      return Vec3(o.x() + r * std::cos(angle), o.y() + w * depth, o.z() + r * std::sin(angle));
+    }));
   }
   if (arch.abutments) {
     // Under each springing a four-sided block (extruded along y): its top is the springing face
@@ -173,15 +195,129 @@ BodyMesh arch_mesh(const ArchMeshSpec& arch) {
       const Eigen::Vector2d foot_in = at(R * c, R * s - arch.abutment_height);
       const Eigen::Vector2d foot_out =
           at(R * c + arch.abutment_width, R * s - arch.abutment_height);
-      append_piece(mesh, mapped_box_mesh(cells, [&](double u, double v, double w) {
-                     const Eigen::Vector2d p = (1 - v) * ((1 - u) * foot_in + u * foot_out) +
-                                               v * ((1 - u) * top_in + u * top_out);
-                     return Vec3(p.x(), o.y() + w * arch.depth, p.y());
-                   }));
+      units.push_back(mapped_unit(cells, [=](double u, double v, double w) {
+        const Eigen::Vector2d p =
+            (1 - v) * ((1 - u) * foot_in + u * foot_out) + v * ((1 - u) * top_in + u * top_out);
+        return Vec3(p.x(), o.y() + w * depth, p.y());
+      }));
     }
   }
-  mesh.source = "arch generator";
+  return units;
+}
+
+BodyMesh join_units(const std::vector<MeshUnit>& units, std::string source) {
+  BodyMesh mesh;
+  for (const MeshUnit& unit : units) append_piece(mesh, unit.make());
+  mesh.source = std::move(source);
   return mesh;
+}
+
+// Units as chunks: unit u is piece u, its nodes and tets follow those of the units before it.
+BodyChunks unit_chunks(std::vector<MeshUnit> units) {
+  BodyChunks chunks;
+  auto node_offset = std::make_shared<std::vector<std::int64_t>>();
+  auto tet_offset = std::make_shared<std::vector<std::int64_t>>();
+  for (const MeshUnit& unit : units) {
+    node_offset->push_back(chunks.n_nodes);
+    tet_offset->push_back(chunks.chunk_tets.empty()
+                              ? 0
+                              : tet_offset->back() + chunks.chunk_tets.back());
+    chunks.n_nodes += unit.n_nodes();
+    chunks.chunk_tets.push_back(unit.n_tets());
+  }
+  chunks.n_pieces = static_cast<std::int32_t>(units.size());
+  auto shared_units = std::make_shared<std::vector<MeshUnit>>(std::move(units));
+  chunks.generate = [shared_units, node_offset, tet_offset](std::int64_t u) {
+    MeshChunk chunk;
+    chunk.mesh = (*shared_units)[static_cast<std::size_t>(u)].make();
+    const std::size_t n = chunk.mesh.coords.size() / 3;
+    chunk.node_id.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      chunk.node_id[i] = (*node_offset)[static_cast<std::size_t>(u)] + static_cast<std::int64_t>(i);
+    chunk.first_tet = (*tet_offset)[static_cast<std::size_t>(u)];
+    chunk.piece = static_cast<std::int32_t>(u);
+    return chunk;
+  };
+  return chunks;
+}
+
+// One row of cells (j, k) of a box: the nodes of its two node rows in j and k, numbered as
+// box_mesh numbers them, and its 6·nx tets in box_mesh's order.
+MeshChunk box_row(const BoxMeshSpec& box, std::int64_t row) {
+  const int nx = box.cells[0], ny = box.cells[1], nz = box.cells[2];
+  const int j = static_cast<int>(row % ny), k = static_cast<int>(row / ny);
+  const Vec3 h = (box.max - box.min).cwiseQuotient(Vec3(nx, ny, nz));
+  MeshChunk chunk;
+  chunk.mesh.source = "box generator";
+  chunk.first_tet = row * nx * 6;
+  const auto local = [&](int i, int jj, int kk) {
+    return static_cast<LocalIndex>(((kk - k) * 2 + (jj - j)) * (nx + 1) + i);
+  };
+  for (int kk = k; kk <= k + 1; ++kk)
+    for (int jj = j; jj <= j + 1; ++jj)
+      for (int i = 0; i <= nx; ++i) {
+        chunk.mesh.coords.push_back(i == nx ? box.max.x() : box.min.x() + i * h.x());
+        chunk.mesh.coords.push_back(jj == ny ? box.max.y() : box.min.y() + jj * h.y());
+        chunk.mesh.coords.push_back(kk == nz ? box.max.z() : box.min.z() + kk * h.z());
+        chunk.node_id.push_back((std::int64_t{kk} * (ny + 1) + jj) * (nx + 1) + i);
+      }
+  static const int permutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                         {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int i = 0; i < nx; ++i)
+    for (const auto& perm : permutations) {
+      int corner[3] = {0, 0, 0};
+      LocalIndex tet[4];
+      tet[0] = local(i, j, k);
+      for (int s = 0; s < 3; ++s) {
+        corner[perm[s]] = 1;
+        tet[s + 1] = local(i + corner[0], j + corner[1], k + corner[2]);
+      }
+      Vec3 X[4];
+      for (int c = 0; c < 4; ++c) X[c] = vec3_at(chunk.mesh.coords.data(), tet[c]);
+      if (tet_reference(X).volume < 0.0) std::swap(tet[2], tet[3]);
+      chunk.mesh.tets.insert(chunk.mesh.tets.end(), tet, tet + 4);
+    }
+  return chunk;
+}
+
+}  // namespace
+
+BodyMesh wall_mesh(const WallMeshSpec& wall) {
+  const bool running = wall.bond == WallMeshSpec::Bond::running;
+  return join_units(wall_units(wall),
+                    std::string(running ? "running" : "stack") + " bond wall generator");
+}
+
+BodyMesh tower_mesh(const TowerMeshSpec& tower) {
+  return join_units(tower_units(tower), "tower generator");
+}
+
+BodyMesh arch_mesh(const ArchMeshSpec& arch) {
+  return join_units(arch_units(arch), "arch generator");
+}
+
+BodyChunks body_chunks(const MeshSpec& mesh) {
+  switch (mesh.kind) {
+    case MeshSpec::Kind::box: {
+      const BoxMeshSpec box = mesh.box;
+      const std::int64_t nx = box.cells[0], ny = box.cells[1], nz = box.cells[2];
+      BodyChunks chunks;
+      chunks.n_nodes = (nx + 1) * (ny + 1) * (nz + 1);
+      chunks.n_pieces = 1;
+      chunks.chunk_tets.assign(static_cast<std::size_t>(ny * nz), 6 * nx);
+      chunks.generate = [box](std::int64_t row) { return box_row(box, row); };
+      return chunks;
+    }
+    case MeshSpec::Kind::wall:
+      return unit_chunks(wall_units(mesh.wall));
+    case MeshSpec::Kind::tower:
+      return unit_chunks(tower_units(mesh.tower));
+    case MeshSpec::Kind::arch:
+      return unit_chunks(arch_units(mesh.arch));
+    case MeshSpec::Kind::file:
+      break;
+  }
+  throw InputError("mesh file '" + mesh.file + "' has no chunked form");
 }
 
 std::vector<BodyMesh> load_body_meshes(const Scene& scene) {

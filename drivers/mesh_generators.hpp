@@ -30,6 +30,12 @@ BodyMesh tower_mesh(const TowerMeshSpec& tower);
 // Appends `piece`'s nodes and tets to `mesh` (its nodes stay separate from the others').
 void append_piece(BodyMesh& mesh, const BodyMesh& piece);
 
+// Chunked generation (distributed start-up): a box body splits into rows of cells (fixed j, k), a
+// wall, tower or arch into its units (one piece each).  Chunk by chunk the same nodes, tets and
+// corner order as box_mesh / wall_mesh / tower_mesh / arch_mesh.  Throws InputError for a mesh
+// read from a file (it has no chunked form).
+BodyChunks body_chunks(const MeshSpec& mesh);
+
 // Loads or generates the mesh of every body of the scene, in scene order.
 std::vector<BodyMesh> load_body_meshes(const Scene& scene);
 

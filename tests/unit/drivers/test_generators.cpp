@@ -341,3 +341,89 @@ TEST_CASE("scene reader: wall, arch and tower keys and their messages", "[driver
                          "    joints: interfaces\n"),
              Contains("bodies[0].joints") && Contains("needs fracture properties"));
 }
+
+namespace {
+
+// The whole body mesh put together from its chunks (nodes by their whole-mesh number).
+BodyMesh mesh_from_chunks(const BodyChunks& chunks, std::vector<std::int32_t>* tet_piece) {
+  BodyMesh whole;
+  whole.coords.assign(3 * static_cast<std::size_t>(chunks.n_nodes), std::nan(""));
+  std::int64_t next_tet = 0;
+  for (std::size_t c = 0; c < chunks.chunk_tets.size(); ++c) {
+    const MeshChunk chunk = chunks.generate(static_cast<std::int64_t>(c));
+    REQUIRE(chunk.first_tet == next_tet);
+    REQUIRE(static_cast<std::int64_t>(chunk.mesh.tets.size() / 4) == chunks.chunk_tets[c]);
+    next_tet += chunks.chunk_tets[c];
+    for (std::size_t n = 0; n < chunk.node_id.size(); ++n)
+      for (int k = 0; k < 3; ++k) {
+        double& x = whole.coords[3 * static_cast<std::size_t>(chunk.node_id[n]) + k];
+        // A node shared by two chunks has the same coordinates in both, bit for bit.
+        if (!std::isnan(x)) REQUIRE(x == chunk.mesh.coords[3 * n + k]);
+        x = chunk.mesh.coords[3 * n + k];
+      }
+    for (LocalIndex n : chunk.mesh.tets)
+      whole.tets.push_back(static_cast<LocalIndex>(chunk.node_id[static_cast<std::size_t>(n)]));
+    tet_piece->insert(tet_piece->end(), chunk.mesh.tets.size() / 4, chunk.piece);
+  }
+  return whole;
+}
+
+void require_chunks_give(const MeshSpec& spec, const BodyMesh& expected) {
+  const BodyChunks chunks = body_chunks(spec);
+  std::vector<std::int32_t> tet_piece;
+  const BodyMesh whole = mesh_from_chunks(chunks, &tet_piece);
+  REQUIRE(whole.coords.size() == expected.coords.size());
+  for (std::size_t i = 0; i < whole.coords.size(); ++i) REQUIRE(whole.coords[i] == expected.coords[i]);
+  REQUIRE(whole.tets == expected.tets);
+  std::int32_t n_pieces = 0;
+  REQUIRE(tet_piece == connected_pieces(expected.tets,
+                                        static_cast<LocalIndex>(expected.coords.size() / 3),
+                                        &n_pieces));
+  REQUIRE(n_pieces == chunks.n_pieces);
+}
+
+}  // namespace
+
+TEST_CASE("chunked generation gives the whole generator's mesh, node for node and tet for tet",
+          "[drivers][generators]") {
+  MeshSpec box;
+  box.kind = MeshSpec::Kind::box;
+  box.box.min = Vec3(-0.3, 0.1, -1.0 / 3.0);
+  box.box.max = Vec3(0.7, 0.35, 0.2);
+  box.box.cells[0] = 5;
+  box.box.cells[1] = 3;
+  box.box.cells[2] = 4;
+  require_chunks_give(box, box_mesh(box.box));
+
+  MeshSpec wall;
+  wall.kind = MeshSpec::Kind::wall;
+  wall.wall.bond = WallMeshSpec::Bond::running;
+  wall.wall.unit = Vec3(0.3, 0.1, 0.07);
+  wall.wall.courses = 3;
+  wall.wall.units_per_course = 3;
+  wall.wall.mortar_gap = 0.01;
+  wall.wall.cells[0] = 4;
+  require_chunks_give(wall, wall_mesh(wall.wall));
+
+  MeshSpec tower;
+  tower.kind = MeshSpec::Kind::tower;
+  tower.tower.block = Vec3(0.2, 0.2, 0.15);
+  tower.tower.blocks = 4;
+  require_chunks_give(tower, tower_mesh(tower.tower));
+
+  MeshSpec arch;
+  arch.kind = MeshSpec::Kind::arch;
+  arch.arch.radius = 1.0;
+  arch.arch.thickness = 0.15;
+  arch.arch.depth = 0.3;
+  arch.arch.voussoirs = 7;
+  arch.arch.abutments = true;
+  arch.arch.abutment_width = 0.4;
+  arch.arch.abutment_height = 0.5;
+  require_chunks_give(arch, arch_mesh(arch.arch));
+
+  MeshSpec file;
+  file.kind = MeshSpec::Kind::file;
+  file.file = "part.msh";
+  REQUIRE_THROWS_AS(body_chunks(file), InputError);
+}
