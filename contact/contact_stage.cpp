@@ -30,14 +30,31 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
-    compute_boxes(model, model.nodes.x.data());
-    std::vector<double> size(model.tets.size());
-    for (LocalIndex t = 0; t < model.tets.size(); ++t)
-      size[t] = std::max({hi_[3 * t] - lo_[3 * t], hi_[3 * t + 1] - lo_[3 * t + 1],
-                          hi_[3 * t + 2] - lo_[3 * t + 2]});
+    std::vector<double> size = tet_sizes(model);
     std::nth_element(size.begin(), size.begin() + size.size() / 2, size.end());
-    buffer_ = 0.25 * size[size.size() / 2];
+    buffer_ = auto_buffer(size[size.size() / 2]);
   }
+}
+
+std::vector<double> ContactStage::tet_sizes(const Model& model) {
+  const TetArrays& tets = model.tets;
+  const double* x = model.nodes.x.data();
+  std::vector<double> size;
+  size.reserve(static_cast<std::size_t>(tets.size()));
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    if (!tets.is_owned(t)) continue;
+    double largest = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      double lo = x[3 * tets.nodes[4 * t] + k], hi = lo;
+      for (int c = 1; c < 4; ++c) {
+        lo = std::min(lo, x[3 * tets.nodes[4 * t + c] + k]);
+        hi = std::max(hi, x[3 * tets.nodes[4 * t + c] + k]);
+      }
+      largest = std::max(largest, hi - lo);
+    }
+    size.push_back(largest);
+  }
+  return size;
 }
 
 bool ContactStage::needed(const Model& model) {
@@ -54,6 +71,7 @@ double ContactStage::critical_time_step(const Model& model) const {
   const TetArrays& tets = model.tets;
   double dt = std::numeric_limits<double>::infinity();
   for (LocalIndex t = 0; t < tets.size(); ++t) {
+    if (!tets.is_owned(t)) continue;  // each tet counts once, on its owner
     Vec3 x[4];
     for (int c = 0; c < 4; ++c) x[c] = vec3_at(model.nodes.x.data(), tets.nodes[4 * t + c]);
     const double h = smallest_altitude(x);

@@ -48,6 +48,11 @@ class ContactStage {
  public:
   ContactStage(const Model& model, ContactSettings settings);
 
+  // Largest box extent (m) of each owned tet at the current positions, and the automatic buffer
+  // made from their median (0.25 × median): distributed runs take the median over all ranks.
+  static std::vector<double> tet_sizes(const Model& model);
+  static double auto_buffer(double median_tet_size) { return 0.25 * median_tet_size; }
+
   // Whether a scene needs contact at all: at least two pieces that are not both fixed.
   static bool needed(const Model& model);
 

@@ -441,8 +441,55 @@ std::uint64_t morton_key(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   return key;
 }
 
-Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, ElementOrder order) {
-  FDEM_VERIFY(meshes.size() == scene.bodies.size(), "one mesh per body");
+void check_tet_shape(const Vec3 (&X)[4], const std::string& body, const std::string& source,
+                     std::int64_t tag) {
+  const double volume = tet_reference(X).volume;
+  const double scale = std::pow(std::max(smallest_altitude(X), 1e-300), 3.0);
+  if (!(volume > 1e-12 * scale) || !std::isfinite(volume)) {
+    std::ostringstream msg;
+    msg << "body '" << body << "' (" << source << "): tetrahedron " << tag
+        << (volume < 0 ? " is inverted (negative volume " : " is degenerate (volume ") << volume
+        << " m^3). Fix the mesh: nodes of a 4-node tetrahedron must be ordered so that "
+           "(x1-x0)x(x2-x0).(x3-x0) > 0, as Gmsh writes them.";
+    throw InputError(msg.str());
+  }
+}
+
+TetSetup setup_tet(const Vec3 (&X)[4], const MaterialProperties& mat) {
+  const TetReference ref = tet_reference(X);
+  TetSetup out;
+  out.dm_inv = ref.dm_inv;
+  out.volume = ref.volume;
+  out.mass = mat.density * ref.volume;
+  // Viscosity that gives damping ratio ξ in the element's highest mode: η = 2ξμ/ω_max.
+  if (mat.damping_ratio > 0.0) {
+    const double k_max = tet_max_stiffness_eigenvalue(ref.dm_inv, ref.volume, mat.lame);
+    const double omega = std::sqrt(k_max / (0.25 * out.mass));
+    out.viscosity = 2.0 * mat.damping_ratio * mat.lame.mu / omega;
+  }
+  return out;
+}
+
+void add_to_piece(PieceInfo& piece, double element_mass, const Vec3 (&X)[4]) {
+  piece.mass += element_mass;
+  piece.centroid0 += element_mass * 0.25 * (X[0] + X[1] + X[2] + X[3]);
+}
+
+void finish_piece(PieceInfo& piece) {
+  if (piece.mass > 0.0) piece.centroid0 /= piece.mass;
+}
+
+void set_initial_velocities(const Scene& scene, Model& model) {
+  NodeArrays& nodes = model.nodes;
+  for (LocalIndex n = 0; n < nodes.size(); ++n) {
+    const PieceInfo& piece = model.pieces[nodes.piece[n]];
+    const BodySpec& body = scene.bodies[piece.body];
+    const Vec3 r = vec3_at(nodes.x0.data(), n) - piece.centroid0;
+    vec3_at(nodes.v.data(), n) = body.velocity + body.angular_velocity.cross(r);
+  }
+}
+
+Model model_frame(const Scene& scene) {
   Model model;
   model.gravity = scene.gravity;
   for (const auto& spec : scene.materials) model.materials.push_back(resolve_material(spec));
@@ -450,6 +497,12 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     model.body_names.push_back(body.name);
     model.body_fixed.push_back(body.fixed);
   }
+  return model;
+}
+
+Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, ElementOrder order) {
+  FDEM_VERIFY(meshes.size() == scene.bodies.size(), "one mesh per body");
+  Model model = model_frame(scene);
 
   // Gather every tet of every body with its body, piece and source position.
   struct TetRecord {
@@ -478,17 +531,8 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     for (LocalIndex t = 0; t < n_tets; ++t) {
       Vec3 X[4];
       for (int c = 0; c < 4; ++c) X[c] = vec3_at(mesh.coords.data(), mesh.tets[4 * t + c]);
-      const double volume = tet_reference(X).volume;
-      const double scale = std::pow(std::max(smallest_altitude(X), 1e-300), 3.0);
-      if (!(volume > 1e-12 * scale) || !std::isfinite(volume)) {
-        std::ostringstream msg;
-        msg << "body '" << scene.bodies[b].name << "' (" << mesh.source << "): tetrahedron "
-            << (mesh.source_tags.empty() ? t + 1 : mesh.source_tags[t])
-            << (volume < 0 ? " is inverted (negative volume " : " is degenerate (volume ") << volume
-            << " m^3). Fix the mesh: nodes of a 4-node tetrahedron must be ordered so that "
-               "(x1-x0)x(x2-x0).(x3-x0) > 0, as Gmsh writes them.";
-        throw InputError(msg.str());
-      }
+      check_tet_shape(X, scene.bodies[b].name, mesh.source,
+                      mesh.source_tags.empty() ? t + 1 : mesh.source_tags[t]);
       records.push_back({static_cast<std::int32_t>(b), t, piece_base + piece[t], 0});
     }
   }
@@ -570,25 +614,14 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
       X[c] = vec3_at(nodes.x0.data(), n);
       nodes.piece[n] = r.piece;
     }
-    const TetReference ref = tet_reference(X);
-    Eigen::Map<Mat3>(tets.dm_inv.data() + 9 * t) = ref.dm_inv;
-    tets.volume0[t] = ref.volume;
-    const double element_mass = mat.density * ref.volume;
-    for (int c = 0; c < 4; ++c) nodes.mass[tets.nodes[4 * t + c]] += 0.25 * element_mass;
-    // Viscosity that gives damping ratio ξ in the element's highest mode: η = 2ξμ/ω_max.
-    if (mat.damping_ratio > 0.0) {
-      const double k_max = tet_max_stiffness_eigenvalue(ref.dm_inv, ref.volume, mat.lame);
-      const double omega = std::sqrt(k_max / (0.25 * element_mass));
-      tets.viscosity[t] = 2.0 * mat.damping_ratio * mat.lame.mu / omega;
-    } else {
-      tets.viscosity[t] = 0.0;
-    }
-    PieceInfo& piece = model.pieces[r.piece];
-    piece.mass += element_mass;
-    piece.centroid0 += element_mass * 0.25 * (X[0] + X[1] + X[2] + X[3]);
+    const TetSetup setup = setup_tet(X, mat);
+    Eigen::Map<Mat3>(tets.dm_inv.data() + 9 * t) = setup.dm_inv;
+    tets.volume0[t] = setup.volume;
+    tets.viscosity[t] = setup.viscosity;
+    for (int c = 0; c < 4; ++c) nodes.mass[tets.nodes[4 * t + c]] += 0.25 * setup.mass;
+    add_to_piece(model.pieces[r.piece], setup.mass, X);
   }
-  for (auto& piece : model.pieces)
-    if (piece.mass > 0.0) piece.centroid0 /= piece.mass;
+  for (auto& piece : model.pieces) finish_piece(piece);
 
   // Contact groups: a piece, or a single tet of a jointed body.
   tets.contact_group.resize(n_tets);
@@ -603,13 +636,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
   for (LocalIndex t = 0; t < n_tets; ++t) model_tet[records[t].body][records[t].local] = t;
   place_joints(scene, meshes, model_tet, hi - lo, model);
 
-  // Initial velocity: translation plus rotation about each piece's own centroid.
-  for (LocalIndex n = 0; n < n_nodes; ++n) {
-    const PieceInfo& piece = model.pieces[nodes.piece[n]];
-    const BodySpec& body = scene.bodies[piece.body];
-    const Vec3 r = vec3_at(nodes.x0.data(), n) - piece.centroid0;
-    vec3_at(nodes.v.data(), n) = body.velocity + body.angular_velocity.cross(r);
-  }
+  set_initial_velocities(scene, model);
 
   build_tet_force_order(tets, model.tet_force_order);
   apply_constraints(scene, model);

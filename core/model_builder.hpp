@@ -34,9 +34,9 @@ struct MeshChunk {
 
 // How a body's mesh splits into chunks, without generating it.
 struct BodyChunks {
-  std::int64_t n_nodes = 0;               // nodes of the whole body mesh
-  std::int32_t n_pieces = 0;              // connected pieces (numbered as connected_pieces does)
-  std::vector<std::int64_t> chunk_tets;   // tets of each chunk, in whole-mesh tet order
+  std::int64_t n_nodes = 0;              // nodes of the whole body mesh
+  std::int32_t n_pieces = 0;             // connected pieces (numbered as connected_pieces does)
+  std::vector<std::int64_t> chunk_tets;  // tets of each chunk, in whole-mesh tet order
   std::function<MeshChunk(std::int64_t chunk)> generate;
 };
 
@@ -46,6 +46,31 @@ std::vector<std::int32_t> connected_pieces(const std::vector<LocalIndex>& tets, 
 
 // 63-bit Morton key of a point inside the box [lo, hi] (21 bits per axis).
 std::uint64_t morton_key(const Vec3& p, const Vec3& lo, const Vec3& hi);
+
+// Throws InputError naming the body, its source and the tet's number (`tag`) if the tet with
+// corners X is inverted or degenerate.
+void check_tet_shape(const Vec3 (&X)[4], const std::string& body, const std::string& source,
+                     std::int64_t tag);
+
+// What a tet's reference shape and material give: Dm⁻¹ (1/m), volume (m³), mass (kg) and the
+// viscosity (Pa·s) that damps its highest mode by the material's ratio (0 without damping).
+struct TetSetup {
+  Mat3 dm_inv;
+  double volume = 0.0, mass = 0.0, viscosity = 0.0;
+};
+TetSetup setup_tet(const Vec3 (&X)[4], const MaterialProperties& material);
+
+// Piece mass and centroid, summed tet by tet in ascending tet gid (the order fixes the rounding),
+// then finished (centroid = Σ m·c / Σ m).
+void add_to_piece(PieceInfo& piece, double element_mass, const Vec3 (&X)[4]);
+void finish_piece(PieceInfo& piece);
+
+// Initial velocity of every node: its body's translation plus rotation about its piece's own
+// reference centroid.
+void set_initial_velocities(const Scene& scene, Model& model);
+
+// A model with the scene's materials, body names, fixed flags and gravity, and no mesh yet.
+Model model_frame(const Scene& scene);
 
 enum class ElementOrder { space_filling_curve, as_given };
 

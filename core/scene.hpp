@@ -174,6 +174,9 @@ struct OutputSpec {
 struct ParallelSpec {
   double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this
   long redistribute_every = 0;        // steps; also redistribute this often (0: at detections only)
+  // N ranks, generated meshes without joints: each rank builds only its part (false: every rank
+  // builds the whole model first, as scenes with Gmsh meshes or joints always do).
+  bool distributed_start = true;
 };
 
 struct Scene {

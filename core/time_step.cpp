@@ -31,7 +31,8 @@ CriticalStep critical_time_step(const Model& model) {
   CriticalStep out;
   out.dt = std::numeric_limits<double>::infinity();
   for (LocalIndex t = 0; t < n_tets; ++t) {
-    if (weight[t] <= 0.0) continue;
+    // Each tet counts once, on its owner (whose halo holds every tet around its nodes).
+    if (weight[t] <= 0.0 || !tets.is_owned(t)) continue;
     double corner_mass[4];
     for (int c = 0; c < 4; ++c) {
       const LocalIndex n = tets.nodes[4 * t + c];

@@ -138,10 +138,9 @@ std::vector<MeshUnit> wall_units(const WallMeshSpec& wall) {
     units.push_back(box_unit(start, half, half_cells, c[1], c[2]));
     const double first = half.x() + g;
     for (int i = 0; i + 1 < n; ++i)
-      units.push_back(
-          box_unit(start + Vec3(first + i * (lx + g), 0, 0), size, c[0], c[1], c[2]));
-    units.push_back(box_unit(start + Vec3(first + (n - 1) * (lx + g), 0, 0), half, half_cells,
-                             c[1], c[2]));
+      units.push_back(box_unit(start + Vec3(first + i * (lx + g), 0, 0), size, c[0], c[1], c[2]));
+    units.push_back(
+        box_unit(start + Vec3(first + (n - 1) * (lx + g), 0, 0), half, half_cells, c[1], c[2]));
   }
   return units;
 }
@@ -219,9 +218,8 @@ BodyChunks unit_chunks(std::vector<MeshUnit> units) {
   auto tet_offset = std::make_shared<std::vector<std::int64_t>>();
   for (const MeshUnit& unit : units) {
     node_offset->push_back(chunks.n_nodes);
-    tet_offset->push_back(chunks.chunk_tets.empty()
-                              ? 0
-                              : tet_offset->back() + chunks.chunk_tets.back());
+    tet_offset->push_back(
+        chunks.chunk_tets.empty() ? 0 : tet_offset->back() + chunks.chunk_tets.back());
     chunks.n_nodes += unit.n_nodes();
     chunks.chunk_tets.push_back(unit.n_tets());
   }

@@ -63,6 +63,10 @@ std::vector<std::string> StagePlan::describe() const {
 }
 
 Simulation::Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm)
+    : Simulation(std::move(scene), std::move(model), std::move(options), comm, nullptr, -1.0) {}
+
+Simulation::Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm,
+                       std::unique_ptr<Distribution> distribution, double contact_buffer)
     : scene_(std::move(scene)),
       model_(std::move(model)),
       options_(std::move(options)),
@@ -71,26 +75,35 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
       "internal_forces", "joint_forces", "fracture",    "contact_detection", "contact_forces",
       "external_forces", "integrate",    "halo_update", "redistribution",    "output"};
   for (int s = 0; s < n_stages; ++s) clocks_[s].name = names[s];
+  // Distributed start: the model is this rank's part with its halo, and what concerns the whole
+  // model comes from reductions over the owned entries; otherwise it is the whole model.
+  const bool distributed = distribution != nullptr;
+  const auto global_min = [&](double v) { return distributed ? comm_->min(v) : v; };
+  const auto global_sum = [&](auto v) { return distributed ? comm_->sum(v) : v; };
   loads_ = std::make_unique<LoadSchedule>(scene_, model_);
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
   plan_.kinematic_loads = !scene_.loads.empty();
 
   plan_.contact = ContactStage::needed(model_);
   const CriticalStep critical = fdem::critical_time_step(model_);
-  dt_critical_ = critical.dt;
+  dt_critical_ = global_min(critical.dt);
   // Energies below this are round-off for the model (1e-12 of Σ E·V, J): a balance "error" among
   // them says nothing about stability.
   for (LocalIndex t = 0; t < model_.tets.size(); ++t)
-    energy_floor_ +=
-        1e-12 * model_.materials[model_.tets.material[t]].young * std::abs(model_.tets.volume0[t]);
+    if (model_.tets.is_owned(t))
+      energy_floor_ += 1e-12 * model_.materials[model_.tets.material[t]].young *
+                       std::abs(model_.tets.volume0[t]);
+  energy_floor_ = global_sum(energy_floor_);
   if (plan_.contact) {
-    contact_ = std::make_unique<ContactStage>(model_, ContactSettings{scene_.contact_buffer});
+    contact_ = std::make_unique<ContactStage>(
+        model_, ContactSettings{distributed ? contact_buffer : scene_.contact_buffer});
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
-    const double dt_contact = contact_->critical_time_step(model_);
+    const double dt_contact = global_min(contact_->critical_time_step(model_));
     dt_critical_ =
         1.0 / std::sqrt(1.0 / (dt_critical_ * dt_critical_) + 1.0 / (dt_contact * dt_contact));
   }
   plan_.joints = JointStage::needed(model_);
+  FDEM_VERIFY(!(distributed && plan_.joints), "the distributed start takes scenes without joints");
   if (plan_.joints) {
     joints_ = std::make_unique<JointStage>(model_);
     const double dt_joint = joints_->critical_time_step(model_);  // joint springs add ω² too
@@ -107,21 +120,29 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   dt_ = scene_.time.auto_step ? scene_.time.safety * dt_critical_ : scene_.time.step;
   if (!std::isfinite(dt_) || dt_ <= 0.0)
     throw InputError(scene_.source_path + ": could not determine a time step (critical step " +
-                     std::to_string(critical.dt) + " s)");
-  whole_nodes_ = model_.nodes.size();
-  whole_tets_ = model_.tets.size();
+                     std::to_string(dt_critical_) + " s)");
+  std::int64_t owned_tets = 0;
+  for (LocalIndex t = 0; t < model_.tets.size(); ++t) owned_tets += model_.tets.is_owned(t);
+  whole_nodes_ = global_sum(std::int64_t{model_.nodes.n_owned});
+  whole_tets_ = global_sum(owned_tets);
   whole_joints_ = model_.joints.size();
-  reference_hash_ = reference_hash(model_.nodes);
+  reference_hash_ =
+      distributed ? global_reference_hash(model_.nodes, *comm_) : reference_hash(model_.nodes);
   next_checkpoint_time_ = scene_.output.checkpoint_every;
-  // A restart overwrites the state of the whole model (and of the stages) with the checkpoint's.
+  if (distributed) {  // the stages were made on the local model: bind them to its halo
+    distribution_ = std::move(distribution);
+    TravellingState state = travelling_state();
+    rebind_stages(state, false);
+  }
+  // A restart overwrites the state of the model (and of the stages) with the checkpoint's.
   if (!options_.restart_path.empty()) {
     mark_phase(CommPhase::restart);
     restore_checkpoint(options_.restart_path);
     mark_phase(CommPhase::startup);
   }
-  // N ranks: everything above came from the whole model (the same on every rank); now keep this
-  // rank's part and halo.
-  if (comm_ && comm_->size() > 1) {
+  // N ranks, whole-model start: everything above came from the whole model (the same on every
+  // rank); now keep this rank's part and halo.
+  if (!distributed && comm_ && comm_->size() > 1) {
     DistributionSettings settings;
     settings.rebalance_threshold = scene_.parallel.rebalance_threshold;
     // Blocks that touch at the start should share a rank: the first detection, on the whole
@@ -144,167 +165,6 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   startup_peak_rss_kib_ = peak_rss_kib();
   release_free_memory();
   reset_peak_rss();
-}
-
-// ---------------------------------------------------------------------------------------------
-// Checkpoint and restart (parallel/checkpoint.hpp): rows keyed by global id, so any rank count can
-// continue any checkpoint; the run scalars make the continuation bit-identical.
-// ---------------------------------------------------------------------------------------------
-void Simulation::write_checkpoint() {
-  CheckpointHeader header;
-  header.n_nodes = whole_nodes_;
-  header.n_tets = whole_tets_;
-  header.n_joints = whole_joints_;
-  header.reference_hash = reference_hash_;
-  header.doubles = {{"time", time_},
-                    {"time_step", dt_},
-                    {"critical_time_step", dt_critical_},
-                    {"energy_input", energy_input_},
-                    {"kinetic_half_step", kinetic_half_step_},
-                    {"next_frame_time", next_frame_time_},
-                    {"next_energy_time", next_energy_time_},
-                    {"next_checkpoint_time", next_checkpoint_time_},
-                    {"joint_friction_through_previous", joint_friction_.through_previous},
-                    {"joint_friction_first_before", joint_friction_.first_before},
-                    {"joint_friction_started", joint_friction_.started ? 1.0 : 0.0}};
-  for (const auto& [name, value] : ledger_.saved_state())
-    header.doubles.emplace_back("ledger_" + name, value);
-  header.integers = {{"steps", steps_},
-                     {"contact_detected", contact_ && contact_->detected() ? 1 : 0},
-                     {"contact_detections", contact_ ? contact_->detections() : 0}};
-
-  CheckpointRows rows;
-  const NodeArrays& nodes = model_.nodes;
-  const std::vector<double>& at_detection = contact_ ? contact_->x_at_detection() : nodes.x;
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    rows.node_gid.push_back(nodes.gid[n]);
-    for (int k = 0; k < 3; ++k) {
-      rows.node_x.push_back(nodes.x[3 * n + k]);
-      rows.node_v.push_back(nodes.v[3 * n + k]);
-      rows.node_x_at_detection.push_back(at_detection[3 * n + k]);
-      rows.node_prescribed_velocity.push_back(nodes.prescribed_velocity[3 * n + k]);
-    }
-  }
-  rows.joint_history_bytes = sizeof(JointHistory);
-  const JointArrays& joint_rows = model_.joints;
-  for (LocalIndex j = 0; j < joint_rows.size(); ++j) {
-    if (!model_.tets.is_owned(joint_rows.tets[2 * j])) continue;
-    rows.joint_gid.push_back(joint_rows.gid[j]);
-    rows.joint_broken.push_back(joint_rows.broken[j]);
-    rows.joint_mode.push_back(joint_rows.mode[j]);
-    rows.joint_failure_time.push_back(joint_rows.failure_time[j]);
-    rows.joint_damage.push_back(joint_rows.damage[j]);
-    const auto* bytes = reinterpret_cast<const std::uint8_t*>(&joints_->history()[j]);
-    rows.joint_history.insert(rows.joint_history.end(), bytes, bytes + sizeof(JointHistory));
-  }
-  if (contact_)
-    for (const FrictionEntry& e : contact_->friction_entries()) {
-      const auto it = std::lower_bound(model_.tets.gid.begin(), model_.tets.gid.end(), e.a);
-      if (it == model_.tets.gid.end() || *it != e.a ||
-          !model_.tets.is_owned(static_cast<LocalIndex>(it - model_.tets.gid.begin())))
-        continue;  // the owner of the pair's first tet writes it
-      rows.friction_a.push_back(e.a);
-      rows.friction_b.push_back(e.b);
-      for (int k = 0; k < 3; ++k) rows.friction_spring.push_back(e.spring[k]);
-      rows.friction_stiffness.push_back(e.stiffness);
-    }
-  char name[64];
-  std::snprintf(name, sizeof(name), "checkpoint_%08ld.h5", steps_);
-  const std::string path = (std::filesystem::path(options_.output_dir) / name).string();
-  fdem::write_checkpoint(path, *comm_, header, rows);
-  checkpoints_.push_back(path);
-  // Keep the newest two: the one just written and the previous one.
-  if (checkpoints_.size() > 2 && comm_->rank() == 0) {
-    std::error_code ignored;
-    std::filesystem::remove(checkpoints_[checkpoints_.size() - 3], ignored);
-  }
-}
-
-void Simulation::restore_checkpoint(const std::string& path) {
-  if (!comm_) throw InputError(path + ": a restart needs the MPI environment of the fdem command");
-  const auto [header, rows] = read_checkpoint(path, *comm_);
-  if (header.n_nodes != whole_nodes_ || header.n_tets != whole_tets_ ||
-      header.n_joints != whole_joints_ || header.reference_hash != reference_hash_)
-    throw InputError("checkpoint '" + path + "' was written for a different scene (" +
-                     std::to_string(header.n_nodes) + " nodes, " + std::to_string(header.n_tets) +
-                     " tetrahedra, " + std::to_string(header.n_joints) +
-                     " joints; this scene has " + std::to_string(whole_nodes_) + ", " +
-                     std::to_string(whole_tets_) + ", " + std::to_string(whole_joints_) +
-                     (header.n_nodes == whole_nodes_ ? ", and other reference positions" : "") +
-                     ")");
-  if (header.n_joints > 0 && rows.joint_history_bytes != sizeof(JointHistory))
-    throw InputError("checkpoint '" + path + "' holds joint histories of " +
-                     std::to_string(rows.joint_history_bytes) + " bytes; this fdem uses " +
-                     std::to_string(sizeof(JointHistory)));
-  std::map<std::string, double> doubles;
-  for (const auto& [name, value] : header.doubles) doubles[name] = value;
-  std::map<std::string, std::int64_t> integers;
-  for (const auto& [name, value] : header.integers) integers[name] = value;
-  const auto number = [&](const std::string& name) {
-    const auto it = doubles.find(name);
-    if (it == doubles.end())
-      throw InputError("checkpoint '" + path + "' has no run value '" + name + "'");
-    return it->second;
-  };
-  const auto integer = [&](const std::string& name) {
-    const auto it = integers.find(name);
-    if (it == integers.end())
-      throw InputError("checkpoint '" + path + "' has no run value '" + name + "'");
-    return it->second;
-  };
-  // The whole model is in gid order here (local index = gid).
-  NodeArrays& nodes = model_.nodes;
-  std::vector<double> at_detection = nodes.x;
-  for (std::size_t i = 0; i < rows.node_gid.size(); ++i) {
-    const auto n = static_cast<std::size_t>(rows.node_gid[i]);
-    for (int k = 0; k < 3; ++k) {
-      nodes.x[3 * n + k] = rows.node_x[3 * i + k];
-      nodes.v[3 * n + k] = rows.node_v[3 * i + k];
-      nodes.prescribed_velocity[3 * n + k] = rows.node_prescribed_velocity[3 * i + k];
-      at_detection[3 * n + k] = rows.node_x_at_detection[3 * i + k];
-    }
-  }
-  JointArrays& joint_rows = model_.joints;
-  std::vector<JointHistory> history(static_cast<std::size_t>(joint_rows.size()));
-  for (std::size_t i = 0; i < rows.joint_gid.size(); ++i) {
-    const auto j = static_cast<std::size_t>(rows.joint_gid[i]);
-    joint_rows.broken[j] = rows.joint_broken[i];
-    joint_rows.mode[j] = rows.joint_mode[i];
-    joint_rows.failure_time[j] = rows.joint_failure_time[i];
-    joint_rows.damage[j] = rows.joint_damage[i];
-    std::memcpy(&history[j], &rows.joint_history[i * sizeof(JointHistory)], sizeof(JointHistory));
-  }
-  if (joints_) joints_->rebind(model_, std::move(history));
-  if (contact_) {
-    // A tet's joint state: cracked once one of its joints broke, intact while it has joints.
-    std::vector<std::uint8_t> joint_state = contact_->tet_joint_states();
-    for (LocalIndex j = 0; j < joint_rows.size(); ++j)
-      if (joint_rows.broken[j])
-        for (int side = 0; side < 2; ++side) joint_state[joint_rows.tets[2 * j + side]] = 2;
-    std::vector<FrictionEntry> friction(rows.friction_a.size());
-    for (std::size_t i = 0; i < friction.size(); ++i) {
-      friction[i].a = rows.friction_a[i];
-      friction[i].b = rows.friction_b[i];
-      friction[i].spring = Vec3(rows.friction_spring[3 * i], rows.friction_spring[3 * i + 1],
-                                rows.friction_spring[3 * i + 2]);
-      friction[i].stiffness = rows.friction_stiffness[i];
-    }
-    contact_->rebind(model_, std::move(at_detection), std::move(joint_state), friction,
-                     integer("contact_detected") != 0);
-  }
-  time_ = number("time");
-  steps_ = integer("steps");
-  dt_ = number("time_step");
-  dt_critical_ = number("critical_time_step");
-  energy_input_ = number("energy_input");
-  kinetic_half_step_ = number("kinetic_half_step");
-  next_frame_time_ = number("next_frame_time");
-  next_energy_time_ = number("next_energy_time");
-  next_checkpoint_time_ = number("next_checkpoint_time");
-  joint_friction_.through_previous = number("joint_friction_through_previous");
-  joint_friction_.first_before = number("joint_friction_first_before");
-  joint_friction_.started = number("joint_friction_started") != 0.0;
-  ledger_.restore([&](const std::string& name) { return number("ledger_" + name); });
 }
 
 bool Simulation::is_root() const {
@@ -825,11 +685,43 @@ RunReport Simulation::run() {
   return result;
 }
 
+bool distributed_start_possible(const Scene& scene) {
+  if (!scene.parallel.distributed_start || !scene.interfaces.empty()) return false;
+  for (const BodySpec& body : scene.bodies)
+    if (body.mesh.kind == MeshSpec::Kind::file || body.joints != JointPlacement::none) return false;
+  return true;
+}
+
 std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options,
                                             const Communicator* comm) {
   if (!comm || comm->size() == 1) {
     Model model = build_model(scene, load_body_meshes(scene));
     return std::make_unique<Simulation>(scene, std::move(model), std::move(options), comm);
+  }
+  if (distributed_start_possible(scene)) {
+    // Each rank generates its chunks of the meshes and keeps its block
+    // (parallel/distributed_build).
+    std::vector<BodyChunks> chunks;
+    comm->run_collectively([&] {
+      for (const BodySpec& body : scene.bodies) chunks.push_back(body_chunks(body.mesh));
+    });
+    DistributedModel start = build_distributed_model(scene, chunks, *comm);
+    chunks.clear();
+    double buffer = 0.0;  // contact buffer (m): as the contact stage sets it on one rank
+    if (ContactStage::needed(start.model)) {
+      buffer = scene.contact_buffer;
+      if (buffer < 0)
+        buffer = ContactStage::auto_buffer(
+            distributed_nth_value(ContactStage::tet_sizes(start.model), start.n_tets / 2, *comm));
+    }
+    DistributionSettings settings;
+    settings.rebalance_threshold = scene.parallel.rebalance_threshold;
+    Model local;
+    TravellingState local_state;
+    auto distribution = std::make_unique<Distribution>(*comm, settings, std::move(start), buffer,
+                                                       local, local_state);
+    return std::make_unique<Simulation>(scene, std::move(local), std::move(options), comm,
+                                        std::move(distribution), buffer);
   }
   // Every rank builds the same whole model; a bad scene or mesh stops every rank with the message.
   // What the constructor checks before distributing is decided from that same model, so every

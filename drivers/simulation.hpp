@@ -81,6 +81,10 @@ class Simulation {
   // `comm`: the ranks that run it together (nullptr or one rank: serial).  On N ranks every rank
   // passes the same whole model; each keeps its part and halo (parallel/distribution.hpp).
   Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm = nullptr);
+  // Distributed start (make_simulation): `model` is this rank's part with its halo, made by
+  // `distribution` for the contact buffer `contact_buffer` (m).
+  Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm,
+             std::unique_ptr<Distribution> distribution, double contact_buffer);
   ~Simulation();
 
   // Runs to scene.time.end (writing outputs); never throws NumericalFailure: a failure is
@@ -162,6 +166,10 @@ class Simulation {
   std::uint64_t reference_hash_ = 0;                          // of the whole model's x0
   long startup_peak_rss_kib_ = 0;                             // this rank, end of start-up
 };
+
+// Whether N ranks can start the scene without any rank holding the whole model: every mesh is
+// generated (box, wall, arch, tower) and no body has joints (docs/parallel.md).
+bool distributed_start_possible(const Scene& scene);
 
 // Builds a Simulation from a scene file (meshes loaded or generated).
 std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options,

@@ -809,7 +809,11 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   }
 
   if (const YAML::Node parallel = root["parallel"]) {
-    r.check_keys(parallel, "parallel", {"rebalance_threshold", "redistribute_every"});
+    r.check_keys(parallel, "parallel",
+                 {"rebalance_threshold", "redistribute_every", "distributed_start"});
+    if (parallel["distributed_start"])
+      scene.parallel.distributed_start =
+          r.boolean(parallel["distributed_start"], "parallel.distributed_start");
     if (parallel["rebalance_threshold"])
       scene.parallel.rebalance_threshold =
           r.non_negative(parallel["rebalance_threshold"], "parallel.rebalance_threshold",

@@ -194,6 +194,13 @@ class Communicator {
   template <class T>
   std::vector<T> allgatherv(const std::vector<T>& local, std::vector<int>* counts = nullptr) const;
 
+  // Personalised all-to-all: `outbox[r]` goes to rank r (outbox has size() entries); returns
+  // what every rank sent here, concatenated in rank order.  `sources` (optional) receives the
+  // sending rank of each element.  Elements travel as one MPI type of sizeof(T) bytes, so a
+  // message may hold up to 2^31 − 1 elements whatever their size.
+  template <class T>
+  std::vector<T> exchange(const std::vector<std::vector<T>>& outbox,
+                          std::vector<int>* sources = nullptr) const;
   // Returns root's string on every rank.
   std::string broadcast(const std::string& text, int root = 0) const;
 
@@ -248,6 +255,44 @@ std::vector<T> Communicator::allgather(const T& value) const {
   const int n = detail::mpi_scale<T>();
   MPI_Allgather(&value, n, detail::mpi_type<T>(), all.data(), n, detail::mpi_type<T>(), comm_);
   return all;
+}
+
+template <class T>
+std::vector<T> Communicator::exchange(const std::vector<std::vector<T>>& outbox,
+                                      std::vector<int>* sources) const {
+  static_assert(std::is_trivially_copyable_v<T>, "exchange moves plain values only");
+  FDEM_VERIFY(static_cast<int>(outbox.size()) == size_, "one outbox per rank");
+  std::vector<int> send_counts(size_), send_displs(size_), receive_counts(size_),
+      receive_displs(size_);
+  std::size_t total = 0;
+  for (int r = 0; r < size_; ++r) {
+    send_displs[r] = detail::checked_count(total, 1);
+    send_counts[r] = detail::checked_count(outbox[r].size(), 1);
+    total += outbox[r].size();
+  }
+  std::vector<T> send;
+  send.reserve(total);
+  for (const auto& box : outbox) send.insert(send.end(), box.begin(), box.end());
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_);
+  total = 0;
+  for (int r = 0; r < size_; ++r) {
+    receive_displs[r] = detail::checked_count(total, 1);
+    total += static_cast<std::size_t>(receive_counts[r]);
+  }
+  detail::checked_count(total, 1);
+  std::vector<T> received(total);
+  MPI_Datatype type;
+  MPI_Type_contiguous(static_cast<int>(sizeof(T)), MPI_BYTE, &type);
+  MPI_Type_commit(&type);
+  MPI_Alltoallv(send.data(), send_counts.data(), send_displs.data(), type, received.data(),
+                receive_counts.data(), receive_displs.data(), type, comm_);
+  MPI_Type_free(&type);
+  if (sources) {
+    sources->clear();
+    sources->reserve(total);
+    for (int r = 0; r < size_; ++r) sources->insert(sources->end(), receive_counts[r], r);
+  }
+  return received;
 }
 
 template <class T>

@@ -20,6 +20,7 @@ namespace {
 // Rows as they travel: plain values, node and tet references as global ids.
 struct TetRow {
   GlobalId gid;
+  std::int32_t owner;  // rank that owns it after this redistribution
   GlobalId nodes[4];
   double dm_inv[9];
   double volume0, viscosity;
@@ -28,6 +29,8 @@ struct TetRow {
 };
 struct NodeRow {
   GlobalId gid;
+  GlobalId first_tet;  // smallest tet gid that uses it (fixed)
+  std::int32_t owner;  // the owner of first_tet after this redistribution
   double x[3], x0[3], v[3], prescribed_velocity[3], x_at_detection[3];
   double mass;
   std::int32_t piece;
@@ -131,8 +134,17 @@ double largest_joint_gap(const Model& model) {
 // joints whose first tet they are, and their friction pairs (pairs keyed by their first tet).
 class RowPacker {
  public:
-  RowPacker(const Model& model, const TravellingState& state)
-      : model_(model), state_(state), stamp_(model.nodes.size(), -1) {
+  // `tet_owner`, `node_owner`, `node_first_tet`: per local tet and node, their owners after the
+  // redistribution and the nodes' first tets.
+  RowPacker(const Model& model, const TravellingState& state,
+            const std::vector<std::int32_t>& tet_owner, const std::vector<std::int32_t>& node_owner,
+            const std::vector<GlobalId>& node_first_tet)
+      : model_(model),
+        state_(state),
+        tet_owner_(tet_owner),
+        node_owner_(node_owner),
+        node_first_tet_(node_first_tet),
+        stamp_(model.nodes.size(), -1) {
     const JointArrays& joints = model.joints;
     joint_offsets_.assign(static_cast<std::size_t>(model.tets.size()) + 1, 0);
     for (LocalIndex j = 0; j < joints.size(); ++j) ++joint_offsets_[joints.tets[2 * j] + 1];
@@ -177,6 +189,7 @@ class RowPacker {
     for (LocalIndex t : tet_list) {
       TetRow row{};
       row.gid = tets.gid[t];
+      row.owner = tet_owner_[t];
       for (int c = 0; c < 4; ++c) row.nodes[c] = nodes.gid[tets.nodes[4 * t + c]];
       std::copy_n(&tets.dm_inv[9 * static_cast<std::size_t>(t)], 9, row.dm_inv);
       row.volume0 = tets.volume0[t];
@@ -190,6 +203,8 @@ class RowPacker {
     for (LocalIndex n : node_list) {
       NodeRow row{};
       row.gid = nodes.gid[n];
+      row.first_tet = node_first_tet_[n];
+      row.owner = node_owner_[n];
       for (int k = 0; k < 3; ++k) {
         row.x[k] = nodes.x[3 * n + k];
         row.x0[k] = nodes.x0[3 * n + k];
@@ -229,6 +244,9 @@ class RowPacker {
  private:
   const Model& model_;
   const TravellingState& state_;
+  const std::vector<std::int32_t>& tet_owner_;
+  const std::vector<std::int32_t>& node_owner_;
+  const std::vector<GlobalId>& node_first_tet_;
   std::vector<int> stamp_;
   int mark_ = 0;
   std::vector<std::int64_t> joint_offsets_;
@@ -246,20 +264,28 @@ class RowPacker {
 class OwnerGrid {
  public:
   OwnerGrid(const double origin[3], double cell) : cell_(cell) { std::copy_n(origin, 3, origin_); }
-  // Calls `visit(key)` for each cell a box (lo xyz, hi xyz) grown by `grow` touches.
+  // The cells a box (lo xyz, hi xyz) grown by `grow` touches: first xyz, last xyz.
+  void cell_range(const double* box, double grow, std::int64_t range[6]) const {
+    for (int k = 0; k < 3; ++k) {
+      range[k] = static_cast<std::int64_t>(std::floor((box[k] - grow - origin_[k]) / cell_));
+      range[3 + k] =
+          static_cast<std::int64_t>(std::floor((box[3 + k] + grow - origin_[k]) / cell_));
+    }
+  }
+  // Calls `visit(key, cell)` for each cell a box grown by `grow` touches.
   template <class Visit>
   void cells(const double* box, double grow, Visit&& visit) const {
-    std::int64_t first[3], last[3];
-    for (int k = 0; k < 3; ++k) {
-      first[k] = static_cast<std::int64_t>(std::floor((box[k] - grow - origin_[k]) / cell_));
-      last[k] = static_cast<std::int64_t>(std::floor((box[3 + k] + grow - origin_[k]) / cell_));
-    }
-    for (std::int64_t i = first[0]; i <= last[0]; ++i)
-      for (std::int64_t j = first[1]; j <= last[1]; ++j)
-        for (std::int64_t k = first[2]; k <= last[2]; ++k) visit(key(i, j, k));
+    std::int64_t r[6];
+    cell_range(box, grow, r);
+    for (std::int64_t i = r[0]; i <= r[3]; ++i)
+      for (std::int64_t j = r[1]; j <= r[4]; ++j)
+        for (std::int64_t k = r[2]; k <= r[5]; ++k) {
+          const std::int64_t cell[3] = {i, j, k};
+          visit(key(i, j, k), cell);
+        }
   }
-  void add(std::uint64_t key, std::int32_t rank) {
-    std::vector<std::int32_t>& ranks = owners_[key];
+  void add(const std::int64_t cell[3], std::int32_t rank) {
+    std::vector<std::int32_t>& ranks = owners_[key(cell[0], cell[1], cell[2])];
     if (std::find(ranks.begin(), ranks.end(), rank) == ranks.end()) ranks.push_back(rank);
   }
   const std::vector<std::int32_t>* owners(std::uint64_t key) const {
@@ -279,8 +305,9 @@ class OwnerGrid {
   std::unordered_map<std::uint64_t, std::vector<std::int32_t>> owners_;
 };
 
-struct CellOwner {
-  std::uint64_t key;
+// A claimed cell of the owner grid (integer cell coordinates) and the rank that claims it.
+struct CellClaim {
+  std::int64_t cell[3];
   std::int32_t rank;
 };
 
@@ -294,20 +321,17 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   const TetArrays& tets = global.tets;
   const int ranks = comm_.size(), me = comm_.rank();
   // Node → its smallest tet gid: fixed for the whole run (fracture breaks joints, never tets).
-  GlobalId max_node = -1, max_tet = -1;
-  for (LocalIndex n = 0; n < global.nodes.size(); ++n)
-    max_node = std::max(max_node, global.nodes.gid[n]);
-  for (LocalIndex t = 0; t < tets.size(); ++t) max_tet = std::max(max_tet, tets.gid[t]);
-  node_first_tet_.assign(static_cast<std::size_t>(max_node + 1),
+  // The whole model is in gid order here (local index = gid).
+  node_first_tet_.assign(static_cast<std::size_t>(global.nodes.size()),
                          std::numeric_limits<GlobalId>::max());
   for (LocalIndex t = 0; t < tets.size(); ++t)
     for (int c = 0; c < 4; ++c) {
-      GlobalId& first = node_first_tet_[global.nodes.gid[tets.nodes[4 * t + c]]];
+      GlobalId& first = node_first_tet_[tets.nodes[4 * t + c]];
       first = std::min(first, tets.gid[t]);
     }
 
   // Initial partition: METIS on the element graph (faces and joints, weighted by cost), on rank 0.
-  part_.assign(static_cast<std::size_t>(max_tet + 1), 0);
+  tet_owner_.assign(static_cast<std::size_t>(tets.size()), 0);
   if (ranks > 1) {
     std::string encoded;
     if (me == 0) {
@@ -315,19 +339,22 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
       cost.joint = settings_.joint_cost;
       const ElementGraph graph = element_graph(global, cost, TetAdjacency::shared_face, neighbours);
       const std::vector<std::int32_t> parts = partition_metis(graph, ranks);
-      for (std::int32_t v = 0; v < graph.n_vertices(); ++v)
-        part_[static_cast<std::size_t>(graph.gid[v])] = parts[v];
-      encoded.assign(reinterpret_cast<const char*>(part_.data()),
-                     part_.size() * sizeof(std::int32_t));
+      for (std::int32_t v = 0; v < graph.n_vertices(); ++v) tet_owner_[graph.tet[v]] = parts[v];
+      encoded.assign(reinterpret_cast<const char*>(tet_owner_.data()),
+                     tet_owner_.size() * sizeof(std::int32_t));
     }
     encoded = comm_.broadcast(encoded, 0);
-    std::memcpy(part_.data(), encoded.data(), part_.size() * sizeof(std::int32_t));
+    std::memcpy(tet_owner_.data(), encoded.data(), tet_owner_.size() * sizeof(std::int32_t));
   }
+  node_owner_.resize(node_first_tet_.size());
+  for (std::size_t n = 0; n < node_owner_.size(); ++n)
+    node_owner_[n] = tet_owner_[static_cast<std::size_t>(node_first_tet_[n])];
 
   // This rank's tets: its own and every tet near them (destinations(), all tets known here).
   has_joint_state_ = !global_state.tet_joint_state.empty();
   std::vector<char> rows;
-  RowPacker(global, global_state).pack(destinations(global, true)[me], rows);
+  RowPacker(global, global_state, tet_owner_, node_owner_, node_first_tet_)
+      .pack(destinations(global, true)[me], rows);
   local.materials = global.materials;
   local.pieces = global.pieces;
   local.body_names = global.body_names;
@@ -340,8 +367,66 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   update_report(local);
 }
 
-void Distribution::assemble(const std::vector<char>& rows, Model& model,
-                            TravellingState& state) const {
+Distribution::Distribution(const Communicator& comm, DistributionSettings settings,
+                           DistributedModel start, double buffer, Model& local,
+                           TravellingState& local_state)
+    : comm_(comm), settings_(settings), buffer_(buffer) {
+  // The blocks are the initial partition: every local tet is owned here.
+  tet_owner_.assign(static_cast<std::size_t>(start.model.tets.size()), comm_.rank());
+  node_owner_ = std::move(start.node_owner);
+  node_first_tet_ = std::move(start.node_first_tet);
+  TravellingState state;
+  state.x_at_detection = start.model.nodes.x;
+  local = Model{};
+  local.materials = start.model.materials;
+  local.pieces = start.model.pieces;
+  local.body_names = start.model.body_names;
+  local.body_fixed = start.model.body_fixed;
+  local.gravity = start.model.gravity;
+  local.joint_laws = start.model.joint_laws;
+  migrate(start.model, state, local, local_state);
+  report_.cycles = 1;
+  update_report(local);
+}
+
+// Sends every owned tet (with its rows) to its owner and to the ranks near it, and assembles what
+// arrives into `out` (which may be `model` itself).
+void Distribution::migrate(const Model& model, const TravellingState& state, Model& out,
+                           TravellingState& out_state) {
+  const int ranks = comm_.size();
+  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
+  std::vector<char> send;
+  std::vector<int> send_counts(ranks, 0), send_offsets(ranks, 0);
+  {
+    RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_);
+    for (int p = 0; p < ranks; ++p) {
+      send_offsets[p] = static_cast<int>(send.size());
+      if (!lists[p].empty()) packer.pack(lists[p], send);
+      const std::size_t bytes = send.size() - static_cast<std::size_t>(send_offsets[p]);
+      FDEM_VERIFY(bytes < static_cast<std::size_t>(std::numeric_limits<int>::max()),
+                  "a migration message under 2 GiB");
+      send_counts[p] = static_cast<int>(bytes);
+    }
+  }
+  std::vector<int> receive_counts(ranks, 0), receive_offsets(ranks, 0);
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
+  std::size_t received = 0;
+  for (int p = 0; p < ranks; ++p) {
+    receive_offsets[p] = static_cast<int>(received);
+    received += static_cast<std::size_t>(receive_counts[p]);
+  }
+  FDEM_VERIFY(received < static_cast<std::size_t>(std::numeric_limits<int>::max()),
+              "migration data under 2 GiB per rank");
+  std::vector<char> receive(received);
+  MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, receive.data(),
+                receive_counts.data(), receive_offsets.data(), MPI_BYTE, comm_.handle());
+  send.clear();
+  send.shrink_to_fit();
+  assemble(receive, out, out_state);
+  build_exchange(out);
+}
+
+void Distribution::assemble(const std::vector<char>& rows, Model& model, TravellingState& state) {
   const int me = comm_.rank();
   std::vector<TetRow> tet_rows;
   std::vector<NodeRow> node_rows;
@@ -364,19 +449,23 @@ void Distribution::assemble(const std::vector<char>& rows, Model& model,
   node_rows.erase(std::unique(node_rows.begin(), node_rows.end(), same_gid), node_rows.end());
   // Owned nodes first (integrated here), then ghosts; each range in ascending gid.
   std::stable_partition(node_rows.begin(), node_rows.end(),
-                        [&](const NodeRow& r) { return owner_of_node(r.gid) == me; });
+                        [&](const NodeRow& r) { return r.owner == me; });
 
   NodeArrays& nodes = model.nodes;
   const LocalIndex n_nodes = static_cast<LocalIndex>(node_rows.size());
   nodes.resize(n_nodes);
   nodes.n_owned = 0;
+  node_owner_.resize(static_cast<std::size_t>(n_nodes));
+  node_first_tet_.resize(static_cast<std::size_t>(n_nodes));
   state.x_at_detection.assign(3 * static_cast<std::size_t>(n_nodes), 0.0);
   std::unordered_map<GlobalId, LocalIndex> node_index;
   node_index.reserve(node_rows.size());
   for (LocalIndex n = 0; n < n_nodes; ++n) {
     const NodeRow& r = node_rows[n];
-    if (owner_of_node(r.gid) == me) nodes.n_owned = n + 1;
+    if (r.owner == me) nodes.n_owned = n + 1;
     nodes.gid[n] = r.gid;
+    node_owner_[n] = r.owner;
+    node_first_tet_[n] = r.first_tet;
     for (int k = 0; k < 3; ++k) {
       nodes.x[3 * n + k] = r.x[k];
       nodes.x0[3 * n + k] = r.x0[k];
@@ -398,12 +487,14 @@ void Distribution::assemble(const std::vector<char>& rows, Model& model,
   tets.contact_group.resize(n_tets);
   tets.owned.assign(n_tets, 0);
   tets.active.assign(n_tets, 0);
+  tet_owner_.resize(static_cast<std::size_t>(n_tets));
   state.tet_joint_state.assign(has_joint_state_ ? n_tets : 0, 0);
   std::unordered_map<GlobalId, LocalIndex> tet_index;
   tet_index.reserve(tet_rows.size());
   for (LocalIndex t = 0; t < n_tets; ++t) {
     const TetRow& r = tet_rows[t];
     tets.gid[t] = r.gid;
+    tet_owner_[t] = r.owner;
     bool touches_owned = false;
     for (int c = 0; c < 4; ++c) {
       const auto it = node_index.find(r.nodes[c]);
@@ -417,7 +508,7 @@ void Distribution::assemble(const std::vector<char>& rows, Model& model,
     tets.material[t] = r.material;
     tets.piece[t] = r.piece;
     tets.contact_group[t] = r.contact_group;
-    tets.owned[t] = owner_of_tet(r.gid) == me;
+    tets.owned[t] = r.owner == me;
     tets.active[t] = tets.owned[t] || touches_owned;
     tets.n_owned += tets.owned[t];
     if (has_joint_state_) state.tet_joint_state[t] = r.joint_state;
@@ -477,6 +568,7 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(const Model& mod
                                                                 bool whole) const {
   // Senders: the tets this rank owns, or (at the start, every rank holding the whole model) all.
   const TetArrays& tets = model.tets;
+  const int ranks = comm_.size();
   const auto sends = [&](LocalIndex t) { return whole || tets.is_owned(t); };
   std::vector<double> tet_boxes(6 * static_cast<std::size_t>(tets.size()));
   std::vector<double> sums = {0.0, 0.0};  // Σ extent, count of sending tets
@@ -498,39 +590,75 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(const Model& mod
   const std::vector<double> reach = tet_reach(model, tet_boxes);
   const double grow = 2.5 * buffer_ + joint_gap;
   OwnerGrid grid(origin.data(), 2.0 * sums[0] / std::max(sums[1], 1.0) + grow);
-  // Claims: the cells within reach of each tet, for its (new) owner; exchanged unless all known.
-  std::vector<CellOwner> claims;
+  // Claims: the cells within reach of each tet, for its (new) owner.
+  std::vector<CellClaim> claims;
   {
     std::unordered_map<std::uint64_t, std::vector<std::int32_t>> seen;
     for (LocalIndex t = 0; t < tets.size(); ++t) {
       if (!sends(t)) continue;
-      const std::int32_t p = owner_of_tet(tets.gid[t]);
-      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], reach[t], [&](std::uint64_t key) {
-        std::vector<std::int32_t>& owners_here = seen[key];
-        if (std::find(owners_here.begin(), owners_here.end(), p) == owners_here.end()) {
-          owners_here.push_back(p);
-          claims.push_back({key, p});
-        }
-      });
+      const std::int32_t p = tet_owner_[t];
+      grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], reach[t],
+                 [&](std::uint64_t key, const std::int64_t cell[3]) {
+                   std::vector<std::int32_t>& owners_here = seen[key];
+                   if (std::find(owners_here.begin(), owners_here.end(), p) == owners_here.end()) {
+                     owners_here.push_back(p);
+                     claims.push_back({{cell[0], cell[1], cell[2]}, p});
+                   }
+                 });
     }
   }
-  for (const CellOwner& c : whole ? claims : comm_.allgatherv(claims)) grid.add(c.key, c.rank);
+  if (whole) {
+    for (const CellClaim& c : claims) grid.add(c.cell, c.rank);
+  } else {
+    // Each rank needs the claims on the cells its senders' grown boxes touch: the cell range of
+    // every rank (O(P) numbers) says where to send each claim, so no rank receives the claims of
+    // the whole domain.
+    std::vector<std::int64_t> range(6, 0);  // first xyz, last xyz (last < first: sends nothing)
+    double box[6] = {
+        std::numeric_limits<double>::infinity(),  std::numeric_limits<double>::infinity(),
+        std::numeric_limits<double>::infinity(),  -std::numeric_limits<double>::infinity(),
+        -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    bool any = false;
+    for (LocalIndex t = 0; t < tets.size(); ++t) {
+      if (!sends(t)) continue;
+      any = true;
+      for (int k = 0; k < 3; ++k) {
+        box[k] = std::min(box[k], tet_boxes[6 * static_cast<std::size_t>(t) + k]);
+        box[3 + k] = std::max(box[3 + k], tet_boxes[6 * static_cast<std::size_t>(t) + 3 + k]);
+      }
+    }
+    if (any)
+      grid.cell_range(box, grow, range.data());
+    else
+      range = {0, 0, 0, -1, -1, -1};
+    const std::vector<std::int64_t> ranges = comm_.allgatherv(range);
+    std::vector<std::vector<CellClaim>> outbox(static_cast<std::size_t>(ranks));
+    for (const CellClaim& c : claims)
+      for (int p = 0; p < ranks; ++p) {
+        const std::int64_t* r = &ranges[6 * static_cast<std::size_t>(p)];
+        bool inside = true;
+        for (int k = 0; k < 3; ++k) inside = inside && c.cell[k] >= r[k] && c.cell[k] <= r[3 + k];
+        if (inside) outbox[static_cast<std::size_t>(p)].push_back(c);
+      }
+    for (const CellClaim& c : comm_.exchange(outbox)) grid.add(c.cell, c.rank);
+  }
 
-  std::vector<std::vector<LocalIndex>> lists(static_cast<std::size_t>(comm_.size()));
-  std::vector<LocalIndex> sent_to(static_cast<std::size_t>(comm_.size()), -1);
+  std::vector<std::vector<LocalIndex>> lists(static_cast<std::size_t>(ranks));
+  std::vector<LocalIndex> sent_to(static_cast<std::size_t>(ranks), -1);
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     if (!sends(t)) continue;
-    const int owner = owner_of_tet(tets.gid[t]);
+    const int owner = tet_owner_[t];
     lists[owner].push_back(t);
     sent_to[owner] = t;
-    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], grow, [&](std::uint64_t key) {
-      if (const std::vector<std::int32_t>* owners = grid.owners(key))
-        for (const std::int32_t p : *owners)
-          if (sent_to[p] != t) {
-            sent_to[p] = t;
-            lists[p].push_back(t);
-          }
-    });
+    grid.cells(&tet_boxes[6 * static_cast<std::size_t>(t)], grow,
+               [&](std::uint64_t key, const std::int64_t*) {
+                 if (const std::vector<std::int32_t>* owners = grid.owners(key))
+                   for (const std::int32_t p : *owners)
+                     if (sent_to[p] != t) {
+                       sent_to[p] = t;
+                       lists[p].push_back(t);
+                     }
+               });
   }
   return lists;
 }
@@ -581,44 +709,26 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     const std::vector<GlobalId> all_gids = comm_.allgatherv(gids);
     const std::vector<std::int32_t> parts =
         partition_rcb(all_centroids, all_weights, all_gids, ranks);
-    for (std::size_t i = 0; i < all_gids.size(); ++i) {
-      std::int32_t& owner = part_[static_cast<std::size_t>(all_gids[i])];
-      if (owner != parts[i]) ++migrated;
-      owner = parts[i];
+    // New owners of the held tets and of the first tets of the held nodes.
+    std::unordered_map<GlobalId, std::int32_t> part_of;
+    part_of.reserve(all_gids.size());
+    for (std::size_t i = 0; i < all_gids.size(); ++i) part_of.emplace(all_gids[i], parts[i]);
+    for (LocalIndex t = 0; t < tets.size(); ++t) {
+      const std::int32_t p = part_of.at(tets.gid[t]);
+      if (tets.is_owned(t) && p != tet_owner_[t]) ++migrated;
+      tet_owner_[t] = p;
     }
+    migrated = comm_.sum(static_cast<std::int64_t>(migrated));
+    for (std::size_t n = 0; n < node_owner_.size(); ++n)
+      node_owner_[n] = part_of.at(node_first_tet_[n]);
     report_.imbalance = imbalance(all_weights, parts, ranks);
     ++report_.rebalances;
     report_.migrated_tets += migrated;
   }
 
-  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
-  RowPacker packer(model, state);
-  std::vector<char> send;
-  std::vector<int> send_counts(ranks, 0), send_offsets(ranks, 0);
-  for (int p = 0; p < ranks; ++p) {
-    send_offsets[p] = static_cast<int>(send.size());
-    if (!lists[p].empty()) packer.pack(lists[p], send);
-    const std::size_t bytes = send.size() - static_cast<std::size_t>(send_offsets[p]);
-    FDEM_VERIFY(bytes < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-                "a migration message under 2 GiB");
-    send_counts[p] = static_cast<int>(bytes);
-  }
-  std::vector<int> receive_counts(ranks, 0), receive_offsets(ranks, 0);
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
-  std::size_t received = 0;
-  for (int p = 0; p < ranks; ++p) {
-    receive_offsets[p] = static_cast<int>(received);
-    received += static_cast<std::size_t>(receive_counts[p]);
-  }
-  FDEM_VERIFY(received < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-              "migration data under 2 GiB per rank");
-  std::vector<char> receive(received);
-  MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, receive.data(),
-                receive_counts.data(), receive_offsets.data(), MPI_BYTE, comm_.handle());
-  send.clear();
-  send.shrink_to_fit();
-  assemble(receive, model, state);
-  build_exchange(model);
+  TravellingState arrived;
+  migrate(model, state, model, arrived);
+  state = std::move(arrived);
   ++report_.cycles;
   update_report(model);
 }
@@ -630,7 +740,7 @@ void Distribution::build_exchange(const Model& model) {
   std::vector<std::vector<LocalIndex>> receive(static_cast<std::size_t>(ranks));
   std::vector<std::vector<GlobalId>> request(static_cast<std::size_t>(ranks));
   for (LocalIndex n = nodes.n_owned; n < nodes.size(); ++n) {
-    const int owner = owner_of_node(nodes.gid[n]);
+    const int owner = node_owner_[static_cast<std::size_t>(n)];
     FDEM_VERIFY(owner != comm_.rank(), "a ghost node is owned elsewhere");
     receive[owner].push_back(n);
     request[owner].push_back(nodes.gid[n]);
@@ -729,30 +839,11 @@ void Distribution::update_report(const Model& model) {
 }
 
 std::uint64_t global_state_hash(const NodeArrays& nodes, const Communicator& comm) {
-  struct Row {
-    GlobalId gid;
-    double x[3], v[3];
-  };
-  std::vector<Row> mine(static_cast<std::size_t>(nodes.n_owned));
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    mine[n].gid = nodes.gid[n];
-    for (int k = 0; k < 3; ++k) {
-      mine[n].x[k] = nodes.x[3 * n + k];
-      mine[n].v[k] = nodes.v[3 * n + k];
-    }
-  }
-  const std::vector<Row> all = comm.allgatherv(mine);
-  NodeArrays whole;
-  whole.resize(static_cast<LocalIndex>(all.size()));
-  whole.n_owned = whole.size();
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    whole.gid[i] = all[i].gid;
-    for (int k = 0; k < 3; ++k) {
-      whole.x[3 * i + k] = all[i].x[k];
-      whole.v[3 * i + k] = all[i].v[k];
-    }
-  }
-  return state_hash(whole);
+  return comm.sum(state_hash(nodes));  // unsigned: the sum wraps modulo 2^64, like the local one
+}
+
+std::uint64_t global_reference_hash(const NodeArrays& nodes, const Communicator& comm) {
+  return comm.sum(reference_hash(nodes));
 }
 
 std::int64_t global_fragment_count(const Model& model, const Communicator& comm) {

@@ -1,7 +1,7 @@
 // The distributed model: which rank owns which tet, the halo each rank holds, migration of tets
 // with everything that travels with them, and the per-step ghost exchange (docs/parallel.md).
 //
-// Owner computes.  A tet's owner is part[gid]; a node's owner is the owner of the lowest-gid tet
+// Owner computes.  A tet has one owning rank; a node's owner is the owner of the lowest-gid tet
 // that holds it.  A rank holds every tet whose box comes within a margin of the box of the tets it
 // owns (margin = 2 × the largest tet extent + 2 × the contact buffer), which covers every tet that
 // shares a node with an owned node, every contact partner such a tet can meet before the next
@@ -23,6 +23,7 @@
 #include "core/model.hpp"
 #include "fracture/joint_kernels.hpp"
 #include "parallel/communicator.hpp"
+#include "parallel/distributed_build.hpp"
 
 namespace fdem {
 
@@ -66,6 +67,13 @@ class Distribution {
                const std::vector<std::pair<LocalIndex, LocalIndex>>& neighbours, Model& local,
                TravellingState& local_state);
 
+  // Collective, distributed start: every rank passes its block of the model
+  // (build_distributed_model) and the contact buffer.  The blocks — a Morton space-filling curve
+  // over the tet centroids cut into equal parts — are the initial partition; each rank receives
+  // the halo its tets need from the ranks that own it, and no rank ever holds the whole model.
+  Distribution(const Communicator& comm, DistributionSettings settings, DistributedModel start,
+               double buffer, Model& local, TravellingState& local_state);
+
   // Collective, at a contact-detection cycle: measures the owned cost (a tet costs 1; plus
   // `contact_cost`: the cost of the contact pairs whose first tet it is, in the same unit, or
   // empty), re-partitions when the
@@ -77,10 +85,6 @@ class Distribution {
   void start_halo_exchange(const NodeArrays& nodes);
   void finish_halo_exchange(NodeArrays& nodes);
 
-  int owner_of_tet(GlobalId tet) const { return part_[static_cast<std::size_t>(tet)]; }
-  int owner_of_node(GlobalId node) const {
-    return part_[static_cast<std::size_t>(node_first_tet_[static_cast<std::size_t>(node)])];
-  }
   const DistributionReport& report() const { return report_; }
 
  private:
@@ -89,7 +93,9 @@ class Distribution {
     std::vector<LocalIndex> send, receive;  // local node indices
     std::vector<double> send_buffer, receive_buffer;
   };
-  void assemble(const std::vector<char>& rows, Model& model, TravellingState& state) const;
+  void migrate(const Model& model, const TravellingState& state, Model& out,
+               TravellingState& out_state);
+  void assemble(const std::vector<char>& rows, Model& model, TravellingState& state);
   void build_exchange(const Model& model);
   // Per rank, the local tets to send it: each sending tet to its owner and to every rank that
   // claimed a cell its box grown by 2.5 buffers (+ the widest joint gap) touches; a rank claims
@@ -101,8 +107,12 @@ class Distribution {
   Communicator comm_;
   DistributionSettings settings_;
   double buffer_ = 0.0;
-  std::vector<std::int32_t> part_;        // by tet gid: owning rank
-  std::vector<GlobalId> node_first_tet_;  // by node gid: smallest tet gid holding it (static)
+  // Per local tet: its owner (after a re-partition, its new one).  Per local node: the smallest
+  // tet gid that uses it (fixed for the run) and that tet's owner, which owns the node.  Local
+  // only: no rank keeps a table of the whole model.
+  std::vector<std::int32_t> tet_owner_;
+  std::vector<std::int32_t> node_owner_;
+  std::vector<GlobalId> node_first_tet_;
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
   DistributionReport report_;
@@ -110,8 +120,10 @@ class Distribution {
 };
 
 // Collective: state_hash (core/state_hash.hpp) of the owned nodes of all ranks, the value one rank
-// holding every node computes.
+// holding every node computes (one integer sum-reduction).
 std::uint64_t global_state_hash(const NodeArrays& nodes, const Communicator& comm);
+// Collective: reference_hash of the owned nodes of all ranks.
+std::uint64_t global_reference_hash(const NodeArrays& nodes, const Communicator& comm);
 
 // Collective: count_fragments (core/model.hpp) of the whole model — connected components of tets
 // linked by a shared node or an intact joint — from each rank's owned tets and joints.

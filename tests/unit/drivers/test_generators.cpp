@@ -373,7 +373,8 @@ void require_chunks_give(const MeshSpec& spec, const BodyMesh& expected) {
   std::vector<std::int32_t> tet_piece;
   const BodyMesh whole = mesh_from_chunks(chunks, &tet_piece);
   REQUIRE(whole.coords.size() == expected.coords.size());
-  for (std::size_t i = 0; i < whole.coords.size(); ++i) REQUIRE(whole.coords[i] == expected.coords[i]);
+  for (std::size_t i = 0; i < whole.coords.size(); ++i)
+    REQUIRE(whole.coords[i] == expected.coords[i]);
   REQUIRE(whole.tets == expected.tets);
   std::int32_t n_pieces = 0;
   REQUIRE(tet_piece == connected_pieces(expected.tets,

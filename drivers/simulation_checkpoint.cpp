@@ -1,0 +1,205 @@
+// Checkpoint and restart of a Simulation (parallel/checkpoint.hpp holds the file format): rows
+// keyed by global id, so any rank count can continue any checkpoint; the run scalars make the
+// continuation bit-identical.
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+
+#include "contact/contact_stage.hpp"
+#include "core/error.hpp"
+#include "drivers/simulation.hpp"
+#include "fracture/joint_kernels.hpp"
+#include "fracture/joint_stage.hpp"
+#include "parallel/checkpoint.hpp"
+#include "parallel/communicator.hpp"
+
+namespace fdem {
+
+namespace {
+
+// Local index of the node with global id `gid` (owned and ghost ranges are each in ascending
+// gid), or −1 when this rank does not hold it.
+LocalIndex local_node(const NodeArrays& nodes, GlobalId gid) {
+  const auto owned_end = nodes.gid.begin() + nodes.n_owned;
+  auto it = std::lower_bound(nodes.gid.begin(), owned_end, gid);
+  if (it != owned_end && *it == gid) return static_cast<LocalIndex>(it - nodes.gid.begin());
+  it = std::lower_bound(owned_end, nodes.gid.end(), gid);
+  if (it != nodes.gid.end() && *it == gid) return static_cast<LocalIndex>(it - nodes.gid.begin());
+  return -1;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Checkpoint and restart (parallel/checkpoint.hpp): rows keyed by global id, so any rank count can
+// continue any checkpoint; the run scalars make the continuation bit-identical.
+// ---------------------------------------------------------------------------------------------
+void Simulation::write_checkpoint() {
+  CheckpointHeader header;
+  header.n_nodes = whole_nodes_;
+  header.n_tets = whole_tets_;
+  header.n_joints = whole_joints_;
+  header.reference_hash = reference_hash_;
+  header.doubles = {{"time", time_},
+                    {"time_step", dt_},
+                    {"critical_time_step", dt_critical_},
+                    {"energy_input", energy_input_},
+                    {"kinetic_half_step", kinetic_half_step_},
+                    {"next_frame_time", next_frame_time_},
+                    {"next_energy_time", next_energy_time_},
+                    {"next_checkpoint_time", next_checkpoint_time_},
+                    {"joint_friction_through_previous", joint_friction_.through_previous},
+                    {"joint_friction_first_before", joint_friction_.first_before},
+                    {"joint_friction_started", joint_friction_.started ? 1.0 : 0.0}};
+  for (const auto& [name, value] : ledger_.saved_state())
+    header.doubles.emplace_back("ledger_" + name, value);
+  header.integers = {{"steps", steps_},
+                     {"contact_detected", contact_ && contact_->detected() ? 1 : 0},
+                     {"contact_detections", contact_ ? contact_->detections() : 0}};
+
+  CheckpointRows rows;
+  const NodeArrays& nodes = model_.nodes;
+  const std::vector<double>& at_detection = contact_ ? contact_->x_at_detection() : nodes.x;
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
+    rows.node_gid.push_back(nodes.gid[n]);
+    for (int k = 0; k < 3; ++k) {
+      rows.node_x.push_back(nodes.x[3 * n + k]);
+      rows.node_v.push_back(nodes.v[3 * n + k]);
+      rows.node_x_at_detection.push_back(at_detection[3 * n + k]);
+      rows.node_prescribed_velocity.push_back(nodes.prescribed_velocity[3 * n + k]);
+    }
+  }
+  rows.joint_history_bytes = sizeof(JointHistory);
+  const JointArrays& joint_rows = model_.joints;
+  for (LocalIndex j = 0; j < joint_rows.size(); ++j) {
+    if (!model_.tets.is_owned(joint_rows.tets[2 * j])) continue;
+    rows.joint_gid.push_back(joint_rows.gid[j]);
+    rows.joint_broken.push_back(joint_rows.broken[j]);
+    rows.joint_mode.push_back(joint_rows.mode[j]);
+    rows.joint_failure_time.push_back(joint_rows.failure_time[j]);
+    rows.joint_damage.push_back(joint_rows.damage[j]);
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(&joints_->history()[j]);
+    rows.joint_history.insert(rows.joint_history.end(), bytes, bytes + sizeof(JointHistory));
+  }
+  if (contact_)
+    for (const FrictionEntry& e : contact_->friction_entries()) {
+      const auto it = std::lower_bound(model_.tets.gid.begin(), model_.tets.gid.end(), e.a);
+      if (it == model_.tets.gid.end() || *it != e.a ||
+          !model_.tets.is_owned(static_cast<LocalIndex>(it - model_.tets.gid.begin())))
+        continue;  // the owner of the pair's first tet writes it
+      rows.friction_a.push_back(e.a);
+      rows.friction_b.push_back(e.b);
+      for (int k = 0; k < 3; ++k) rows.friction_spring.push_back(e.spring[k]);
+      rows.friction_stiffness.push_back(e.stiffness);
+    }
+  char name[64];
+  std::snprintf(name, sizeof(name), "checkpoint_%08ld.h5", steps_);
+  const std::string path = (std::filesystem::path(options_.output_dir) / name).string();
+  fdem::write_checkpoint(path, *comm_, header, rows);
+  checkpoints_.push_back(path);
+  // Keep the newest two: the one just written and the previous one.
+  if (checkpoints_.size() > 2 && comm_->rank() == 0) {
+    std::error_code ignored;
+    std::filesystem::remove(checkpoints_[checkpoints_.size() - 3], ignored);
+  }
+}
+
+void Simulation::restore_checkpoint(const std::string& path) {
+  if (!comm_) throw InputError(path + ": a restart needs the MPI environment of the fdem command");
+  const auto [header, rows] = read_checkpoint(path, *comm_);
+  if (header.n_nodes != whole_nodes_ || header.n_tets != whole_tets_ ||
+      header.n_joints != whole_joints_ || header.reference_hash != reference_hash_)
+    throw InputError("checkpoint '" + path + "' was written for a different scene (" +
+                     std::to_string(header.n_nodes) + " nodes, " + std::to_string(header.n_tets) +
+                     " tetrahedra, " + std::to_string(header.n_joints) +
+                     " joints; this scene has " + std::to_string(whole_nodes_) + ", " +
+                     std::to_string(whole_tets_) + ", " + std::to_string(whole_joints_) +
+                     (header.n_nodes == whole_nodes_ ? ", and other reference positions" : "") +
+                     ")");
+  if (header.n_joints > 0 && rows.joint_history_bytes != sizeof(JointHistory))
+    throw InputError("checkpoint '" + path + "' holds joint histories of " +
+                     std::to_string(rows.joint_history_bytes) + " bytes; this fdem uses " +
+                     std::to_string(sizeof(JointHistory)));
+  std::map<std::string, double> doubles;
+  for (const auto& [name, value] : header.doubles) doubles[name] = value;
+  std::map<std::string, std::int64_t> integers;
+  for (const auto& [name, value] : header.integers) integers[name] = value;
+  const auto number = [&](const std::string& name) {
+    const auto it = doubles.find(name);
+    if (it == doubles.end())
+      throw InputError("checkpoint '" + path + "' has no run value '" + name + "'");
+    return it->second;
+  };
+  const auto integer = [&](const std::string& name) {
+    const auto it = integers.find(name);
+    if (it == integers.end())
+      throw InputError("checkpoint '" + path + "' has no run value '" + name + "'");
+    return it->second;
+  };
+  // Rows of the entries held here (all of them when this rank holds the whole model).
+  NodeArrays& nodes = model_.nodes;
+  std::vector<double> at_detection = nodes.x;
+  for (std::size_t i = 0; i < rows.node_gid.size(); ++i) {
+    const LocalIndex local = local_node(nodes, rows.node_gid[i]);
+    if (local < 0) continue;
+    const auto n = static_cast<std::size_t>(local);
+    for (int k = 0; k < 3; ++k) {
+      nodes.x[3 * n + k] = rows.node_x[3 * i + k];
+      nodes.v[3 * n + k] = rows.node_v[3 * i + k];
+      nodes.prescribed_velocity[3 * n + k] = rows.node_prescribed_velocity[3 * i + k];
+      at_detection[3 * n + k] = rows.node_x_at_detection[3 * i + k];
+    }
+  }
+  JointArrays& joint_rows = model_.joints;
+  std::vector<JointHistory> history(static_cast<std::size_t>(joint_rows.size()));
+  for (std::size_t i = 0; i < rows.joint_gid.size(); ++i) {
+    const auto it =
+        std::lower_bound(joint_rows.gid.begin(), joint_rows.gid.end(), rows.joint_gid[i]);
+    if (it == joint_rows.gid.end() || *it != rows.joint_gid[i]) continue;
+    const auto j = static_cast<std::size_t>(it - joint_rows.gid.begin());
+    joint_rows.broken[j] = rows.joint_broken[i];
+    joint_rows.mode[j] = rows.joint_mode[i];
+    joint_rows.failure_time[j] = rows.joint_failure_time[i];
+    joint_rows.damage[j] = rows.joint_damage[i];
+    std::memcpy(&history[j], &rows.joint_history[i * sizeof(JointHistory)], sizeof(JointHistory));
+  }
+  if (joints_) joints_->rebind(model_, std::move(history));
+  if (contact_) {
+    // A tet's joint state: cracked once one of its joints broke, intact while it has joints.
+    std::vector<std::uint8_t> joint_state = contact_->tet_joint_states();
+    for (LocalIndex j = 0; j < joint_rows.size(); ++j)
+      if (joint_rows.broken[j])
+        for (int side = 0; side < 2; ++side) joint_state[joint_rows.tets[2 * j + side]] = 2;
+    std::vector<FrictionEntry> friction;  // the pairs whose first tet is held here
+    for (std::size_t i = 0; i < rows.friction_a.size(); ++i) {
+      if (!std::binary_search(model_.tets.gid.begin(), model_.tets.gid.end(), rows.friction_a[i]))
+        continue;
+      FrictionEntry e;
+      e.a = rows.friction_a[i];
+      e.b = rows.friction_b[i];
+      e.spring = Vec3(rows.friction_spring[3 * i], rows.friction_spring[3 * i + 1],
+                      rows.friction_spring[3 * i + 2]);
+      e.stiffness = rows.friction_stiffness[i];
+      friction.push_back(e);
+    }
+    contact_->rebind(model_, std::move(at_detection), std::move(joint_state), friction,
+                     integer("contact_detected") != 0);
+  }
+  time_ = number("time");
+  steps_ = integer("steps");
+  dt_ = number("time_step");
+  dt_critical_ = number("critical_time_step");
+  energy_input_ = number("energy_input");
+  kinetic_half_step_ = number("kinetic_half_step");
+  next_frame_time_ = number("next_frame_time");
+  next_energy_time_ = number("next_energy_time");
+  next_checkpoint_time_ = number("next_checkpoint_time");
+  joint_friction_.through_previous = number("joint_friction_through_previous");
+  joint_friction_.first_before = number("joint_friction_first_before");
+  joint_friction_.started = number("joint_friction_started") != 0.0;
+  ledger_.restore([&](const std::string& name) { return number("ledger_" + name); });
+}
+
+}  // namespace fdem

@@ -1,0 +1,442 @@
+#include "parallel/distributed_build.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "core/tet_kernels.hpp"
+
+namespace fdem {
+
+namespace {
+
+// A tet on its way to its block: sort key, origin, corners as whole-model mesh node numbers
+// (body node base + number in the body mesh) and corner reference positions.
+struct TetRecord {
+  std::uint64_t key;
+  std::int32_t body, piece;  // piece: model piece index
+  std::int64_t mesh_tet;     // index in its body's mesh
+  std::int64_t node[4];
+  double x[12];  // m
+};
+
+// build_model's order: Morton key, ties by input order (body, then mesh tet).
+struct SortKey {
+  std::uint64_t key;
+  std::int64_t body, mesh_tet;
+};
+bool operator<(const SortKey& a, const SortKey& b) {
+  if (a.key != b.key) return a.key < b.key;
+  if (a.body != b.body) return a.body < b.body;
+  return a.mesh_tet < b.mesh_tet;
+}
+SortKey sort_key(const TetRecord& r) {
+  return {r.key, r.body, r.mesh_tet};
+}
+
+// Rank holding global position g when [block[r], block[r+1]) is rank r's.
+int block_owner(const std::vector<GlobalId>& block, GlobalId g) {
+  return static_cast<int>(std::upper_bound(block.begin(), block.end(), g) - block.begin()) - 1;
+}
+
+// Sample sort of the records of all ranks, cut into the blocks: rank r ends with global positions
+// [block[r], block[r+1]) in order.
+std::vector<TetRecord> sort_into_blocks(std::vector<TetRecord> local,
+                                        const std::vector<GlobalId>& block,
+                                        const Communicator& comm) {
+  const auto less = [](const TetRecord& a, const TetRecord& b) {
+    return sort_key(a) < sort_key(b);
+  };
+  std::sort(local.begin(), local.end(), less);
+  const int ranks = comm.size();
+  if (ranks == 1) return local;
+  // Splitters from regular samples (32 per rank): O(P) keys on every rank.
+  constexpr std::size_t samples_per_rank = 32;
+  std::vector<SortKey> samples;
+  const std::size_t n = local.size(), s = std::min(n, samples_per_rank);
+  for (std::size_t i = 0; i < s; ++i) samples.push_back(sort_key(local[(2 * i + 1) * n / (2 * s)]));
+  std::vector<SortKey> all = comm.allgatherv(samples);
+  std::sort(all.begin(), all.end());
+  std::vector<SortKey> splitters;
+  for (int r = 1; r < ranks && !all.empty(); ++r)
+    splitters.push_back(all[static_cast<std::size_t>(r) * all.size() / ranks]);
+  std::vector<std::vector<TetRecord>> outbox(static_cast<std::size_t>(ranks));
+  for (const TetRecord& r : local) {
+    const auto bucket =
+        std::upper_bound(splitters.begin(), splitters.end(), sort_key(r)) - splitters.begin();
+    outbox[static_cast<std::size_t>(bucket)].push_back(r);
+  }
+  local.clear();
+  local.shrink_to_fit();
+  std::vector<TetRecord> bucket = comm.exchange(outbox);
+  outbox.assign(static_cast<std::size_t>(ranks), {});
+  std::sort(bucket.begin(), bucket.end(), less);
+  // Buckets are in global order by rank: each record's position, and so its block, follows.
+  const std::vector<std::int64_t> counts = comm.allgather(static_cast<std::int64_t>(bucket.size()));
+  const GlobalId first =
+      std::accumulate(counts.begin(), counts.begin() + comm.rank(), std::int64_t{0});
+  for (std::size_t i = 0; i < bucket.size(); ++i)
+    outbox[static_cast<std::size_t>(block_owner(block, first + static_cast<GlobalId>(i)))]
+        .push_back(bucket[i]);
+  bucket.clear();
+  bucket.shrink_to_fit();
+  return comm.exchange(outbox);  // from lower ranks first, each sorted: in order
+}
+
+// A use of a mesh node by a tet corner: use = 4 × tet gid + corner (first use = smallest).
+struct NodeUse {
+  std::int64_t mesh_node, use;
+  double x[3];
+};
+// A mesh node's model gid and its first tet.
+struct NodeNumber {
+  std::int64_t mesh_node;
+  GlobalId gid, first_tet;
+};
+struct MassPart {
+  GlobalId node, tet;
+  double mass;  // kg
+};
+struct NodeMass {
+  GlobalId node;
+  double mass;
+};
+
+// Directory rank of a mesh node (equal ranges of the whole model's mesh node numbers).
+int directory_rank(std::int64_t mesh_node, std::int64_t n_mesh_nodes, int ranks) {
+  return static_cast<int>(static_cast<__int128>(mesh_node) * ranks / n_mesh_nodes);
+}
+
+// Steps 1–2: this rank's chunks generated, shapes checked, keys given.
+std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<BodyChunks>& chunks,
+                                        const std::vector<std::int64_t>& node_base,
+                                        const std::vector<std::int32_t>& piece_base,
+                                        const Communicator& comm) {
+  std::int64_t total = 0;
+  for (const BodyChunks& body : chunks)
+    for (std::int64_t n : body.chunk_tets) total += n;
+  if (total == 0) throw InputError(scene.source_path + ": the scene has no tetrahedra");
+  std::vector<TetRecord> records;
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  comm.run_collectively([&] {
+    std::int64_t before = 0;  // tets of the chunks before this one
+    for (std::size_t b = 0; b < chunks.size(); ++b)
+      for (std::size_t c = 0; c < chunks[b].chunk_tets.size(); ++c) {
+        const std::int64_t tets = chunks[b].chunk_tets[c];
+        // Chunks are dealt in order, each to the rank whose share of the tets it starts in.
+        const int rank = static_cast<int>(static_cast<__int128>(before) * comm.size() / total);
+        before += tets;
+        if (rank != comm.rank()) continue;
+        const MeshChunk chunk = chunks[b].generate(static_cast<std::int64_t>(c));
+        const std::vector<double>& coords = chunk.mesh.coords;
+        for (std::size_t n = 0; n < coords.size() / 3; ++n) {
+          lo = lo.cwiseMin(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
+          hi = hi.cwiseMax(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
+        }
+        for (std::size_t t = 0; t < chunk.mesh.tets.size() / 4; ++t) {
+          TetRecord r{};
+          r.body = static_cast<std::int32_t>(b);
+          r.piece = piece_base[b] + chunk.piece;
+          r.mesh_tet = chunk.first_tet + static_cast<std::int64_t>(t);
+          Vec3 X[4];
+          for (int k = 0; k < 4; ++k) {
+            const LocalIndex n = chunk.mesh.tets[4 * t + k];
+            r.node[k] = node_base[b] + chunk.node_id[static_cast<std::size_t>(n)];
+            X[k] = vec3_at(coords.data(), n);
+            for (int d = 0; d < 3; ++d) r.x[3 * k + d] = X[k][d];
+          }
+          check_tet_shape(X, scene.bodies[b].name, chunk.mesh.source, r.mesh_tet + 1);
+          records.push_back(r);
+        }
+      }
+  });
+  std::vector<double> low(lo.data(), lo.data() + 3), high(hi.data(), hi.data() + 3);
+  comm.min_in_place(low);
+  comm.max_in_place(high);
+  lo = Vec3(low[0], low[1], low[2]);
+  hi = Vec3(high[0], high[1], high[2]);
+  for (TetRecord& r : records) {
+    Vec3 c = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) c += Vec3(r.x[3 * k], r.x[3 * k + 1], r.x[3 * k + 2]);
+    r.key = morton_key(0.25 * c, lo, hi);
+  }
+  return records;
+}
+
+// Step 4: node gids by first use.  Returns, per corner of the local tets, its node's number.
+std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalId first_tet,
+                                     const std::vector<GlobalId>& block, std::int64_t n_mesh_nodes,
+                                     const Communicator& comm, GlobalId* n_nodes) {
+  const int ranks = comm.size();
+  std::vector<std::vector<NodeUse>> uses(static_cast<std::size_t>(ranks));
+  for (std::size_t t = 0; t < tets.size(); ++t)
+    for (int c = 0; c < 4; ++c) {
+      NodeUse u{tets[t].node[c], 4 * (first_tet + static_cast<GlobalId>(t)) + c, {}};
+      std::copy_n(&tets[t].x[3 * c], 3, u.x);
+      uses[static_cast<std::size_t>(directory_rank(u.mesh_node, n_mesh_nodes, ranks))].push_back(u);
+    }
+  // Directory: the first use of each node, and who asked.
+  std::vector<int> asker;
+  std::vector<NodeUse> seen = comm.exchange(uses, &asker);
+  uses.assign(static_cast<std::size_t>(ranks), {});
+  std::vector<std::size_t> order(seen.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return seen[a].mesh_node != seen[b].mesh_node ? seen[a].mesh_node < seen[b].mesh_node
+                                                  : seen[a].use < seen[b].use;
+  });
+  std::vector<std::vector<NodeUse>> firsts(static_cast<std::size_t>(ranks));
+  for (std::size_t i = 0; i < order.size(); ++i)
+    if (i == 0 || seen[order[i]].mesh_node != seen[order[i - 1]].mesh_node)
+      firsts[static_cast<std::size_t>(block_owner(block, seen[order[i]].use / 4))].push_back(
+          seen[order[i]]);
+  // First users' ranks number the nodes they own, in order of first use.
+  std::vector<NodeUse> owned = comm.exchange(firsts);
+  firsts.clear();
+  std::sort(owned.begin(), owned.end(),
+            [](const NodeUse& a, const NodeUse& b) { return a.use < b.use; });
+  const std::vector<std::int64_t> counts = comm.allgather(static_cast<std::int64_t>(owned.size()));
+  const GlobalId base =
+      std::accumulate(counts.begin(), counts.begin() + comm.rank(), std::int64_t{0});
+  *n_nodes = std::accumulate(counts.begin(), counts.end(), std::int64_t{0});
+  std::vector<std::vector<NodeNumber>> numbers(static_cast<std::size_t>(ranks));
+  for (std::size_t i = 0; i < owned.size(); ++i)
+    numbers[static_cast<std::size_t>(directory_rank(owned[i].mesh_node, n_mesh_nodes, ranks))]
+        .push_back({owned[i].mesh_node, base + static_cast<GlobalId>(i), owned[i].use / 4});
+  // Back to the directory, which answers every rank that used the node.
+  std::vector<NodeNumber> known = comm.exchange(numbers);
+  numbers.assign(static_cast<std::size_t>(ranks), {});
+  std::sort(known.begin(), known.end(),
+            [](const NodeNumber& a, const NodeNumber& b) { return a.mesh_node < b.mesh_node; });
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const NodeUse& u = seen[order[i]];
+    const int to = asker[order[i]];
+    bool answered = false;  // one answer per (node, rank): uses of a node are adjacent
+    for (std::size_t j = i; j-- > 0 && seen[order[j]].mesh_node == u.mesh_node;)
+      if (asker[order[j]] == to) answered = true;
+    if (answered) continue;
+    const auto it =
+        std::lower_bound(known.begin(), known.end(), u.mesh_node,
+                         [](const NodeNumber& a, std::int64_t m) { return a.mesh_node < m; });
+    FDEM_VERIFY(it != known.end() && it->mesh_node == u.mesh_node, "every node is numbered");
+    numbers[static_cast<std::size_t>(to)].push_back(*it);
+  }
+  std::vector<NodeNumber> mine = comm.exchange(numbers);
+  std::sort(mine.begin(), mine.end(),
+            [](const NodeNumber& a, const NodeNumber& b) { return a.mesh_node < b.mesh_node; });
+  return mine;
+}
+
+// Step 5b: piece masses and centroids summed tet by tet in gid order along the ranks (rank r
+// continues the sums rank r − 1 reached), as one process summing all tets in order does.
+void sum_pieces(std::vector<PieceInfo>& pieces, const Model& model, const Communicator& comm) {
+  const int me = comm.rank(), ranks = comm.size();
+  std::vector<double> running(4 * pieces.size(), 0.0);
+  constexpr int tag = 51;
+  if (me > 0)
+    MPI_Recv(running.data(), detail::checked_count(running.size(), 1), MPI_DOUBLE, me - 1, tag,
+             comm.handle(), MPI_STATUS_IGNORE);
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    pieces[p].mass = running[4 * p];
+    pieces[p].centroid0 = Vec3(running[4 * p + 1], running[4 * p + 2], running[4 * p + 3]);
+  }
+  const TetArrays& tets = model.tets;
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    Vec3 X[4];
+    for (int c = 0; c < 4; ++c) X[c] = vec3_at(model.nodes.x0.data(), tets.nodes[4 * t + c]);
+    add_to_piece(pieces[static_cast<std::size_t>(tets.piece[t])],
+                 model.materials[tets.material[t]].density * tets.volume0[t], X);
+  }
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    running[4 * p] = pieces[p].mass;
+    for (int k = 0; k < 3; ++k) running[4 * p + 1 + k] = pieces[p].centroid0[k];
+  }
+  if (me + 1 < ranks)
+    MPI_Send(running.data(), detail::checked_count(running.size(), 1), MPI_DOUBLE, me + 1, tag,
+             comm.handle());
+  MPI_Bcast(running.data(), detail::checked_count(running.size(), 1), MPI_DOUBLE, ranks - 1,
+            comm.handle());
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    pieces[p].mass = running[4 * p];
+    pieces[p].centroid0 = Vec3(running[4 * p + 1], running[4 * p + 2], running[4 * p + 3]);
+    finish_piece(pieces[p]);
+  }
+}
+
+}  // namespace
+
+DistributedModel build_distributed_model(const Scene& scene, const std::vector<BodyChunks>& chunks,
+                                         const Communicator& comm) {
+  FDEM_VERIFY(chunks.size() == scene.bodies.size(), "one chunk plan per body");
+  const int ranks = comm.size(), me = comm.rank();
+  DistributedModel out;
+  Model& model = out.model;
+  model = model_frame(scene);
+  std::vector<std::int64_t> node_base(chunks.size() + 1, 0);
+  std::vector<std::int32_t> piece_base(chunks.size() + 1, 0);
+  for (std::size_t b = 0; b < chunks.size(); ++b) {
+    node_base[b + 1] = node_base[b] + chunks[b].n_nodes;
+    piece_base[b + 1] = piece_base[b] + chunks[b].n_pieces;
+    for (std::int32_t p = 0; p < chunks[b].n_pieces; ++p)
+      model.pieces.push_back({static_cast<std::int32_t>(b), p});
+    for (std::int64_t n : chunks[b].chunk_tets) out.n_tets += n;
+  }
+
+  // Steps 1–3: records generated here, sorted into equal blocks of gids.
+  std::vector<TetRecord> records = generate_records(scene, chunks, node_base, piece_base, comm);
+  out.tet_block.resize(static_cast<std::size_t>(ranks) + 1);
+  for (int r = 0; r <= ranks; ++r)
+    out.tet_block[r] = static_cast<GlobalId>(static_cast<__int128>(out.n_tets) * r / ranks);
+  records = sort_into_blocks(std::move(records), out.tet_block, comm);
+  const GlobalId first_tet = out.tet_block[me];
+  FDEM_VERIFY(static_cast<GlobalId>(records.size()) == out.tet_block[me + 1] - first_tet,
+              "a rank receives its block of tets");
+
+  // Step 4: node numbers; local nodes = owned (first used here) then the others, each by gid.
+  const std::vector<NodeNumber> numbers =
+      number_nodes(records, first_tet, out.tet_block, node_base.back(), comm, &out.n_nodes);
+  const auto number_of = [&](std::int64_t mesh_node) -> const NodeNumber& {
+    const auto it =
+        std::lower_bound(numbers.begin(), numbers.end(), mesh_node,
+                         [](const NodeNumber& a, std::int64_t m) { return a.mesh_node < m; });
+    FDEM_VERIFY(it != numbers.end() && it->mesh_node == mesh_node, "a used node has a number");
+    return *it;
+  };
+  struct LocalNode {
+    GlobalId gid, first_tet;
+    const double* x;
+    std::int32_t piece;
+  };
+  std::vector<LocalNode> local_nodes;
+  local_nodes.reserve(numbers.size());
+  for (const TetRecord& r : records)
+    for (int c = 0; c < 4; ++c) {
+      const NodeNumber& n = number_of(r.node[c]);
+      local_nodes.push_back({n.gid, n.first_tet, &r.x[3 * c], r.piece});
+    }
+  const auto owned_here = [&](const LocalNode& n) {
+    return n.first_tet >= first_tet && n.first_tet < out.tet_block[me + 1];
+  };
+  std::sort(local_nodes.begin(), local_nodes.end(), [&](const LocalNode& a, const LocalNode& b) {
+    const bool oa = owned_here(a), ob = owned_here(b);
+    return oa != ob ? oa : a.gid < b.gid;
+  });
+  local_nodes.erase(
+      std::unique(local_nodes.begin(), local_nodes.end(),
+                  [](const LocalNode& a, const LocalNode& b) { return a.gid == b.gid; }),
+      local_nodes.end());
+  NodeArrays& nodes = model.nodes;
+  const LocalIndex n_local = static_cast<LocalIndex>(local_nodes.size());
+  nodes.resize(n_local);
+  nodes.n_owned = 0;
+  out.node_first_tet.resize(static_cast<std::size_t>(n_local));
+  out.node_owner.resize(static_cast<std::size_t>(n_local));
+  for (LocalIndex n = 0; n < n_local; ++n) {
+    const LocalNode& l = local_nodes[n];
+    nodes.gid[n] = l.gid;
+    for (int k = 0; k < 3; ++k) nodes.x0[3 * n + k] = l.x[k];
+    nodes.piece[n] = l.piece;
+    out.node_first_tet[n] = l.first_tet;
+    out.node_owner[n] = block_owner(out.tet_block, l.first_tet);
+    if (out.node_owner[n] == me) nodes.n_owned = n + 1;
+  }
+  nodes.x = nodes.x0;
+  std::fill(nodes.v.begin(), nodes.v.end(), 0.0);
+  std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
+  std::fill(nodes.mass.begin(), nodes.mass.end(), 0.0);
+  std::fill(nodes.constrained.begin(), nodes.constrained.end(), 0);
+  std::fill(nodes.prescribed_velocity.begin(), nodes.prescribed_velocity.end(), 0.0);
+  const auto local_node = [&](GlobalId gid) {
+    const auto owned_end = nodes.gid.begin() + nodes.n_owned;
+    auto it = std::lower_bound(nodes.gid.begin(), owned_end, gid);
+    if (it == owned_end || *it != gid) it = std::lower_bound(owned_end, nodes.gid.end(), gid);
+    FDEM_VERIFY(it != nodes.gid.end() && *it == gid, "a node of a local tet is local");
+    return static_cast<LocalIndex>(it - nodes.gid.begin());
+  };
+
+  // Tets: reference shapes, viscosities; node masses summed at the owners in tet-gid order.
+  TetArrays& tets = model.tets;
+  const LocalIndex n_tets = static_cast<LocalIndex>(records.size());
+  tets.resize(n_tets);
+  tets.n_owned = n_tets;
+  tets.contact_group.resize(n_tets);
+  tets.owned.assign(n_tets, 1);
+  tets.active.assign(n_tets, 1);
+  std::vector<std::vector<MassPart>> parts(static_cast<std::size_t>(ranks));
+  for (LocalIndex t = 0; t < n_tets; ++t) {
+    const TetRecord& r = records[t];
+    const std::int32_t material = scene.bodies[r.body].material;
+    tets.gid[t] = first_tet + t;
+    tets.material[t] = material;
+    tets.piece[t] = tets.contact_group[t] = r.piece;
+    Vec3 X[4];
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = local_node(number_of(r.node[c]).gid);
+      tets.nodes[4 * t + c] = n;
+      X[c] = vec3_at(nodes.x0.data(), n);
+    }
+    const TetSetup setup = setup_tet(X, model.materials[material]);
+    Eigen::Map<Mat3>(tets.dm_inv.data() + 9 * static_cast<std::size_t>(t)) = setup.dm_inv;
+    tets.volume0[t] = setup.volume;
+    tets.viscosity[t] = setup.viscosity;
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = tets.nodes[4 * t + c];
+      parts[static_cast<std::size_t>(out.node_owner[n])].push_back(
+          {nodes.gid[n], tets.gid[t], 0.25 * setup.mass});
+    }
+  }
+  records.clear();
+  records.shrink_to_fit();
+  std::vector<MassPart> arrived = comm.exchange(parts);
+  parts.clear();
+  std::sort(arrived.begin(), arrived.end(), [](const MassPart& a, const MassPart& b) {
+    return a.node != b.node ? a.node < b.node : a.tet < b.tet;
+  });
+  for (const MassPart& p : arrived) nodes.mass[local_node(p.node)] += p.mass;
+  // The other local nodes ask their owners for the mass.
+  std::vector<std::vector<GlobalId>> asks(static_cast<std::size_t>(ranks));
+  for (LocalIndex n = nodes.n_owned; n < n_local; ++n)
+    asks[static_cast<std::size_t>(out.node_owner[n])].push_back(nodes.gid[n]);
+  std::vector<int> asker;
+  const std::vector<GlobalId> asked = comm.exchange(asks, &asker);
+  std::vector<std::vector<NodeMass>> answers(static_cast<std::size_t>(ranks));
+  for (std::size_t i = 0; i < asked.size(); ++i)
+    answers[static_cast<std::size_t>(asker[i])].push_back(
+        {asked[i], nodes.mass[local_node(asked[i])]});
+  for (const NodeMass& m : comm.exchange(answers)) nodes.mass[local_node(m.node)] = m.mass;
+
+  // Pieces, velocities, constraints, force order.
+  sum_pieces(model.pieces, model, comm);
+  set_initial_velocities(scene, model);
+  build_tet_force_order(tets, model.tet_force_order);
+  apply_constraints(scene, model);
+  return out;
+}
+
+double distributed_nth_value(const std::vector<double>& values, std::int64_t k,
+                             const Communicator& comm) {
+  // Non-negative doubles order as their bit patterns: find the smallest pattern v with more than
+  // k values ≤ v.
+  std::vector<std::uint64_t> bits(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    FDEM_VERIFY(values[i] >= 0.0, "distributed_nth_value takes non-negative values");
+    std::memcpy(&bits[i], &values[i], sizeof(double));
+  }
+  std::uint64_t lo = 0, hi = std::numeric_limits<std::uint64_t>::max() >> 1;  // (lo, hi]
+  while (lo < hi) {
+    const std::uint64_t mid = lo + (hi - lo) / 2;
+    std::int64_t count = 0;
+    for (std::uint64_t b : bits) count += b <= mid;
+    if (comm.sum(count) > k)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  double out;
+  std::memcpy(&out, &lo, sizeof(double));
+  return out;
+}
+
+}  // namespace fdem
