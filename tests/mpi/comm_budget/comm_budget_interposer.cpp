@@ -35,19 +35,17 @@ const char* const kPhaseNames[] = {"init",   "startup",    "step",    "redistrib
                                    "output", "checkpoint", "restart", "finish"};
 constexpr int kNamedPhases = sizeof(kPhaseNames) / sizeof(kPhaseNames[0]);
 
-#define FDEM_BUDGET_OPS(X)                                                                         \
-  X(Recv)                                                                                          \
-  X(Irecv)                                                                                         \
-  X(Sendrecv)                                                                                      \
-  X(Sendrecv_replace) X(Bcast) X(Reduce) X(Allreduce) X(Scan) X(Exscan) X(Gather) X(Gatherv)       \
-      X(Scatter) X(Scatterv) X(Allgather) X(Allgatherv) X(Alltoall) X(Alltoallv) X(Alltoallw)      \
-          X(Reduce_scatter) X(Reduce_scatter_block) X(Barrier) X(Neighbor_allgather)               \
-              X(Neighbor_allgatherv) X(Neighbor_alltoall) X(Neighbor_alltoallv) X(Ibcast)          \
-                  X(Ireduce) X(Iallreduce) X(Iallgather) X(Iallgatherv) X(Ialltoall) X(Ialltoallv) \
-                      X(Ibarrier) X(File_read) X(File_read_at) X(File_read_all)                    \
-                          X(File_read_at_all) X(File_read_shared) X(File_read_ordered)             \
-                              X(File_iread) X(File_iread_at) X(File_write) X(File_write_at)        \
-                                  X(File_write_all) X(File_write_at_all)
+// clang-format off
+#define FDEM_BUDGET_OPS(X)                                                                        \
+  X(Recv) X(Irecv) X(Sendrecv) X(Sendrecv_replace) X(Bcast) X(Reduce) X(Allreduce) X(Scan)        \
+  X(Exscan) X(Gather) X(Gatherv) X(Scatter) X(Scatterv) X(Allgather) X(Allgatherv) X(Alltoall)    \
+  X(Alltoallv) X(Alltoallw) X(Reduce_scatter) X(Reduce_scatter_block) X(Barrier)                 \
+  X(Neighbor_allgather) X(Neighbor_allgatherv) X(Neighbor_alltoall) X(Neighbor_alltoallv)         \
+  X(Ibcast) X(Ireduce) X(Iallreduce) X(Iallgather) X(Iallgatherv) X(Ialltoall) X(Ialltoallv)      \
+  X(Ibarrier) X(File_read) X(File_read_at) X(File_read_all) X(File_read_at_all)                   \
+  X(File_read_shared) X(File_read_ordered) X(File_iread) X(File_iread_at) X(File_write)           \
+  X(File_write_at) X(File_write_all) X(File_write_at_all)
+// clang-format on
 
 enum Op : int {
 #define FDEM_BUDGET_ENUM(name) op_##name,
