@@ -177,6 +177,9 @@ struct ParallelSpec {
   // N ranks, generated meshes without joints: each rank builds only its part (false: every rank
   // builds the whole model first, as scenes with Gmsh meshes or joints always do).
   bool distributed_start = true;
+  // Re-partition method (Zoltan): rib (inertial bisection), rcb (coordinate bisection), hsfc
+  // (Hilbert curve: least data moved while partitioning).
+  std::string partitioner = "rib";
 };
 
 struct Scene {

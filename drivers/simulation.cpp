@@ -48,6 +48,16 @@ constexpr double runaway_balance_error = 0.2;
 // Stored energy above this multiple of the energy put in means a mode is growing (see check_state).
 constexpr double runaway_energy_growth = 100.0;
 
+// The distribution's settings from the scene's `parallel` block.
+DistributionSettings distribution_settings(const ParallelSpec& spec) {
+  DistributionSettings settings;
+  settings.rebalance_threshold = spec.rebalance_threshold;
+  settings.partitioner = spec.partitioner == "rcb"    ? GeometricMethod::rcb
+                         : spec.partitioner == "hsfc" ? GeometricMethod::hsfc
+                                                      : GeometricMethod::rib;
+  return settings;
+}
+
 }  // namespace
 
 std::vector<std::string> StagePlan::describe() const {
@@ -143,8 +153,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   // N ranks, whole-model start: everything above came from the whole model (the same on every
   // rank); now keep this rank's part and halo.
   if (!distributed && comm_ && comm_->size() > 1) {
-    DistributionSettings settings;
-    settings.rebalance_threshold = scene_.parallel.rebalance_threshold;
+    const DistributionSettings settings = distribution_settings(scene_.parallel);
     // Blocks that touch at the start should share a rank: the first detection, on the whole
     // model, gives the partitioner those pairs (one rank detects at the same positions in step 0).
     std::vector<std::pair<LocalIndex, LocalIndex>> touching;
@@ -703,7 +712,8 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
     // (parallel/distributed_build).
     std::vector<BodyChunks> chunks;
     comm->run_collectively([&] {
-      for (const BodySpec& body : scene.bodies) chunks.push_back(body_chunks(body.mesh));
+      for (const BodySpec& body : scene.bodies)
+        chunks.push_back(body_chunks(body.mesh, comm->size()));
     });
     DistributedModel start = build_distributed_model(scene, chunks, *comm);
     chunks.clear();
@@ -714,8 +724,7 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
         buffer = ContactStage::auto_buffer(
             distributed_nth_value(ContactStage::tet_sizes(start.model), start.n_tets / 2, *comm));
     }
-    DistributionSettings settings;
-    settings.rebalance_threshold = scene.parallel.rebalance_threshold;
+    const DistributionSettings settings = distribution_settings(scene.parallel);
     Model local;
     TravellingState local_state;
     auto distribution = std::make_unique<Distribution>(*comm, settings, std::move(start), buffer,

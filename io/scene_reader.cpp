@@ -810,7 +810,10 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
 
   if (const YAML::Node parallel = root["parallel"]) {
     r.check_keys(parallel, "parallel",
-                 {"rebalance_threshold", "redistribute_every", "distributed_start"});
+                 {"rebalance_threshold", "redistribute_every", "distributed_start", "partitioner"});
+    if (parallel["partitioner"])
+      scene.parallel.partitioner =
+          r.choice(parallel["partitioner"], "parallel.partitioner", {"rib", "rcb", "hsfc"});
     if (parallel["distributed_start"])
       scene.parallel.distributed_start =
           r.boolean(parallel["distributed_start"], "parallel.distributed_start");

@@ -24,6 +24,7 @@
 #include "fracture/joint_kernels.hpp"
 #include "parallel/communicator.hpp"
 #include "parallel/distributed_build.hpp"
+#include "parallel/zoltan_partition.hpp"
 
 namespace fdem {
 
@@ -38,6 +39,7 @@ struct TravellingState {
 struct DistributionSettings {
   double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this
   double joint_cost = 1.0;            // cost of an intact joint
+  GeometricMethod partitioner = GeometricMethod::rib;  // the re-partition at detection cycles
 };
 
 // What the last (re)distribution did, the same on every rank.
@@ -97,6 +99,9 @@ class Distribution {
                TravellingState& out_state);
   void assemble(const std::vector<char>& rows, Model& model, TravellingState& state);
   void build_exchange(const Model& model);
+  // After a re-partition: the new owner of each node of an owned tet (the new owner of its first
+  // tet), through a directory of tet owners keyed by gid.
+  void update_node_owners(const Model& model);
   // Per rank, the local tets to send it: each sending tet to its owner and to every rank that
   // claimed a cell its box grown by 2.5 buffers (+ the widest joint gap) touches; a rank claims
   // the cells within reach of each tet it will own.  `whole`: every rank holds the whole model
@@ -113,6 +118,7 @@ class Distribution {
   std::vector<std::int32_t> tet_owner_;
   std::vector<std::int32_t> node_owner_;
   std::vector<GlobalId> node_first_tet_;
+  GlobalId n_tets_ = 0;  // tets of the whole model
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
   DistributionReport report_;
