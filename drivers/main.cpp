@@ -8,6 +8,7 @@
 
 #include "contact/contact_stage.hpp"
 #include "core/error.hpp"
+#include "drivers/run_limits.hpp"
 #include "drivers/simulation.hpp"
 #include "fracture/joint_stage.hpp"
 #include "io/scene_reader.hpp"
@@ -42,9 +43,18 @@ int check(const fdem::Scene& scene) {
                 scene.bodies[b].fixed ? ", fixed" : "");
   std::printf("  mesh: %d nodes, %d tetrahedra, %zu discrete elements\n", model.nodes.size(),
               model.tets.size(), model.pieces.size());
-  std::printf("  time: end %g s, step %g s (%s; critical %g s), %ld steps\n", scene.time.end,
-              sim->time_step(), scene.time.auto_step ? "auto" : "fixed", sim->critical_time_step(),
-              static_cast<long>(scene.time.end / sim->time_step() + 0.999999));
+  std::printf("  time: end %g s, step %g s (%s; critical %g s), %ld steps (limit %g)\n",
+              scene.time.end, sim->time_step(), scene.time.auto_step ? "auto" : "fixed",
+              sim->critical_time_step(),
+              fdem::checked_step_count(0.0, scene.time.end, sim->time_step()),
+              scene.limits.max_steps);
+  std::string ceiling_source;
+  const double ceiling = fdem::memory_ceiling_per_rank(scene.limits, 1, &ceiling_source);
+  std::printf("  memory: about %s per rank on 1 rank (limit %s, %s)\n",
+              fdem::format_bytes(
+                  fdem::estimated_bytes_per_rank(fdem::model_size(sim->model()), 1))
+                  .c_str(),
+              fdem::format_bytes(ceiling).c_str(), ceiling_source.c_str());
   if (const fdem::ContactStage* contact = sim->contact_stage()) {
     std::printf("  contact: buffer %g m, penalties", contact->buffer());
     for (std::size_t m = 0; m < model.materials.size(); ++m)

@@ -18,6 +18,7 @@
 #include "drivers/loads.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/run_files.hpp"
+#include "drivers/run_limits.hpp"
 #include "fracture/joint_kernels.hpp"
 #include "fracture/joint_stage.hpp"
 #include "parallel/checkpoint.hpp"
@@ -41,6 +42,18 @@ class Timed {
   StageClock& clock_;
   std::chrono::steady_clock::time_point start_;
 };
+
+// The first of next, next + every, next + 2 every, ... after `now` (s).  Many intervals within
+// one step are skipped at once (the scene reader guarantees every ≥ 1e-12 time.end, so that
+// next + every > next); the same sums as adding `every` one at a time when they are few.
+double next_output_time(double next, double now, double every) {
+  if (next <= now) {
+    const double skipped = std::floor((now - next) / every);
+    if (skipped > 16) next += (skipped - 1) * every;
+  }
+  while (next <= now) next += every;
+  return next;
+}
 
 // A run whose energy balance error exceeds this has blown up (well-resolved runs stay below 1 %).
 constexpr double runaway_balance_error = 0.2;
@@ -114,6 +127,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   next_checkpoint_time_ = scene_.output.checkpoint_every;
   // A restart overwrites the state of the whole model (and of the stages) with the checkpoint's.
   if (!options_.restart_path.empty()) restore_checkpoint(options_.restart_path);
+  check_run_limits();
   // N ranks: everything above came from the whole model (the same on every rank); now keep this
   // rank's part and halo.
   if (comm_ && comm_->size() > 1) {
@@ -296,6 +310,43 @@ void Simulation::restore_checkpoint(const std::string& path) {
   joint_friction_.first_before = number("joint_friction_first_before");
   joint_friction_.started = number("joint_friction_started") != 0.0;
   ledger_.restore([&](const std::string& name) { return number("ledger_" + name); });
+}
+
+// Refuses a run that cannot advance (a restart past time.end) or needs more steps than the
+// scene's limits allow; decided from the whole model, so every rank throws alike.
+void Simulation::check_run_limits() const {
+  if (!options_.restart_path.empty() && !(scene_.time.end > time_)) {
+    std::ostringstream msg;
+    msg << scene_.source_path << ": time.end = " << scene_.time.end
+        << " s is not after the time of the checkpoint '" << options_.restart_path << "' ("
+        << time_ << " s, step " << steps_
+        << "): there is nothing to continue. Set a later time.end (--set time.end=...).";
+    throw InputError(msg.str());
+  }
+  check_step_limit(scene_, time_, dt_, step_origin());
+}
+
+// Where the time step comes from, for messages: the element that sets the elastic critical step
+// and the contact and joint stiffness bounds.
+std::string Simulation::step_origin() const {
+  std::ostringstream out;
+  out.precision(3);
+  if (scene_.time.auto_step)
+    out << "The step is time.safety " << scene_.time.safety << " x the critical step "
+        << dt_critical_ << " s, set by:";
+  else
+    out << "The step is time.step (the critical step is " << dt_critical_ << " s:";
+  const CriticalStep elastic = fdem::critical_time_step(model_);
+  out << " elastic " << elastic.dt << " s at " << describe_tet(model_, elastic.limiting_tet);
+  if (contact_) {
+    out << ", contact " << contact_->critical_time_step(model_) << " s (contact penalties";
+    for (std::size_t m = 0; m < model_.materials.size(); ++m)
+      out << " " << model_.materials[m].name << " " << contact_->material_penalty()[m] << " Pa";
+    out << ")";
+  }
+  if (joints_) out << ", cohesive joints " << joints_->critical_time_step(model_) << " s";
+  out << (scene_.time.auto_step ? "." : ").");
+  return out.str();
 }
 
 bool Simulation::is_root() const {
@@ -700,7 +751,8 @@ void Simulation::write_outputs(bool force) {
   if (steps_ > 0 && (force || energy_time >= next_energy_time_ - 1e-12 * dt_)) {
     files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());
     if (energy_every > 0)
-      while (next_energy_time_ <= energy_time + 1e-12 * dt_) next_energy_time_ += energy_every;
+      next_energy_time_ = next_output_time(next_energy_time_, energy_time + 1e-12 * dt_,
+                                           energy_every);
     else
       next_energy_time_ = scene_.time.end;
   }
@@ -717,13 +769,14 @@ void Simulation::write_outputs(bool force) {
     if (contact_) files_->write_contacts(time_, contact_->records());
     files_->write_bodies_rows(time_, model_, piece_motions(model_, sum_over_ranks));
     if (scene_.output.every > 0)
-      while (next_frame_time_ <= time_ + 1e-12 * dt_) next_frame_time_ += scene_.output.every;
+      next_frame_time_ = next_output_time(next_frame_time_, time_ + 1e-12 * dt_,
+                                          scene_.output.every);
     else
       next_frame_time_ = scene_.time.end;
   }
   const double every = scene_.output.checkpoint_every;
   if (comm_ && every > 0 && steps_ > 0 && time_ >= next_checkpoint_time_ - 1e-12 * dt_) {
-    while (next_checkpoint_time_ <= time_ + 1e-12 * dt_) next_checkpoint_time_ += every;
+    next_checkpoint_time_ = next_output_time(next_checkpoint_time_, time_ + 1e-12 * dt_, every);
     write_checkpoint();
   }
 }
@@ -741,7 +794,7 @@ RunReport Simulation::run() {
       files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields,
                                           comm_ ? comm_->rank() : 0, comm_ ? comm_->size() : 1);
   }
-  const long total_steps = static_cast<long>(std::ceil(scene_.time.end / dt_ - 1e-9));
+  const long total_steps = checked_step_count(0.0, scene_.time.end, dt_);
   RunReport result;
   auto last_progress = wall_start_;
   try {
@@ -801,8 +854,21 @@ RunReport Simulation::run() {
 
 std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options,
                                             const Communicator* comm) {
+  // Memory before any mesh is generated (from the specs), then on the built model (file meshes
+  // are only known once read).  Ranks on different nodes may see different ceilings: decided
+  // collectively.
+  const int ranks = comm ? comm->size() : 1;
+  const int ranks_on_node = comm ? comm->ranks_on_this_node() : 1;
+  const auto check_memory = [&](const ModelSize& size, const char* what) {
+    if (comm && comm->size() > 1)
+      comm->run_collectively([&] { check_memory_limit(scene, size, ranks, ranks_on_node, what); });
+    else
+      check_memory_limit(scene, size, ranks, ranks_on_node, what);
+  };
+  check_memory(estimate_generated_size(scene), "the generated meshes");
   if (!comm || comm->size() == 1) {
     Model model = build_model(scene, load_body_meshes(scene));
+    check_memory(model_size(model), "the model");
     return std::make_unique<Simulation>(scene, std::move(model), std::move(options), comm);
   }
   // Every rank builds the same whole model; a bad scene or mesh stops every rank with the message.
@@ -810,6 +876,7 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
   // rank throws alike there.
   Model model;
   comm->run_collectively([&] { model = build_model(scene, load_body_meshes(scene)); });
+  check_memory(model_size(model), "the model");
   return std::make_unique<Simulation>(scene, std::move(model), std::move(options), comm);
 }
 

@@ -115,6 +115,8 @@ class Simulation {
     n_stages
   };
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
+  void check_run_limits() const;
+  std::string step_origin() const;
   void redistribute();
   TravellingState travelling_state() const;
   void rebind_stages(TravellingState& state, bool detected);
