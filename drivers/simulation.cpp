@@ -15,6 +15,7 @@
 #include "core/model_builder.hpp"
 #include "core/state_hash.hpp"
 #include "core/time_step.hpp"
+#include "drivers/interrupt.hpp"
 #include "drivers/loads.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/run_files.hpp"
@@ -218,6 +219,7 @@ void Simulation::write_checkpoint() {
   const std::string path = (std::filesystem::path(options_.output_dir) / name).string();
   fdem::write_checkpoint(path, *comm_, header, rows);
   checkpoints_.push_back(path);
+  checkpoint_step_ = steps_;
   // Keep the newest two: the one just written and the previous one.
   if (checkpoints_.size() > 2 && comm_->rank() == 0) {
     std::error_code ignored;
@@ -565,7 +567,8 @@ void Simulation::step() {
                   motion.momentum_after.y(),
                   motion.momentum_after.z(),
                   motion.finite ? 0.0 : 1.0,
-                  forces.min_jacobian > 0.0 ? 0.0 : 1.0});
+                  forces.min_jacobian > 0.0 ? 0.0 : 1.0,
+                  interrupt_signal() != 0 ? 1.0 : 0.0});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
@@ -579,6 +582,8 @@ void Simulation::step() {
     motion.momentum_after = Vec3(terms[17], terms[18], terms[19]);
     motion.finite = terms[20] == 0.0;
     bad_tet_ranks = terms[21];
+    // A signal on any rank ends the run after this step on every rank (no extra collective).
+    if (terms[22] > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -621,6 +626,7 @@ void Simulation::step() {
   else
     check_state(forces, motion.finite);
 
+  if (!distribution_) interrupt_ = interrupt_signal();
   time_ += dt_;
   ++steps_;
 }
@@ -748,15 +754,35 @@ void Simulation::write_outputs(bool force) {
   const double energy_time = steps_ > 0 ? time_ - dt_ : 0.0;
   const double energy_every =
       scene_.output.energy_every > 0 ? scene_.output.energy_every : scene_.output.every;
-  if (steps_ > 0 && (force || energy_time >= next_energy_time_ - 1e-12 * dt_)) {
-    files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());
+  const bool energy_row =
+      steps_ > 0 && (force || energy_time >= next_energy_time_ - 1e-12 * dt_);
+  if (energy_row) {
     if (energy_every > 0)
       next_energy_time_ = next_output_time(next_energy_time_, energy_time + 1e-12 * dt_,
                                            energy_every);
     else
       next_energy_time_ = scene_.time.end;
   }
-  if (force || time_ >= next_frame_time_ - 1e-12 * dt_) {
+  const bool frame = force || time_ >= next_frame_time_ - 1e-12 * dt_;
+  if (frame) {
+    if (scene_.output.every > 0)
+      next_frame_time_ = next_output_time(next_frame_time_, time_ + 1e-12 * dt_,
+                                          scene_.output.every);
+    else
+      next_frame_time_ = scene_.time.end;
+  }
+  if (energy_row || frame) write_files(frame, energy_row, energy_time);
+  const double every = scene_.output.checkpoint_every;
+  if (comm_ && every > 0 && steps_ > 0 && time_ >= next_checkpoint_time_ - 1e-12 * dt_) {
+    next_checkpoint_time_ = next_output_time(next_checkpoint_time_, time_ + 1e-12 * dt_, every);
+    write_checkpoint();
+  }
+}
+
+// The energy row and/or the frame (with contacts, cracks and bodies.csv rows) of this step.
+void Simulation::write_files(bool frame, bool energy_row, double energy_time) {
+  std::vector<PieceMotion> motion;
+  if (frame) {
     std::function<void(std::vector<double>&)> sum_over_ranks;
     if (distribution_) {
       if (halo_in_flight_) {  // frames show ghost nodes of owned tets: complete the exchange
@@ -765,19 +791,57 @@ void Simulation::write_outputs(bool force) {
       }
       sum_over_ranks = [this](std::vector<double>& v) { comm_->sum_in_place(v); };
     }
+    motion = piece_motions(model_, sum_over_ranks);
+  }
+  const auto write = [&] {
+    if (energy_row)
+      files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());
+    if (!frame) return;
     files_->write_frame(time_, model_, {}, plan_.joints);
     if (contact_) files_->write_contacts(time_, contact_->records());
-    files_->write_bodies_rows(time_, model_, piece_motions(model_, sum_over_ranks));
-    if (scene_.output.every > 0)
-      next_frame_time_ = next_output_time(next_frame_time_, time_ + 1e-12 * dt_,
-                                          scene_.output.every);
-    else
-      next_frame_time_ = scene_.time.end;
-  }
-  const double every = scene_.output.checkpoint_every;
-  if (comm_ && every > 0 && steps_ > 0 && time_ >= next_checkpoint_time_ - 1e-12 * dt_) {
-    next_checkpoint_time_ = next_output_time(next_checkpoint_time_, time_ + 1e-12 * dt_, every);
+    files_->write_bodies_rows(time_, model_, motion);
+  };
+  // A full disk is seen by the ranks that write: every rank stops together (IoError).
+  if (distribution_)
+    comm_->run_collectively(write);
+  else
+    write();
+}
+
+// After a signal: the frame and energy row of the step reached, a checkpoint to continue from.
+void Simulation::finish_interrupted(RunReport& result) {
+  write_outputs(true);
+  if (comm_ && scene_.output.checkpoint_every > 0 && checkpoint_step_ != steps_)
     write_checkpoint();
+  result = report();
+  result.status = "interrupted";
+  std::ostringstream reason;
+  reason << "interrupted by " << (interrupt_ > 0 ? signal_name(interrupt_) : "a signal")
+         << (interrupt_ > 0 ? "" : " received by another rank") << " at step " << steps_
+         << " (t = " << time_ << " s); ";
+  if (checkpoint_step_ == steps_)
+    reason << "continue with --restart " << checkpoints_.back();
+  else
+    reason << "no checkpoint written (output.checkpoint_every is 0)";
+  result.reason = reason.str();
+}
+
+// summary.json whenever the disk allows; when it does not, the run's status says so.
+void Simulation::write_summary(RunReport& result) {
+  const auto write = [&] { files_->write_summary(result, model_, scene_.name); };
+  try {
+    if (distribution_)
+      comm_->run_collectively(write);
+    else
+      write();
+  } catch (const IoError& failure) {
+    if (result.status == "completed" || result.status == "interrupted") {
+      result.status = "failed";
+      result.io_failure = true;
+      result.reason = std::string("I/O failure: ") + failure.what();
+    } else if (is_root()) {
+      std::fprintf(stderr, "fdem: summary.json not written either: %s\n", failure.what());
+    }
   }
 }
 
@@ -799,7 +863,7 @@ RunReport Simulation::run() {
   auto last_progress = wall_start_;
   try {
     write_outputs(true);
-    while (steps_ < total_steps) {
+    while (steps_ < total_steps && interrupt_ == 0) {
       step();
       write_outputs(steps_ == total_steps);
       const auto now = std::chrono::steady_clock::now();
@@ -817,15 +881,26 @@ RunReport Simulation::run() {
         if (steps_ == total_steps) std::fprintf(stderr, "\n");
       }
     }
-    result = report();
-    result.status = "completed";
+    if (steps_ < total_steps) {
+      if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+      finish_interrupted(result);
+    } else {
+      result = report();
+      result.status = "completed";
+    }
   } catch (const NumericalFailure& failure) {
     if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
     result = report();
     result.status = "failed";
     result.reason = failure.what();
+  } catch (const IoError& failure) {
+    if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+    result = report();
+    result.status = "failed";
+    result.io_failure = true;
+    result.reason = std::string("I/O failure: ") + failure.what();
   }
-  if (files_) files_->write_summary(result, model_, scene_.name);
+  if (files_) write_summary(result);
   if (!options_.quiet && is_root()) {
     std::fprintf(stderr, "\n%-20s %12s %10s %8s\n", "stage", "seconds", "calls", "share");
     double total = 0.0;

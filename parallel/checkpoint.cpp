@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -22,6 +23,7 @@ namespace fdem {
 namespace {
 
 constexpr const char* format_name = "fdem-checkpoint";
+constexpr int io_failure_exit_code = 4;  // README: exit codes
 
 // ---------------------------------------------------------------------------------------------
 // HDF5 plumbing: owned identifiers, silenced automatic error printing, error text.
@@ -106,12 +108,17 @@ std::string hdf5_error_text() {
   return text.empty() ? "no HDF5 error detail" : text;
 }
 
-// Messages name the file the user gave (the final path, also while writing the .tmp).
+// Messages name the file the user gave (the final path, also while writing the .tmp).  A file
+// that cannot be read is bad input (the user named it); one that cannot be written is an I/O
+// failure (disk full, quota, permissions).
 class Context {
  public:
-  explicit Context(std::string path) : path_(std::move(path)) {}
+  enum class Mode { read, write };
+  Context(std::string path, Mode mode) : path_(std::move(path)), mode_(mode) {}
   [[noreturn]] void fail(const std::string& what) const {
-    throw InputError("checkpoint '" + path_ + "': " + what);
+    const std::string message = "checkpoint '" + path_ + "': " + what;
+    if (mode_ == Mode::write) throw IoError(message);
+    throw InputError(message);
   }
   [[noreturn]] void fail_hdf5(const std::string& what) const {
     fail(what + " (HDF5: " + hdf5_error_text() + ")");
@@ -123,6 +130,20 @@ class Context {
   void check_status(herr_t status, const std::string& what) const {
     if (status < 0) fail_hdf5(what);
   }
+  // For the collective data writes, flush and close: the file system may fail them on some ranks
+  // only (the aggregators that write), which then leave the collective sequence at another point
+  // than the others.  A collective error report could pair with HDF5's own collectives and hang,
+  // so on N ranks every rank ends here (exit code 4, I/O failure).  write_checkpoint reserves
+  // the file's space first, so a full disk is normally reported collectively before this.
+  void check_collective_write(herr_t status, const std::string& what) const {
+    if (status >= 0) return;
+    if (abort_comm_ && abort_comm_->size() > 1)
+      abort_comm_->abort_all("I/O failure: checkpoint '" + path_ + "': " + what +
+                                 " (HDF5: " + hdf5_error_text() + ")",
+                             io_failure_exit_code);
+    fail_hdf5(what);
+  }
+  void abort_on(const Communicator& comm) { abort_comm_ = &comm; }
   Handle own(hid_t id, Handle::Closer closer, const std::string& what) const {
     return Handle(check(id, what), closer);
   }
@@ -130,6 +151,8 @@ class Context {
 
  private:
   std::string path_;
+  Mode mode_;
+  const Communicator* abort_comm_ = nullptr;
 };
 
 Handle make_plist(const Context& ctx, hid_t cls) {
@@ -462,9 +485,9 @@ class Writer {
       ctx_.check_status(H5Sselect_none(mem_space.get()), "cannot select in " + what);
     static const T dummy{};
     const void* buffer = data.empty() ? static_cast<const void*>(&dummy) : data.data();
-    ctx_.check_status(H5Dwrite(dataset.get(), native_type<T>(), mem_space.get(), file_space.get(),
-                               dxpl_.get(), buffer),
-                      "cannot write " + what);
+    ctx_.check_collective_write(H5Dwrite(dataset.get(), native_type<T>(), mem_space.get(),
+                                         file_space.get(), dxpl_.get(), buffer),
+                                "cannot write " + what);
   }
 
  private:
@@ -564,9 +587,32 @@ void write_file(const Context& ctx, const std::string& tmp_path, const Communica
 
   // Flush to storage (MPI_File_sync), then close: only a complete file gets the final name.
   comm.run_collectively([&] {
-    ctx.check_status(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "cannot flush '" + tmp_path + "'");
-    ctx.check_status(file.close(), "cannot close '" + tmp_path + "'");
+    ctx.check_collective_write(H5Fflush(file.get(), H5F_SCOPE_GLOBAL),
+                               "cannot flush '" + tmp_path + "'");
+    ctx.check_collective_write(file.close(), "cannot close '" + tmp_path + "'");
   });
+}
+
+// The file's size, about: its datasets (bytes per row) and 1 MiB for metadata.
+double estimated_file_bytes(const CheckpointHeader& header, std::size_t history_bytes,
+                            std::int64_t friction_pairs) {
+  return double(header.n_nodes) * (8 + 4 * 24) +
+         double(header.n_joints) * (8 + 1 + 1 + 8 + 8 + double(history_bytes)) +
+         double(friction_pairs) * (8 + 8 + 24 + 8) + 1048576.0;
+}
+
+// Rank 0: claims `bytes` for `path` and frees them again, so that a full disk (or a file size
+// limit) is found before the collective write, where every rank can report it together.  File
+// systems without fallocate are not probed.
+void reserve_space(const Context& ctx, const std::string& path, double bytes) {
+  const int fd = ::open(path.c_str(), O_CREAT | O_WRONLY | O_TRUNC, 0644);
+  if (fd < 0) ctx.fail("cannot create '" + path + "': " + std::strerror(errno));
+  const int error = ::fallocate(fd, 0, 0, static_cast<off_t>(bytes)) == 0 ? 0 : errno;
+  ::close(fd);
+  std::remove(path.c_str());
+  if (error != 0 && error != EOPNOTSUPP && error != ENOSYS)
+    ctx.fail("no room for the checkpoint (about " + std::to_string(std::llround(bytes / 1e6)) +
+             " MB): " + std::strerror(error));
 }
 
 // Best effort: make the rename itself durable.
@@ -729,7 +775,8 @@ void sort_friction(CheckpointRows& rows) {
 // ---------------------------------------------------------------------------------------------
 void write_checkpoint(const std::string& path, const Communicator& comm,
                       const CheckpointHeader& header, const CheckpointRows& owned) {
-  const Context ctx(path);
+  Context ctx(path, Context::Mode::write);
+  ctx.abort_on(comm);
   const std::string tmp_path = path + ".tmp";
 
   // 1. The caller's rows, first each rank's own, then across ranks (all before any file I/O, so
@@ -773,8 +820,14 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
   rows.friction_spring = owned.friction_spring;
   rows.friction_stiffness = owned.friction_stiffness;
 
-  // 2. The file under its temporary name.  A failure is collective: every rank unwinds (closing
-  //    the file together) and rank 0 removes the partial file.
+  // 2. The file under its temporary name, its space claimed first.  A failure is collective:
+  //    every rank unwinds (closing the file together) and rank 0 removes the partial file.
+  const std::int64_t pairs = comm.sum(static_cast<std::int64_t>(owned.friction_a.size()));
+  comm.run_collectively([&] {
+    if (comm.is_root())
+      reserve_space(ctx, tmp_path,
+                    estimated_file_bytes(header, owned.joint_history_bytes, pairs));
+  });
   {
     const SilenceHdf5Errors silence;
     try {
@@ -799,7 +852,7 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
 
 std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& path,
                                                             const Communicator& comm) {
-  const Context ctx(path);
+  const Context ctx(path, Context::Mode::read);
   const SilenceHdf5Errors silence;
   CheckpointHeader header;
   CheckpointRows rows;

@@ -68,8 +68,8 @@ struct CheckpointRows {
 // have matching lengths, friction pairs have a < b, joint_history_bytes agrees, and the owned
 // node / joint gids of all ranks form exactly 0..n-1 once each.  A violation is a bug of the
 // caller and throws CollectiveInternalError on every rank.  A file that cannot be created or an
-// HDF5 failure throws CollectiveInputError on every rank, naming the file; the .tmp file is then
-// removed and an existing file at `path` is left as it was.
+// HDF5 failure (disk full) throws CollectiveIoError on every rank, naming the file; the .tmp file
+// is then removed and an existing file at `path` is left as it was.
 void write_checkpoint(const std::string& path, const Communicator& comm,
                       const CheckpointHeader& header, const CheckpointRows& owned);
 

@@ -206,7 +206,7 @@ void check_header_equal(const CheckpointHeader& got, const CheckpointHeader& wan
 }
 
 // Runs `body` and returns what this rank caught: "input:<message>", "internal:<message>",
-// "other" or "none".
+// "io:<message>", "other" or "none".
 template <class Body>
 std::string caught(Body&& body) {
   try {
@@ -216,6 +216,8 @@ std::string caught(Body&& body) {
     return std::string("input:") + e.what();
   } catch (const CollectiveInternalError& e) {
     return std::string("internal:") + e.what();
+  } catch (const CollectiveIoError& e) {
+    return std::string("io:") + e.what();
   } catch (...) {
     return "other";
   }
@@ -520,7 +522,7 @@ TEST_CASE("checkpoint: written through a temporary name; other files untouched",
   header.integers[0].second = 400;
   const std::string result = caught([&] { write_checkpoint(newer, comm, header, owned); });
   CHECK(same_on_all_ranks(comm, result));
-  CHECK(result.rfind("input:", 0) == 0);
+  CHECK(result.rfind("io:", 0) == 0);  // a write failure is I/O, not bad input
   CHECK(result.find(newer) != std::string::npos);
   comm.barrier();
   CHECK(file_bytes(newer) == newer_bytes);
