@@ -17,6 +17,7 @@
 #include "core/time_step.hpp"
 #include "drivers/interrupt.hpp"
 #include "drivers/loads.hpp"
+#include "drivers/restart_check.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/run_files.hpp"
 #include "drivers/run_limits.hpp"
@@ -175,6 +176,8 @@ void Simulation::write_checkpoint() {
                     {"joint_friction_started", joint_friction_.started ? 1.0 : 0.0}};
   for (const auto& [name, value] : ledger_.saved_state())
     header.doubles.emplace_back("ledger_" + name, value);
+  for (const auto& [key, value] : restart_scene_values(scene_))  // compared on a restart
+    header.doubles.emplace_back(restart_scene_prefix + key, value);
   header.integers = {{"steps", steps_},
                      {"contact_detected", contact_ && contact_->detected() ? 1 : 0},
                      {"contact_detections", contact_ ? contact_->detections() : 0}};
@@ -243,8 +246,13 @@ void Simulation::restore_checkpoint(const std::string& path) {
     throw InputError("checkpoint '" + path + "' holds joint histories of " +
                      std::to_string(rows.joint_history_bytes) + " bytes; this fdem uses " +
                      std::to_string(sizeof(JointHistory)));
-  std::map<std::string, double> doubles;
+  std::map<std::string, double> doubles, scene_values;
   for (const auto& [name, value] : header.doubles) doubles[name] = value;
+  const std::string prefix = restart_scene_prefix;
+  for (const auto& [name, value] : header.doubles)
+    if (name.rfind(prefix, 0) == 0) scene_values[name.substr(prefix.size())] = value;
+  for (const std::string& warning : compare_restart_scene(scene_, scene_values, path))
+    if (is_root()) std::fprintf(stderr, "fdem: warning: restart: %s\n", warning.c_str());
   std::map<std::string, std::int64_t> integers;
   for (const auto& [name, value] : header.integers) integers[name] = value;
   const auto number = [&](const std::string& name) {
