@@ -178,9 +178,13 @@ void Simulation::write_checkpoint() {
     header.doubles.emplace_back("ledger_" + name, value);
   for (const auto& [key, value] : restart_scene_values(scene_))  // compared on a restart
     header.doubles.emplace_back(restart_scene_prefix + key, value);
+  // The state_hash of the state it holds (as summary.json would give it): verified on restart.
+  const std::uint64_t hash =
+      distribution_ ? global_state_hash(model_.nodes, *comm_) : state_hash(model_.nodes);
   header.integers = {{"steps", steps_},
                      {"contact_detected", contact_ && contact_->detected() ? 1 : 0},
-                     {"contact_detections", contact_ ? contact_->detections() : 0}};
+                     {"contact_detections", contact_ ? contact_->detections() : 0},
+                     {"state_hash", static_cast<std::int64_t>(hash)}};
 
   CheckpointRows rows;
   const NodeArrays& nodes = model_.nodes;
@@ -279,6 +283,11 @@ void Simulation::restore_checkpoint(const std::string& path) {
       at_detection[3 * n + k] = rows.node_x_at_detection[3 * i + k];
     }
   }
+  const std::uint64_t restored = state_hash(nodes);  // the whole model: every node
+  if (static_cast<std::uint64_t>(integer("state_hash")) != restored)
+    throw InputError("checkpoint corrupt: the restored state has state_hash " +
+                     hash_to_hex(restored) + ", the checkpoint '" + path + "' holds " +
+                     hash_to_hex(static_cast<std::uint64_t>(integer("state_hash"))));
   JointArrays& joint_rows = model_.joints;
   std::vector<JointHistory> history(static_cast<std::size_t>(joint_rows.size()));
   for (std::size_t i = 0; i < rows.joint_gid.size(); ++i) {

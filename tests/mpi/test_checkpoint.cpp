@@ -448,15 +448,55 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
     CHECK(message.find("/joints/damage") != std::string::npos);
   }
   SECTION("another format version") {
-    const std::string path = good_copy("version2.h5");
+    const std::string path = good_copy("version1.h5");
     alter(path, [](hid_t file) {
       const hid_t attr = H5Aopen(file, "version", H5P_DEFAULT);
-      const std::int32_t two = 2;
-      CHECK(H5Awrite(attr, H5T_NATIVE_INT32, &two) >= 0);
+      const std::int32_t one = 1;  // before checksums
+      CHECK(H5Awrite(attr, H5T_NATIVE_INT32, &one) >= 0);
       H5Aclose(attr);
     });
     const std::string message = read_error(path);
-    CHECK(message.find("version 2") != std::string::npos);
+    CHECK(message.find("version 1") != std::string::npos);
+  }
+  SECTION("one flipped bit in a dataset: checkpoint corrupt, naming the dataset") {
+    for (const char* dataset : {"/nodes/x", "/nodes/v", "/joints/damage", "/joints/history"}) {
+      const std::string path = good_copy("flipped.h5");
+      if (comm.is_root()) {  // the dataset's bytes in the file (contiguous layout), one bit
+        const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+        const hid_t set = H5Dopen2(file, dataset, H5P_DEFAULT);
+        const haddr_t offset = H5Dget_offset(set);
+        const hsize_t size = H5Dget_storage_size(set);
+        H5Dclose(set);
+        H5Fclose(file);
+        REQUIRE(offset != HADDR_UNDEF);
+        REQUIRE(size > 0);
+        std::fstream bytes(path, std::ios::in | std::ios::out | std::ios::binary);
+        bytes.seekg(static_cast<std::streamoff>(offset + size / 2));
+        char byte = 0;
+        bytes.read(&byte, 1);
+        byte = static_cast<char>(byte ^ 0x10);
+        bytes.seekp(static_cast<std::streamoff>(offset + size / 2));
+        bytes.write(&byte, 1);
+      }
+      comm.barrier();
+      const std::string message = read_error(path);
+      INFO(message);
+      CHECK(message.find(std::string("checkpoint corrupt: dataset ") + dataset) !=
+            std::string::npos);
+    }
+  }
+  SECTION("a changed run value: checkpoint corrupt (header)") {
+    const std::string path = good_copy("run_value.h5");
+    alter(path, [&](hid_t file) {
+      const hid_t run = H5Gopen2(file, "/run", H5P_DEFAULT);
+      const hid_t attr = H5Aopen(run, header.doubles.front().first.c_str(), H5P_DEFAULT);
+      const double changed = header.doubles.front().second + 1.0;
+      CHECK(H5Awrite(attr, H5T_NATIVE_DOUBLE, &changed) >= 0);
+      H5Aclose(attr);
+      H5Gclose(run);
+    });
+    const std::string message = read_error(path);
+    CHECK(message.find("checkpoint corrupt: header") != std::string::npos);
   }
   SECTION("a file cut short") {
     const std::string path = good_copy("cut.h5");
@@ -468,7 +508,7 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
     const std::string path = dir.file("no/such/dir/state.h5");
     const std::string result = caught([&] { write_checkpoint(path, comm, header, owned); });
     CHECK(same_on_all_ranks(comm, result));
-    CHECK(result.rfind("input:", 0) == 0);
+    CHECK(result.rfind("io:", 0) == 0);  // writing: an I/O failure
     CHECK(result.find("'" + path + "'") != std::string::npos);
   }
   SECTION("rows that are not a partition are an internal error on every rank") {
