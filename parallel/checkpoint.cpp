@@ -19,6 +19,7 @@
 
 #include "core/error.hpp"
 #include "parallel/checkpoint_checksum.hpp"
+#include "parallel/checkpoint_seal.hpp"
 
 namespace fdem {
 
@@ -545,12 +546,34 @@ class Writer {
   Handle dxpl_, dcpl_;
 };
 
-void write_file(const Context& ctx, const std::string& tmp_path, const Communicator& comm,
-                const CheckpointHeader& header, const FileBlock& block) {
+// Where every dataset's raw data lies in the file (for the seal).  Collective (metadata reads).
+std::vector<FileRegion> data_regions(const Context& ctx, hid_t file) {
+  std::vector<FileRegion> regions;
+  for (const char* name :
+       {"/nodes/gid", "/nodes/x", "/nodes/v", "/nodes/x_at_detection", "/nodes/prescribed_velocity",
+        "/joints/gid", "/joints/broken", "/joints/mode", "/joints/failure_time", "/joints/damage",
+        "/joints/history", "/friction/a", "/friction/b", "/friction/spring",
+        "/friction/stiffness"}) {
+    Handle dataset = ctx.own(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose,
+                             std::string("cannot open ") + name);
+    const haddr_t address = H5Dget_offset(dataset.get());  // from the start of the file
+    const hsize_t size = H5Dget_storage_size(dataset.get());
+    if (address != HADDR_UNDEF && size > 0)
+      regions.push_back({address, size});
+  }
+  return regions;
+}
+
+// Writes the file; returns where its datasets' raw data lie.
+std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_path,
+                                   const Communicator& comm, const CheckpointHeader& header,
+                                   const FileBlock& block) {
   Handle file;
   comm.run_collectively([&] {
     Handle fapl = make_mpio_access(ctx, comm);
-    file = ctx.own(H5Fcreate(tmp_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
+    Handle fcpl = make_plist(ctx, H5P_FILE_CREATE);  // the userblock holds the seal
+    ctx.check_status(H5Pset_userblock(fcpl.get(), checkpoint_seal_bytes), "cannot set userblock");
+    file = ctx.own(H5Fcreate(tmp_path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), H5Fclose,
                    "cannot create '" + tmp_path + "'");
   });
 
@@ -632,12 +655,15 @@ void write_file(const Context& ctx, const std::string& tmp_path, const Communica
     write.rows(friction.get(), "stiffness", total, 0, rows.friction_stiffness, runs, block.checksums.at("/friction/stiffness"));
   });
 
+  std::vector<FileRegion> regions;
+  comm.run_collectively([&] { regions = data_regions(ctx, file.get()); });
   // Flush to storage (MPI_File_sync), then close: only a complete file gets the final name.
   comm.run_collectively([&] {
     ctx.check_collective_write(H5Fflush(file.get(), H5F_SCOPE_GLOBAL),
                                "cannot flush '" + tmp_path + "'");
     ctx.check_collective_write(file.close(), "cannot close '" + tmp_path + "'");
   });
+  return regions;
 }
 
 // The file's size, about: its datasets (bytes per row) and 1 MiB for metadata.
@@ -885,19 +911,26 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
                     estimated_file_bytes(header, owned.joint_history_bytes,
                                          static_cast<std::int64_t>(block.friction_total)));
   });
+  std::vector<FileRegion> regions;
   {
     const SilenceHdf5Errors silence;
     try {
-      write_file(ctx, tmp_path, comm, header, block);
+      regions = write_file(ctx, tmp_path, comm, header, block);
     } catch (const CollectiveFailure&) {
       if (comm.is_root()) std::remove(tmp_path.c_str());
       throw;
     }
   }
 
-  // 3. The final name: an atomic replace by rank 0, which every rank waits for.
+  // 3. The seal, then the final name: an atomic replace by rank 0, which every rank waits for.
   comm.run_collectively([&] {
     if (!comm.is_root()) return;
+    try {
+      write_checkpoint_seal(tmp_path, regions);
+    } catch (const IoError&) {
+      std::remove(tmp_path.c_str());
+      throw;
+    }
     if (std::rename(tmp_path.c_str(), path.c_str()) != 0) {
       const std::string reason = std::strerror(errno);
       std::remove(tmp_path.c_str());
@@ -914,10 +947,15 @@ std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& p
   CheckpointHeader header;
   CheckpointRows rows;
 
+  SealState sealed = SealState::absent;
   comm.run_collectively([&] {
     std::error_code error;
     if (!std::filesystem::exists(path, error)) ctx.fail("file does not exist");
     if (!std::filesystem::is_regular_file(path, error)) ctx.fail("is not a regular file");
+    // The seal first (rank 0): damaged metadata must not reach HDF5's parser.
+    std::string problem;
+    if (comm.is_root()) sealed = check_checkpoint_seal(path, problem);
+    if (sealed == SealState::damaged) ctx.corrupt(problem);
     const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
     if (is_hdf5 < 0) ctx.fail_hdf5("cannot be opened");
     if (is_hdf5 == 0) ctx.fail("is not an HDF5 file, so not an fdem checkpoint");
@@ -945,6 +983,8 @@ std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& p
     if (version != checkpoint_format_version)
       ctx.fail("has format version " + std::to_string(version) + "; this fdem reads version " +
                std::to_string(checkpoint_format_version));
+    if (comm.is_root() && sealed != SealState::intact)
+      ctx.corrupt("its checksum block (the HDF5 userblock) is missing");
     header.ranks = read.number_attribute<std::int32_t>(root, "/", "ranks");
     header.n_nodes = read.number_attribute<std::int64_t>(root, "/", "n_nodes");
     header.n_tets = read.number_attribute<std::int64_t>(root, "/", "n_tets");
