@@ -205,7 +205,11 @@ std::string describe_tet(const Model& model, LocalIndex tet) {
   if (tet < 0 || tet >= model.tets.size()) return "an element";
   const LocalIndex* n = &model.tets.nodes[4 * static_cast<std::size_t>(tet)];
   const double* x = model.nodes.x.data();
-  // Smallest height = 3 V / largest face area (m).
+  // Smallest height = 3 V / largest face area (m), of the current shape.
+  const Vec3 x0 = vec3_at(x, n[0]);
+  const double volume = std::abs((vec3_at(x, n[1]) - x0)
+                                     .dot((vec3_at(x, n[2]) - x0).cross(vec3_at(x, n[3]) - x0))) /
+                        6.0;
   double largest_area = 0.0;
   for (int skip = 0; skip < 4; ++skip) {
     Vec3 p[3];
@@ -213,8 +217,7 @@ std::string describe_tet(const Model& model, LocalIndex tet) {
       if (i != skip) p[k++] = vec3_at(x, n[i]);
     largest_area = std::max(largest_area, 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm());
   }
-  const double height = largest_area > 0 ? 3.0 * std::abs(model.tets.volume0[tet]) / largest_area
-                                         : 0.0;
+  const double height = largest_area > 0 ? 3.0 * volume / largest_area : 0.0;
   const PieceInfo& piece = model.pieces[model.tets.piece[tet]];
   std::ostringstream out;
   out.precision(3);

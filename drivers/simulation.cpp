@@ -57,6 +57,19 @@ double next_output_time(double next, double now, double every) {
   return next;
 }
 
+// Steps between two checks of the deformed mesh's stable step against the time step (the
+// minimum-step guard, LS-DYNA's DTMIN idea): a pass over the tets like one internal-force pass,
+// so about 1 % of the run time; every 10 steps once the bound is below 0.8 of the step, every
+// step below 0.6, so that a crushing element is caught before it inverts.
+long steps_to_next_stability_check(double bound_over_step) {
+  return bound_over_step < 0.6 ? 1 : bound_over_step < 0.8 ? 10 : 100;
+}
+// The guard fires when the deformed mesh's stable-step bound is below this fraction of the time
+// step.  The bound is conservative (the auto step sits at 0.7–0.9 of the limit found by
+// bisection, docs/architecture.md), so at half the step the true limit is surely passed: no run
+// that would stay stable is stopped.
+constexpr double stable_step_margin = 0.5;
+
 // A run whose energy balance error exceeds this has blown up (well-resolved runs stay below 1 %).
 constexpr double runaway_balance_error = 0.2;
 // Stored energy above this multiple of the energy put in means a mode is growing (see check_state).
@@ -558,7 +571,18 @@ void Simulation::step() {
     halo_in_flight_ = true;
   }
 
+  // Minimum-step guard: has an element been deformed so far that the time step is above its
+  // stable step?  (Checked on x_{n+1}; reported below with the other checks.)
+  CriticalStep deformed;
+  if (steps_ >= next_stability_check_) {
+    deformed = fdem::critical_time_step(model_);
+    next_stability_check_ = steps_ + steps_to_next_stability_check(deformed.dt / dt_);
+  }
+  const bool step_too_large =
+      deformed.limiting_tet >= 0 && deformed.dt < stable_step_margin * dt_;
+
   double bad_tet_ranks = 0.0;  // N ranks: ranks holding an inverted or NaN tet
+  double crushed_ranks = step_too_large ? 1.0 : 0.0;
   // The energy terms of every rank (each counts what it owns) in one reduction.
   if (distribution_) {
     const auto start = std::chrono::steady_clock::now();
@@ -585,7 +609,8 @@ void Simulation::step() {
                   motion.momentum_after.z(),
                   motion.finite ? 0.0 : 1.0,
                   forces.min_jacobian > 0.0 ? 0.0 : 1.0,
-                  interrupt_signal() != 0 ? 1.0 : 0.0});
+                  interrupt_signal() != 0 ? 1.0 : 0.0,
+                  crushed_ranks});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
@@ -601,6 +626,7 @@ void Simulation::step() {
     bad_tet_ranks = terms[21];
     // A signal on any rank ends the run after this step on every rank (no extra collective).
     if (terms[22] > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
+    crushed_ranks = terms[23];
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -642,6 +668,10 @@ void Simulation::step() {
     comm_->run_collectively([&] { check_state(forces, motion.finite); });
   else
     check_state(forces, motion.finite);
+  if (distribution_ && crushed_ranks > 0)
+    comm_->run_collectively([&] { check_stable_step(deformed); });
+  else if (step_too_large)
+    check_stable_step(deformed);
 
   if (!distribution_) interrupt_ = interrupt_signal();
   time_ += dt_;
@@ -655,7 +685,8 @@ void Simulation::start_half_step(NodeArrays& nodes) const {
         nodes.v[3 * n + k] -= 0.5 * dt_ * nodes.f[3 * n + k] / nodes.mass[n];
 }
 
-void Simulation::check_state(const InternalForceSummary& forces, bool velocities_finite) const {
+// What to try after a numerical failure, from the time step against the critical step.
+std::string Simulation::step_advice() const {
   std::ostringstream advice;
   const double ratio = dt_ / dt_critical_;
   advice << " The time step is " << dt_ << " s = " << ratio << " x the critical step "
@@ -666,6 +697,11 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
   else
     advice << ". Try a smaller time.safety (e.g. " << std::min(0.5, 0.5 * scene_.time.safety)
            << "), check for very distorted elements, or slow down prescribed velocities.";
+  return advice.str();
+}
+
+void Simulation::check_state(const InternalForceSummary& forces, bool velocities_finite) const {
+  const std::string advice = step_advice();
   if (!(forces.min_jacobian > 0.0)) {
     const LocalIndex t = forces.min_jacobian_tet;
     const PieceInfo& piece = model_.pieces[model_.tets.piece[t]];
@@ -674,13 +710,13 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
         << model_.tets.gid[t] << " of body '" << model_.body_names[piece.body] << "' (piece "
         << piece.index_in_body << ") "
         << (std::isnan(forces.min_jacobian) ? "has NaN coordinates" : "inverted")
-        << " (det F = " << forces.min_jacobian << ")." << advice.str();
+        << " (det F = " << forces.min_jacobian << ")." << advice;
     throw NumericalFailure(msg.str());
   }
   if (!velocities_finite) {
     std::ostringstream msg;
     msg << "numerical failure at step " << steps_ << " (t = " << time_
-        << " s): velocities became NaN or infinite." << advice.str();
+        << " s): velocities became NaN or infinite." << advice;
     throw NumericalFailure(msg.str());
   }
   // Central difference conserves ½m·v⁻·v⁺ + U even past the stability limit (the kinetic term
@@ -695,7 +731,7 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
     msg << "numerical failure at step " << steps_ << " (t = " << time_
         << " s): the run is unstable — the stored energy " << stored << " J grew to "
         << stored / energy_input_ << " x the energy put in (" << energy_input_
-        << " J): a mode beyond the stability limit is growing." << advice.str();
+        << " J): a mode beyond the stability limit is growing." << advice;
     throw NumericalFailure(msg.str());
   }
   if (steps_ > 10 && ledger_.balance_error() > runaway_balance_error &&
@@ -705,9 +741,21 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
         << " s): the run is unstable — the energy "
         << "balance error reached " << ledger_.balance_error() * 100 << " % (total energy "
         << ledger_.current().total() << " J, initially " << ledger_.initial_total() << " J)."
-        << advice.str();
+        << advice;
     throw NumericalFailure(msg.str());
   }
+}
+
+// Throws NumericalFailure when `deformed` (the stable step of the current shapes) fell below the
+// time step: the run is past its stability limit and would blow up within some steps.
+void Simulation::check_stable_step(const CriticalStep& deformed) const {
+  if (deformed.limiting_tet < 0 || !(deformed.dt < stable_step_margin * dt_)) return;
+  std::ostringstream msg;
+  msg << "numerical failure at step " << steps_ << " (t = " << time_ << " s): the stable time "
+      << "step of the " << (steps_ > 0 ? "deformed " : "") << "mesh is " << deformed.dt
+      << " s, below half the time step (minimum-step guard), set by "
+      << describe_tet(model_, deformed.limiting_tet) << "." << step_advice();
+  throw NumericalFailure(msg.str());
 }
 
 RunReport Simulation::report() const {

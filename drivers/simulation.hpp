@@ -119,6 +119,8 @@ class Simulation {
   };
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
   void check_run_limits() const;
+  std::string step_advice() const;
+  void check_stable_step(const struct CriticalStep& deformed) const;
   std::string step_origin() const;
   void redistribute();
   TravellingState travelling_state() const;
@@ -163,6 +165,7 @@ class Simulation {
   double next_checkpoint_time_ = 0.0;
   std::vector<std::string> checkpoints_;  // written so far; the last two are kept
   long checkpoint_step_ = -1;             // step of the newest checkpoint written
+  long next_stability_check_ = 0;         // step of the next minimum-step guard check
   int interrupt_ = 0;  // signal that ends the run after this step (-1: received by another rank)
   long whole_nodes_ = 0, whole_tets_ = 0, whole_joints_ = 0;  // counts of the whole model
   std::uint64_t reference_hash_ = 0;                          // of the whole model's x0

@@ -139,3 +139,27 @@ TEST_CASE("output intervals that cannot advance time are refused; short ones do 
   INFO(o.err);
   CHECK(o.exit_code == 0);
 }
+
+TEST_CASE("a time step far above the mesh's stable step is stopped at once by the minimum-step "
+          "guard",
+          "[cli][limits]") {
+  TempDir dir;
+  write_text(dir / "scene.yaml", wall);
+  // One unit: no contact, so the critical step is the elastic one.
+  const std::string one_unit =
+      " --set bodies.0.mesh.wall.units_per_course=1 --set bodies.0.mesh.wall.courses=1";
+  const Outcome check = run_fdem(dir, "check scene.yaml" + one_unit);
+  REQUIRE(check.exit_code == 0);
+  const std::string needle = "critical ";
+  const auto at = check.out.find(needle);
+  REQUIRE(at != std::string::npos);
+  const double critical = std::stod(check.out.substr(at + needle.size()));
+  const Outcome o = run_fdem(
+      dir, "run scene.yaml -q -o out --set time.step=" + std::to_string(4.0 * critical) + one_unit);
+  INFO(o.err);
+  CHECK(o.exit_code == 3);
+  CHECK_THAT(o.err, Contains("numerical failure at step 0 "));
+  CHECK_THAT(o.err, Contains("below half the time step (minimum-step guard), set by tetrahedron"));
+  CHECK_THAT(o.err, Contains("of body 'wall'"));
+  CHECK_THAT(o.err, Contains("use time.step: auto or a step below"));
+}
