@@ -182,6 +182,13 @@ struct ParallelSpec {
   std::string partitioner = "rib";
 };
 
+// Ceilings between a valid scene and a runnable one (drivers/run_limits): checked by `fdem check`
+// and `run` before the meshes are generated and again on the built model.
+struct LimitsSpec {
+  double max_steps = 1e8;            // time steps of one run (time.end / time step)
+  double max_memory_per_rank = 0.0;  // bytes; 0: automatic (this machine's memory per rank)
+};
+
 struct Scene {
   std::string name;
   std::string source_path;  // the YAML file, for messages
@@ -194,6 +201,7 @@ struct Scene {
   OutputSpec output;
   double contact_buffer = -1.0;  // m; < 0: automatic
   ParallelSpec parallel;
+  LimitsSpec limits;
 };
 
 }  // namespace fdem

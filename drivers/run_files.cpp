@@ -74,6 +74,7 @@ void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balanc
           << e.dissipated_damping << ',' << e.external_work << ',' << e.total() << ','
           << balance_error << '\n';
   energy_.flush();
+  if (!energy_) throw IoError("cannot write " + directory_ + "/energy.csv (disk full?)");
 }
 
 void RunFiles::write_bodies_rows(double time, const Model& model,
@@ -88,6 +89,7 @@ void RunFiles::write_bodies_rows(double time, const Model& model,
             << m.rotation.x() << ',' << m.rotation.y() << ',' << m.rotation.z() << '\n';
   }
   bodies_.flush();
+  if (!bodies_) throw IoError("cannot write " + directory_ + "/bodies.csv (disk full?)");
 }
 
 std::vector<double> tet_damage(const Model& model) {
