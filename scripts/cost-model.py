@@ -2,7 +2,7 @@
 """Cost model of fdem's step on P ranks, fed with figures measured by scripts/cost-model-measure.sh.
 
   python3 scripts/cost-model.py [MEASURED_DIR] [--alpha S] [--beta B/S] [--alpha-coll S]
-        [--active-halo F] [--csv FILE]
+        [--active-halo F] [--redistribution-every STEPS] [--csv FILE]
 
 MEASURED on this machine (MEASURED_DIR, default out/cost-model):
   t_tet      seconds per tet-step on 1 rank, all stages but output (summary.json "stages")
@@ -151,9 +151,14 @@ def main():
     ap.add_argument("--beta", type=float, default=10e9)
     ap.add_argument("--alpha-coll", type=float, default=2e-6)
     ap.add_argument("--active-halo", type=float, default=0.5)
+    ap.add_argument("--redistribution-every", type=float, default=0,
+                    help="wall: one redistribution every this many steps instead of the measured "
+                         "rate (a settling wall detects rarely; a shaken one every few tens of steps)")
     ap.add_argument("--csv", help="write the predictions here")
     a = ap.parse_args()
     m, mpi = measured(a.measured)
+    if a.redistribution_every > 0:
+        m["wall"]["redistributions_per_step"] = 1.0 / a.redistribution_every
 
     print("MEASURED here (1 rank; busiest of 4 ranks under the PMPI interposer):")
     for scene, x in m.items():
