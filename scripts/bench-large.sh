@@ -48,7 +48,7 @@ EOF
 }
 
 {
-  echo "# bench-large.sh: $tets tets (cells $cells), $steps steps, distributed start-up"
+  echo "# bench-large.sh: $tets tets (cells $cells), $steps steps, distributed start-up on N > 1 ranks"
   echo "# $(date -u +%Y-%m-%dT%H:%M:%SZ) fdem $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo '?')"
   echo "# host $(hostname), $cores cores, MemAvailable $(awk '/MemAvailable/ {print int($2/1024)}' /proc/meminfo) MiB"
   echo "# uptime: $(uptime)"
