@@ -9,7 +9,7 @@
 # Sizes (environment): BLOCK_CELLS (default 40,40,40 = 384,000 tets), BLOCK_STEPS (20),
 # WALL_UNITS, WALL_COURSES, WALL_UNIT_CELLS (default 24, 12, 4,2,2 = 27,792 tets), WALL_STEPS
 # (300: the wall settles, so contact detection and redistribution recur). BUILD_DIR, MPIEXEC,
-# NICE as in bench-memory.sh. ~3 minutes on a shared 2-core machine.
+# NICE as in bench-memory.sh. Under a minute on a shared 2-core machine.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 here="$root/benchmarks/scaling"
