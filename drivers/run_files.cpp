@@ -194,6 +194,7 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
       << ", \"ghost_nodes_max\": " << r.ghost_nodes_max
       << ", \"ghost_nodes_mean\": " << r.ghost_nodes_mean
       << ", \"neighbours_max\": " << r.neighbours_max
+      << ", \"active_elements_max\": " << r.active_elements_max
       << ", \"communication_seconds\": " << JsonNumber{r.communication_seconds} << "},\n";
   j << "  \"memory\": {\"startup_peak_rss_kib_max\": " << r.startup_peak_rss_kib_max
     << ", \"startup_peak_rss_kib_mean\": " << r.startup_peak_rss_kib_mean

@@ -670,6 +670,7 @@ RunReport Simulation::report() const {
     r.ghost_nodes_max = d.ghost_nodes_max;
     r.ghost_nodes_mean = d.ghost_nodes_sum / comm_->size();
     r.neighbours_max = d.neighbours_max;
+    r.active_elements_max = comm_->max(static_cast<std::int64_t>(model_.tet_force_order.size()));
     r.communication_seconds =
         clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;
   } else {
