@@ -217,13 +217,23 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
                                      const NodeDirectory& directory, const Communicator& comm,
                                      GlobalId* n_nodes) {
   const int ranks = comm.size();
-  std::vector<std::vector<NodeUse>> uses(static_cast<std::size_t>(ranks));
+  // This rank's first use of each node it uses (one message per node, not per corner).
+  std::vector<std::pair<std::int64_t, std::int64_t>> corner;  // (mesh node, use)
+  corner.reserve(4 * tets.size());
   for (std::size_t t = 0; t < tets.size(); ++t)
-    for (int c = 0; c < 4; ++c) {
-      NodeUse u{tets[t].node[c], 4 * (first_tet + static_cast<GlobalId>(t)) + c, {}};
-      std::copy_n(&tets[t].x[3 * c], 3, u.x);
-      uses[static_cast<std::size_t>(directory.rank_of(u.x))].push_back(u);
-    }
+    for (int c = 0; c < 4; ++c)
+      corner.emplace_back(tets[t].node[c], 4 * (first_tet + static_cast<GlobalId>(t)) + c);
+  std::sort(corner.begin(), corner.end());
+  std::vector<std::vector<NodeUse>> uses(static_cast<std::size_t>(ranks));
+  for (std::size_t i = 0; i < corner.size(); ++i) {
+    if (i > 0 && corner[i].first == corner[i - 1].first) continue;
+    NodeUse u{corner[i].first, corner[i].second, {}};
+    const TetRecord& r = tets[static_cast<std::size_t>(corner[i].second / 4 - first_tet)];
+    std::copy_n(&r.x[3 * (corner[i].second % 4)], 3, u.x);
+    uses[static_cast<std::size_t>(directory.rank_of(u.x))].push_back(u);
+  }
+  corner.clear();
+  corner.shrink_to_fit();
   // Directory: the first use of each node, and who asked.
   std::vector<int> asker;
   std::vector<NodeUse> seen = comm.exchange(uses, &asker);
@@ -259,11 +269,7 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
             [](const NodeNumber& a, const NodeNumber& b) { return a.mesh_node < b.mesh_node; });
   for (std::size_t i = 0; i < order.size(); ++i) {
     const NodeUse& u = seen[order[i]];
-    const int to = asker[order[i]];
-    bool answered = false;  // one answer per (node, rank): uses of a node are adjacent
-    for (std::size_t j = i; j-- > 0 && seen[order[j]].mesh_node == u.mesh_node;)
-      if (asker[order[j]] == to) answered = true;
-    if (answered) continue;
+    const int to = asker[order[i]];  // each rank sent each of its nodes once
     const auto it =
         std::lower_bound(known.begin(), known.end(), u.mesh_node,
                          [](const NodeNumber& a, std::int64_t m) { return a.mesh_node < m; });

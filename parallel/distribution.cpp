@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -363,7 +364,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   local.body_fixed = global.body_fixed;
   local.gravity = global.gravity;
   local.joint_laws = global.joint_laws;
-  assemble(rows, local, local_state);
+  assemble({&rows}, local, local_state);
   build_exchange(local);
   report_.cycles = 1;
   update_report(local);
@@ -394,23 +395,35 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
 
 // Sends every owned tet (with its rows) to its owner and to the ranks near it, and assembles what
 // arrives into `out` (which may be `model` itself).
-void Distribution::migrate(const Model& model, const TravellingState& state, Model& out,
+void Distribution::migrate(Model& model, TravellingState& state, Model& out,
                            TravellingState& out_state) {
-  const int ranks = comm_.size();
+  const int ranks = comm_.size(), me = comm_.rank();
   const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
-  std::vector<char> send;
+  // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
+  std::vector<char> send, own;
   std::vector<int> send_counts(ranks, 0), send_offsets(ranks, 0);
   {
     RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_);
     for (int p = 0; p < ranks; ++p) {
       send_offsets[p] = static_cast<int>(send.size());
-      if (!lists[p].empty()) packer.pack(lists[p], send);
+      if (lists[p].empty()) continue;
+      if (p == me) {
+        packer.pack(lists[p], own);
+        continue;
+      }
+      packer.pack(lists[p], send);
       const std::size_t bytes = send.size() - static_cast<std::size_t>(send_offsets[p]);
-      FDEM_VERIFY(bytes < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-                  "a migration message under 2 GiB");
+      FDEM_VERIFY(send.size() < static_cast<std::size_t>(std::numeric_limits<int>::max()),
+                  "migration data under 2 GiB per rank");
       send_counts[p] = static_cast<int>(bytes);
     }
   }
+  // The rows hold everything that travels: the source arrays can go before the new ones come.
+  model.nodes = NodeArrays{};
+  model.tets = TetArrays{};
+  model.joints = JointArrays{};
+  model.tet_force_order = {};
+  state = TravellingState{};
   std::vector<int> receive_counts(ranks, 0), receive_offsets(ranks, 0);
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
   std::size_t received = 0;
@@ -425,23 +438,27 @@ void Distribution::migrate(const Model& model, const TravellingState& state, Mod
                 receive_counts.data(), receive_offsets.data(), MPI_BYTE, comm_.handle());
   send.clear();
   send.shrink_to_fit();
-  assemble(receive, out, out_state);
+  assemble({&receive, &own}, out, out_state);
   build_exchange(out);
 }
 
-void Distribution::assemble(const std::vector<char>& rows, Model& model, TravellingState& state) {
+void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
+                            TravellingState& state) {
   const int me = comm_.rank();
   std::vector<TetRow> tet_rows;
   std::vector<NodeRow> node_rows;
   std::vector<JointRow> joint_rows;
   std::vector<FrictionRow> friction_rows;
-  for (const char* p = rows.data(); p < rows.data() + rows.size();) {
-    const BlockHeader header = take<BlockHeader>(p);
-    for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
-    for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
-    for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
-    for (std::int64_t i = 0; i < header.friction; ++i)
-      friction_rows.push_back(take<FrictionRow>(p));
+  for (std::vector<char>* rows : buffers) {
+    for (const char* p = rows->data(); p < rows->data() + rows->size();) {
+      const BlockHeader header = take<BlockHeader>(p);
+      for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
+      for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
+      for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
+      for (std::int64_t i = 0; i < header.friction; ++i)
+        friction_rows.push_back(take<FrictionRow>(p));
+    }
+    *rows = std::vector<char>{};  // parsed: its memory goes back before the arrays are built
   }
   const auto by_gid = [](const auto& a, const auto& b) { return a.gid < b.gid; };
   const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
@@ -706,7 +723,8 @@ void Distribution::redistribute(Model& model, TravellingState& state,
       points.push_back({tets.gid[t], {c[0], c[1], c[2]}, cost[t]});
       point_tet.push_back(t);
     }
-    const std::vector<std::int32_t> parts = partition_geometric(points, comm_, settings_.partitioner);
+    const std::vector<std::int32_t> parts =
+        partition_geometric(points, comm_, settings_.partitioner);
     std::vector<double> part_cost(static_cast<std::size_t>(ranks), 0.0);
     for (std::size_t i = 0; i < parts.size(); ++i) {
       std::int32_t& owner = tet_owner_[point_tet[i]];

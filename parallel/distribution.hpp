@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 #include "contact/contact_stage.hpp"
@@ -95,9 +96,12 @@ class Distribution {
     std::vector<LocalIndex> send, receive;  // local node indices
     std::vector<double> send_buffer, receive_buffer;
   };
-  void migrate(const Model& model, const TravellingState& state, Model& out,
-               TravellingState& out_state);
-  void assemble(const std::vector<char>& rows, Model& model, TravellingState& state);
+  // Sends the owned tets where destinations() says, frees `model`'s mesh arrays and `state` once
+  // packed, and assembles what arrives into `out` (which may be `model`).
+  void migrate(Model& model, TravellingState& state, Model& out, TravellingState& out_state);
+  // Builds `model` from packed rows; empties each buffer once parsed.
+  void assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
+                TravellingState& state);
   void build_exchange(const Model& model);
   // After a re-partition: the new owner of each node of an owned tet (the new owner of its first
   // tet), through a directory of tet owners keyed by gid.
