@@ -178,7 +178,8 @@ struct ParallelSpec {
   // builds the whole model first, as scenes with Gmsh meshes or joints always do).
   bool distributed_start = true;
   // Re-partition method (Zoltan): rib (inertial bisection), rcb (coordinate bisection), hsfc
-  // (Hilbert curve: least data moved while partitioning).
+  // (Hilbert curve: least data moved while partitioning); random (a test mode: each re-partition
+  // scatters the tets to ranks at random — results must not change).
   std::string partitioner = "rib";
 };
 

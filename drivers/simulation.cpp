@@ -83,6 +83,7 @@ DistributionSettings distribution_settings(const ParallelSpec& spec) {
   settings.partitioner = spec.partitioner == "rcb"    ? GeometricMethod::rcb
                          : spec.partitioner == "hsfc" ? GeometricMethod::hsfc
                                                       : GeometricMethod::rib;
+  settings.random_parts = spec.partitioner == "random";
   return settings;
 }
 

@@ -618,9 +618,9 @@ void read_limits(const Reader& r, const YAML::Node& node, LimitsSpec& limits) {
     limits.max_steps = r.positive(node["max_steps"], "limits.max_steps",
                                   "the largest number of time steps of a run");
   if (node["max_memory_per_rank"] && !r.is_auto(node["max_memory_per_rank"]))
-    limits.max_memory_per_rank = r.positive(node["max_memory_per_rank"],
-                                            "limits.max_memory_per_rank",
-                                            "the memory one rank may use (bytes) or 'auto'");
+    limits.max_memory_per_rank =
+        r.positive(node["max_memory_per_rank"], "limits.max_memory_per_rank",
+                   "the memory one rank may use (bytes) or 'auto'");
 }
 
 // An interval must move time forward: t + every must differ from t up to time.end (and a frame
@@ -846,8 +846,8 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     r.check_keys(parallel, "parallel",
                  {"rebalance_threshold", "redistribute_every", "distributed_start", "partitioner"});
     if (parallel["partitioner"])
-      scene.parallel.partitioner =
-          r.choice(parallel["partitioner"], "parallel.partitioner", {"rib", "rcb", "hsfc"});
+      scene.parallel.partitioner = r.choice(parallel["partitioner"], "parallel.partitioner",
+                                            {"rib", "rcb", "hsfc", "random"});
     if (parallel["distributed_start"])
       scene.parallel.distributed_start =
           r.boolean(parallel["distributed_start"], "parallel.distributed_start");

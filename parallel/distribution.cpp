@@ -307,6 +307,23 @@ class OwnerGrid {
   std::unordered_map<std::uint64_t, std::vector<std::int32_t>> owners_;
 };
 
+// The test partitioner: each tet to a rank drawn from its gid and the redistribution cycle, so
+// every re-partition scatters the tets anew (results must not depend on it).
+std::vector<std::int32_t> random_parts(const std::vector<PartitionPoint>& points, long cycle,
+                                       int ranks) {
+  std::vector<std::int32_t> parts;
+  parts.reserve(points.size());
+  for (const PartitionPoint& p : points) {
+    std::uint64_t h = static_cast<std::uint64_t>(p.gid) * 0x9E3779B97F4A7C15ULL +
+                      static_cast<std::uint64_t>(cycle) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= h >> 31;
+    h *= 0xbf58476d1ce4e5b9ULL;
+    h ^= h >> 29;
+    parts.push_back(static_cast<std::int32_t>(h % static_cast<std::uint64_t>(ranks)));
+  }
+  return parts;
+}
+
 // A claimed cell of the owner grid (integer cell coordinates) and the rank that claims it.
 struct CellClaim {
   std::int64_t cell[3];
@@ -724,7 +741,8 @@ void Distribution::redistribute(Model& model, TravellingState& state,
       point_tet.push_back(t);
     }
     const std::vector<std::int32_t> parts =
-        partition_geometric(points, comm_, settings_.partitioner);
+        settings_.random_parts ? random_parts(points, report_.cycles, ranks)
+                               : partition_geometric(points, comm_, settings_.partitioner);
     std::vector<double> part_cost(static_cast<std::size_t>(ranks), 0.0);
     for (std::size_t i = 0; i < parts.size(); ++i) {
       std::int32_t& owner = tet_owner_[point_tet[i]];

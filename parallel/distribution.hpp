@@ -41,6 +41,8 @@ struct DistributionSettings {
   double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this
   double joint_cost = 1.0;            // cost of an intact joint
   GeometricMethod partitioner = GeometricMethod::rib;  // the re-partition at detection cycles
+  // Test mode: every re-partition deals the tets to ranks at random (by gid and cycle).
+  bool random_parts = false;
 };
 
 // What the last (re)distribution did, the same on every rank.
