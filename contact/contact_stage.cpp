@@ -102,10 +102,6 @@ void ContactStage::compute_boxes(const Model& model, const double* x) {
 
 namespace {
 
-inline std::uint64_t pair_key(GlobalId a, GlobalId b) {
-  return (static_cast<std::uint64_t>(a) << 32) ^ static_cast<std::uint64_t>(b);
-}
-
 // True if two tets have a node at the same reference position (nodes split from one mesh node).
 bool share_reference_node(const Model& model, LocalIndex a, LocalIndex b) {
   const double* x0 = model.nodes.x0.data();
@@ -165,10 +161,9 @@ void ContactStage::detect(const Model& model) {
   run_detection(model, model.nodes.x.data());
   // Stick springs of pairs that left the list are released (their energy is dissipated).
   if (!friction_.empty()) {
-    std::unordered_set<std::uint64_t> kept;
+    std::unordered_set<PairId, PairIdHash> kept;
     kept.reserve(pairs_.size());
-    for (const CandidatePair& p : pairs_)
-      kept.insert(pair_key(model.tets.gid[p.a], model.tets.gid[p.b]));
+    for (const CandidatePair& p : pairs_) kept.insert({model.tets.gid[p.a], model.tets.gid[p.b]});
     for (auto it = friction_.begin(); it != friction_.end();) {
       if (kept.count(it->first)) {
         ++it;
@@ -237,7 +232,7 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
   for (LocalIndex t = 0; t < tets.size(); ++t) local.emplace(tets.gid[t], t);
   friction_.clear();
   for (const FrictionEntry& e : friction) {
-    PairFriction& pf = friction_[pair_key(e.a, e.b)];
+    PairFriction& pf = friction_[PairId{e.a, e.b}];
     pf.history.tangential_spring = e.spring;
     pf.stiffness = e.stiffness;
     const auto it = local.find(e.a);
@@ -254,8 +249,8 @@ std::vector<FrictionEntry> ContactStage::friction_entries() const {
   out.reserve(friction_.size());
   for (const auto& [key, pf] : friction_) {
     FrictionEntry e;
-    e.a = static_cast<GlobalId>(key >> 32);
-    e.b = static_cast<GlobalId>(key & 0xffffffffULL);
+    e.a = key.a;
+    e.b = key.b;
     e.spring = pf.history.tangential_spring;
     e.stiffness = pf.stiffness;
     out.push_back(e);
@@ -326,7 +321,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     const double penalty = std::min(penalty_[ma], penalty_[mb]);
     const double mu = std::min(friction_coefficient_[ma], friction_coefficient_[mb]);
     const ContactPairResult r = potential_contact(a, b, penalty);
-    const std::uint64_t key = pair_key(tets.gid[pair.a], tets.gid[pair.b]);
+    const PairId key{tets.gid[pair.a], tets.gid[pair.b]};
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
     if (!r.overlapping) {

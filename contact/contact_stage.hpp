@@ -120,7 +120,20 @@ class ContactStage {
     double stiffness = 0.0;  // N/m, for the energy released when the pair ends
     bool owned = true;       // this rank owns tet a: it reports the pair's energies
   };
-  std::unordered_map<std::uint64_t, PairFriction> friction_;
+  // Key of a pair: both tets' global ids in full (64-bit each, any model size).
+  struct PairId {
+    GlobalId a, b;
+    bool operator==(const PairId& other) const { return a == other.a && b == other.b; }
+  };
+  struct PairIdHash {
+    std::size_t operator()(const PairId& p) const {
+      std::uint64_t h = static_cast<std::uint64_t>(p.a) * 0x9E3779B97F4A7C15ULL ^
+                        static_cast<std::uint64_t>(p.b) * 0xC2B2AE3D27D4EB4FULL;
+      h ^= h >> 29;
+      return static_cast<std::size_t>(h * 0xbf58476d1ce4e5b9ULL);
+    }
+  };
+  std::unordered_map<PairId, PairFriction, PairIdHash> friction_;
   double released_spring_energy_ = 0.0;  // J, springs of pairs dropped at the last detection
   std::vector<double> friction_coefficient_, damping_ratio_;
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1

@@ -958,22 +958,30 @@ std::int64_t global_fragment_count(const Model& model, const Communicator& comm)
   if (comm.sum(joint_count) == 0) return static_cast<std::int64_t>(model.pieces.size());
   const std::vector<Link> all_links = comm.allgatherv(links);
   const std::vector<GlobalId> all_tet_nodes = comm.allgatherv(tet_nodes);
-  GlobalId largest = -1;
-  for (const Link& l : all_links) largest = std::max({largest, l.a, l.b});
-  for (GlobalId n : all_tet_nodes) largest = std::max(largest, n);
-  std::vector<GlobalId> parent(static_cast<std::size_t>(largest + 1));
+  // Union-find over the node gids that occur, numbered densely (gids may be sparse or large).
+  std::vector<GlobalId> ids(all_tet_nodes);
+  for (const Link& l : all_links) {
+    ids.push_back(l.a);
+    ids.push_back(l.b);
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  const auto dense = [&](GlobalId gid) {
+    return static_cast<std::size_t>(std::lower_bound(ids.begin(), ids.end(), gid) - ids.begin());
+  };
+  std::vector<std::size_t> parent(ids.size());
   std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&](GlobalId i) {
+  const auto find = [&](std::size_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
   for (const Link& l : all_links) {
-    const GlobalId a = find(l.a), b = find(l.b);
+    const std::size_t a = find(dense(l.a)), b = find(dense(l.b));
     if (a != b) parent[std::max(a, b)] = std::min(a, b);
   }
-  std::vector<GlobalId> roots;
+  std::vector<std::size_t> roots;
   roots.reserve(all_tet_nodes.size());
-  for (GlobalId n : all_tet_nodes) roots.push_back(find(n));
+  for (GlobalId n : all_tet_nodes) roots.push_back(find(dense(n)));
   std::sort(roots.begin(), roots.end());
   return static_cast<std::int64_t>(std::unique(roots.begin(), roots.end()) - roots.begin());
 }

@@ -1,0 +1,81 @@
+// The contact stage keys friction history by the two tets' 64-bit global ids: a model whose ids
+// lie above 2^32 (a model of more than four billion tets, or ids offset for a test) keeps and
+// hands back each pair's history under its own ids.
+#include <catch2/catch.hpp>
+
+#include "contact/contact_stage.hpp"
+#include "core/model_builder.hpp"
+
+using namespace fdem;
+
+namespace {
+
+// A box of 6 Kuhn tets (one cell), corners lo and hi.
+BodyMesh cell(const Vec3& lo, const Vec3& hi) {
+  BodyMesh mesh;
+  mesh.source = "test";
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i)
+        for (int d = 0; d < 3; ++d) {
+          const int bit = d == 0 ? i : d == 1 ? j : k;
+          mesh.coords.push_back(bit ? hi[d] : lo[d]);
+        }
+  // Kuhn subdivision along the diagonal 0–7, positively oriented.
+  const LocalIndex tets[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
+                                 {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
+  for (const auto& t : tets) mesh.tets.insert(mesh.tets.end(), t, t + 4);
+  return mesh;
+}
+
+BodySpec body(const std::string& name) {
+  BodySpec b;
+  b.name = name;
+  b.material = 0;
+  return b;
+}
+
+}  // namespace
+
+TEST_CASE("friction history keyed by global ids above 2^32 survives re-detection",
+          "[contact][stage]") {
+  Scene scene;
+  scene.source_path = "test";
+  MaterialSpec stone;
+  stone.name = "stone";
+  stone.density = 2500;
+  stone.elastic.young = 1e8;
+  stone.elastic.poisson = 0.2;
+  stone.contact.friction = 0.6;
+  scene.materials.push_back(stone);
+  scene.bodies = {body("base"), body("block")};
+  Model model = build_model(scene, {cell(Vec3(0, 0, 0), Vec3(1, 1, 0.2)),
+                                    cell(Vec3(0.2, 0.2, 0.199), Vec3(0.7, 0.7, 0.5))});
+  const GlobalId offset = GlobalId{1} << 33;  // ids above 2^32, low 32 bits equal to the old ones
+  for (GlobalId& g : model.tets.gid) g += offset;
+  for (GlobalId& g : model.nodes.gid) g += offset;
+  build_tet_force_order(model.tets, model.tet_force_order);
+
+  ContactStage stage(model, ContactSettings{0.02});
+  stage.detect(model);
+  REQUIRE(!stage.candidates().empty());
+  std::vector<FrictionEntry> entries;
+  for (const CandidatePair& p : stage.candidates()) {
+    FrictionEntry e;
+    e.a = model.tets.gid[p.a];
+    e.b = model.tets.gid[p.b];
+    e.spring = Vec3(1e-6, -2e-6, 0.0);
+    e.stiffness = 3e5;
+    entries.push_back(e);
+  }
+  stage.rebind(model, model.nodes.x, {}, entries, true);  // repeats the detection
+  const std::vector<FrictionEntry> back = stage.friction_entries();
+  REQUIRE(back.size() == entries.size());
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    CHECK(back[i].a == entries[i].a);
+    CHECK(back[i].b == entries[i].b);
+    CHECK(back[i].a >= offset);
+    CHECK(back[i].spring == entries[i].spring);
+    CHECK(back[i].stiffness == entries[i].stiffness);
+  }
+}
