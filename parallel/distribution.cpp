@@ -56,6 +56,9 @@ struct BlockHeader {
   std::int64_t tets = 0, nodes = 0, joints = 0, friction = 0;
 };
 static_assert(std::is_trivially_copyable_v<JointHistory>, "joint history travels as bytes");
+static_assert(sizeof(TetRow) % 8 == 0 && sizeof(NodeRow) % 8 == 0 && sizeof(JointRow) % 8 == 0 &&
+                  sizeof(FrictionRow) % 8 == 0 && sizeof(BlockHeader) % 8 == 0,
+              "rows travel as 8-byte words");
 
 template <class T>
 void append(std::vector<char>& out, const T& value) {
@@ -422,17 +425,18 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   {
     RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_);
     for (int p = 0; p < ranks; ++p) {
-      send_offsets[p] = static_cast<int>(send.size());
+      send_offsets[p] = static_cast<int>(send.size() / 8);
       if (lists[p].empty()) continue;
       if (p == me) {
         packer.pack(lists[p], own);
         continue;
       }
       packer.pack(lists[p], send);
-      const std::size_t bytes = send.size() - static_cast<std::size_t>(send_offsets[p]);
-      FDEM_VERIFY(send.size() < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-                  "migration data under 2 GiB per rank");
-      send_counts[p] = static_cast<int>(bytes);
+      // Counts in 8-byte words (every row is a multiple of 8 bytes): up to 16 GiB per rank.
+      const std::size_t words = (send.size() - static_cast<std::size_t>(send_offsets[p]) * 8) / 8;
+      FDEM_VERIFY(send.size() / 8 < static_cast<std::size_t>(std::numeric_limits<int>::max()),
+                  "migration data under 16 GiB per rank");
+      send_counts[p] = static_cast<int>(words);
     }
   }
   // The rows hold everything that travels: the source arrays can go before the new ones come.
@@ -443,16 +447,20 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   state = TravellingState{};
   std::vector<int> receive_counts(ranks, 0), receive_offsets(ranks, 0);
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
-  std::size_t received = 0;
+  std::size_t received = 0;  // words
   for (int p = 0; p < ranks; ++p) {
     receive_offsets[p] = static_cast<int>(received);
     received += static_cast<std::size_t>(receive_counts[p]);
   }
   FDEM_VERIFY(received < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-              "migration data under 2 GiB per rank");
-  std::vector<char> receive(received);
-  MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), MPI_BYTE, receive.data(),
-                receive_counts.data(), receive_offsets.data(), MPI_BYTE, comm_.handle());
+              "migration data under 16 GiB per rank");
+  std::vector<char> receive(8 * received);
+  MPI_Datatype word;
+  MPI_Type_contiguous(8, MPI_BYTE, &word);
+  MPI_Type_commit(&word);
+  MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), word, receive.data(),
+                receive_counts.data(), receive_offsets.data(), word, comm_.handle());
+  MPI_Type_free(&word);
   send.clear();
   send.shrink_to_fit();
   assemble({&receive, &own}, out, out_state);
