@@ -6,6 +6,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "core/checked_cast.hpp"
 #include "core/error.hpp"
 #include "core/tet_kernels.hpp"
 #include "io/gmsh_reader.hpp"
@@ -192,9 +193,11 @@ std::vector<MeshUnit> arch_units(const ArchMeshSpec& arch) {
     // (same cells, so it conforms), its foot is horizontal, `height` below the inner corner.
     const double c = std::cos(theta[0]), s = std::sin(theta[0]);
     const double size = t / arch.cells[0];
-    const int cells[3] = {arch.cells[0],
-                          std::max(1, static_cast<int>(std::lround(arch.abutment_height / size))),
-                          arch.cells[2]};
+    const auto high = to_integer<int>(std::max(1.0, std::round(arch.abutment_height / size)));
+    if (!high)
+      throw InputError("arch generator: abutments " + std::to_string(arch.abutment_height) +
+                       " m high need more cells than a mesh can have");
+    const int cells[3] = {arch.cells[0], *high, arch.cells[2]};
     for (double side : {1.0, -1.0}) {
       const auto at = [&](double x_rel, double z_rel) {  // mirror x about the arch's axis
         return Eigen::Vector2d(o.x() + side * x_rel, o.z() + z_rel);
