@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "contact/contact_stage.hpp"
@@ -595,7 +597,8 @@ void Simulation::write_outputs(bool force) {
       }
       sum_over_ranks = [this](std::vector<double>& v) { comm_->sum_in_place(v); };
     }
-    files_->write_frame(time_, model_, {}, plan_.joints);
+    files_->write_frame(time_, model_, {}, plan_.joints,
+                        distribution_ ? distribution_->node_owners() : std::vector<std::int32_t>{});
     if (contact_) files_->write_contacts(time_, contact_->records());
     files_->write_bodies_rows(time_, model_, piece_motions(model_, sum_over_ranks));
     if (scene_.output.every > 0)
@@ -615,15 +618,20 @@ void Simulation::write_outputs(bool force) {
 RunReport Simulation::run() {
   wall_start_ = std::chrono::steady_clock::now();
   if (options_.write_output) {
+    std::optional<XdmfFrames> xdmf;
+    if (scene_.output.format == OutputSpec::FrameFormat::xdmf)
+      xdmf = XdmfFrames{
+          comm_, merge_mpi_io_hints(scene_.output.mpi_io_hints, std::getenv("FDEM_MPIIO_HINTS"))};
     if (comm_)  // rank 0 creates the directory first: every rank writes its frame pieces there
       comm_->run_collectively([&] {
         if (comm_->rank() == 0)
           files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields, 0,
-                                              comm_->size());
+                                              comm_->size(), xdmf);
       });
     if (!files_)
-      files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields,
-                                          comm_ ? comm_->rank() : 0, comm_ ? comm_->size() : 1);
+      files_ =
+          std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields,
+                                     comm_ ? comm_->rank() : 0, comm_ ? comm_->size() : 1, xdmf);
   }
   const long total_steps = static_cast<long>(std::ceil(scene_.time.end / dt_ - 1e-9));
   RunReport result;
