@@ -619,9 +619,15 @@ RunReport Simulation::run() {
   wall_start_ = std::chrono::steady_clock::now();
   if (options_.write_output) {
     std::optional<XdmfFrames> xdmf;
-    if (scene_.output.format == OutputSpec::FrameFormat::xdmf)
-      xdmf = XdmfFrames{
-          comm_, merge_mpi_io_hints(scene_.output.mpi_io_hints, std::getenv("FDEM_MPIIO_HINTS"))};
+    const auto frame_format = [&] {  // a bad FDEM_MPIIO_HINTS stops every rank with one message
+      if (scene_.output.format == OutputSpec::FrameFormat::xdmf)
+        xdmf = XdmfFrames{
+            comm_, merge_mpi_io_hints(scene_.output.mpi_io_hints, std::getenv("FDEM_MPIIO_HINTS"))};
+    };
+    if (comm_)
+      comm_->run_collectively(frame_format);
+    else
+      frame_format();
     if (comm_)  // rank 0 creates the directory first: every rank writes its frame pieces there
       comm_->run_collectively([&] {
         if (comm_->rank() == 0)
