@@ -1,5 +1,15 @@
 # Warnings on everywhere; Release optimises.  Targets opt in with fdem_target_options().
 option(FDEM_NATIVE "Tune for the build machine (-march=native)" OFF)
+# AddressSanitizer + UndefinedBehaviorSanitizer on everything built here (scripts/sanitize.sh).
+# float-cast-overflow is not part of -fsanitize=undefined: it checks the float → integer casts.
+# Any report stops the program (no recovery), so a test that triggers one fails.
+option(FDEM_SANITIZE "Build with ASan + UBSan (including float-cast-overflow)" OFF)
+if(FDEM_SANITIZE)
+  set(FDEM_SANITIZER_FLAGS -fsanitize=address,undefined,float-cast-overflow
+                           -fno-sanitize-recover=all -fno-omit-frame-pointer)
+  add_compile_options(${FDEM_SANITIZER_FLAGS})
+  add_link_options(${FDEM_SANITIZER_FLAGS})
+endif()
 set(CMAKE_CXX_FLAGS_RELEASE "-O3 -DNDEBUG")
 set(CMAKE_CXX_FLAGS_RELWITHDEBINFO "-O2 -g -DNDEBUG")
 

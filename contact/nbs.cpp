@@ -170,6 +170,9 @@ void NbsDetector::map_level(Level& level, double cell_size, NbsLevelStats& level
   }
   double max_span = 0.0;
   for (int k = 0; k < 3; ++k) max_span = std::max(max_span, max_corner[k] - min_corner[k]);
+  // Non-finite boxes would make the cell counts below undefined casts; the driver's state check
+  // stops a run with NaN or infinite positions before they reach detection.
+  FDEM_VERIFY(std::isfinite(max_span), "contact detection over non-finite element boxes");
   if (!(cell_size > 0.0)) {  // every box is a point: any positive size works
     cell_size = max_span > 0.0 ? max_span / std::max(1.0, std::cbrt(static_cast<double>(m))) : 1.0;
   }

@@ -1,6 +1,8 @@
 // Error tiers.  InputError: the user's scene or mesh is wrong (file, line, key, what is valid).
 // NumericalFailure: the run became unstable (which element, which step, what to try).
-// Both carry a complete one-paragraph message; the driver prints it and exits non-zero.
+// IoError: an output or checkpoint file could not be written (disk full, quota, permissions).
+// Each carries a complete one-paragraph message; the driver prints it and exits non-zero with
+// the tier's code (README: 2 input, 3 numerical, 4 I/O).
 #pragma once
 
 #include <stdexcept>
@@ -14,6 +16,11 @@ class InputError : public std::runtime_error {
 };
 
 class NumericalFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class IoError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "core/checked_cast.hpp"
 #include "core/error.hpp"
 #include "core/tet_kernels.hpp"
 
@@ -96,17 +97,28 @@ struct TouchingFaces {
   LocalIndex a[3], b[3];
 };
 
+// The cell of a hash grid of spacing `tol` (m) that holds x.  A coordinate so far from the origin
+// that x / tol leaves the 64-bit range cannot be matched to a neighbour's: an input error.
+std::array<std::int64_t, 3> tolerance_cell(const Vec3& x, double tol) {
+  std::array<std::int64_t, 3> cell{};
+  for (int k = 0; k < 3; ++k) {
+    const auto c = floor_to_integer<std::int64_t>(x[k] / tol);
+    if (!c)
+      throw InputError("a mesh node at (" + std::to_string(x[0]) + ", " + std::to_string(x[1]) +
+                       ", " + std::to_string(x[2]) + ") m is too far from the origin to match " +
+                       "touching faces within " + std::to_string(tol) + " m");
+    cell[k] = *c;
+  }
+  return cell;
+}
+
 // Boundary triangles of a body mesh that coincide (node positions within tol) with a boundary
 // triangle of another piece of the same mesh, each touching pair once (`joints: interfaces`).
 std::vector<TouchingFaces> touching_piece_faces(const BodyMesh& mesh,
                                                 const std::vector<MeshFace>& faces, double tol) {
   const LocalIndex n_nodes = static_cast<LocalIndex>(mesh.coords.size() / 3);
   const auto tet_piece = connected_pieces(mesh.tets, n_nodes, nullptr);
-  const auto cell_of = [&](const Vec3& x) {
-    return std::array<std::int64_t, 3>{static_cast<std::int64_t>(std::floor(x[0] / tol)),
-                                       static_cast<std::int64_t>(std::floor(x[1] / tol)),
-                                       static_cast<std::int64_t>(std::floor(x[2] / tol))};
-  };
+  const auto cell_of = [&](const Vec3& x) { return tolerance_cell(x, tol); };
   std::vector<const MeshFace*> boundary;
   std::map<std::array<LocalIndex, 3>, const MeshFace*> by_key;
   std::map<std::array<std::int64_t, 3>, std::vector<LocalIndex>> grid;
@@ -286,11 +298,7 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     };
     const std::vector<MeshFace> faces_a = boundary(ba), faces_b = boundary(bb);
     // Hash grid of B's boundary nodes with cells of size tol: a match lies in a neighbour cell.
-    const auto cell_of = [&](const Vec3& x) {
-      return std::array<std::int64_t, 3>{static_cast<std::int64_t>(std::floor(x[0] / tol)),
-                                         static_cast<std::int64_t>(std::floor(x[1] / tol)),
-                                         static_cast<std::int64_t>(std::floor(x[2] / tol))};
-    };
+    const auto cell_of = [&](const Vec3& x) { return tolerance_cell(x, tol); };
     const double* xb = meshes[bb].coords.data();
     const double* xa = meshes[ba].coords.data();
     std::map<std::array<std::int64_t, 3>, std::vector<LocalIndex>> grid;

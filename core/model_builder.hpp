@@ -22,13 +22,13 @@ struct BodyMesh {
 };
 
 // A part of a body's mesh generated on its own (distributed start-up, parallel/distributed_build):
-// local node numbers, each with its number in the whole body mesh; the chunk's tets are the
-// whole mesh's tets [first_tet, first_tet + n) with the same corners in the same order, so the
-// chunks of a body together give exactly the mesh the whole generator gives.
+// local node numbers, each with its number in the whole body mesh, and tets with their number in
+// the whole mesh and the same corners in the same order, so the chunks of a body together give
+// exactly the mesh the whole generator gives.
 struct MeshChunk {
   BodyMesh mesh;
   std::vector<std::int64_t> node_id;  // per chunk node: its number in the whole body mesh
-  std::int64_t first_tet = 0;         // whole-mesh index of the chunk's first tet
+  std::vector<std::int64_t> tet_id;   // per chunk tet: its number in the whole body mesh
   std::int32_t piece = 0;             // the connected piece of the body the chunk lies in
 };
 
@@ -36,7 +36,11 @@ struct MeshChunk {
 struct BodyChunks {
   std::int64_t n_nodes = 0;              // nodes of the whole body mesh
   std::int32_t n_pieces = 0;             // connected pieces (numbered as connected_pieces does)
-  std::vector<std::int64_t> chunk_tets;  // tets of each chunk, in whole-mesh tet order
+  std::vector<std::int64_t> chunk_tets;  // tets of each chunk
+  std::vector<Vec3> chunk_centre;        // a point near each chunk's middle (m), to deal chunks
+                                         // to ranks along a space-filling curve
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // box of the body's nodes (m; for curved units
+                                              // that of their corners)
   std::function<MeshChunk(std::int64_t chunk)> generate;
 };
 

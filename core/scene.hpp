@@ -184,6 +184,17 @@ struct ParallelSpec {
   // N ranks, generated meshes without joints: each rank builds only its part (false: every rank
   // builds the whole model first, as scenes with Gmsh meshes or joints always do).
   bool distributed_start = true;
+  // Re-partition method (Zoltan): rib (inertial bisection), rcb (coordinate bisection), hsfc
+  // (Hilbert curve: least data moved while partitioning); random (a test mode: each re-partition
+  // scatters the tets to ranks at random — results must not change).
+  std::string partitioner = "rib";
+};
+
+// Ceilings between a valid scene and a runnable one (drivers/run_limits): checked by `fdem check`
+// and `run` before the meshes are generated and again on the built model.
+struct LimitsSpec {
+  double max_steps = 1e8;            // time steps of one run (time.end / time step)
+  double max_memory_per_rank = 0.0;  // bytes; 0: automatic (this machine's memory per rank)
 };
 
 struct Scene {
@@ -198,6 +209,7 @@ struct Scene {
   OutputSpec output;
   double contact_buffer = -1.0;  // m; < 0: automatic
   ParallelSpec parallel;
+  LimitsSpec limits;
 };
 
 }  // namespace fdem

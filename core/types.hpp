@@ -22,4 +22,11 @@ inline Eigen::Map<const Vec3> vec3_at(const double* xyz, LocalIndex i) {
   return Eigen::Map<const Vec3>(xyz + 3 * i);
 }
 
+// ⌊a·b/c⌋ for 0 ≤ a, b and c > 0 without overflow of the product (block and directory ranks of
+// 64-bit ids: a·b may exceed 2^63).
+inline std::int64_t mul_div(std::int64_t a, std::int64_t b, std::int64_t c) {
+  __extension__ typedef __int128 wide;
+  return static_cast<std::int64_t>(static_cast<wide>(a) * b / c);
+}
+
 }  // namespace fdem

@@ -8,12 +8,20 @@
 
 #include "contact/contact_stage.hpp"
 #include "core/error.hpp"
+#include "drivers/interrupt.hpp"
+#include "drivers/run_limits.hpp"
 #include "drivers/simulation.hpp"
 #include "fracture/joint_stage.hpp"
 #include "io/scene_reader.hpp"
 #include "parallel/communicator.hpp"
 
 namespace {
+
+// Exit codes (README.md): 1 is left to bugs (an internal error, an uncaught exception).
+constexpr int exit_bad_input = 2;          // the scene, mesh, command line or checkpoint is wrong
+constexpr int exit_numerical_failure = 3;  // the run became unstable
+constexpr int exit_io_failure = 4;         // an output or checkpoint file could not be written
+constexpr int exit_interrupted = 5;        // SIGTERM/SIGINT/SIGUSR1: checkpoint + summary written
 
 const char* usage =
     "usage:\n"
@@ -42,9 +50,18 @@ int check(const fdem::Scene& scene) {
                 scene.bodies[b].fixed ? ", fixed" : "");
   std::printf("  mesh: %d nodes, %d tetrahedra, %zu discrete elements\n", model.nodes.size(),
               model.tets.size(), model.pieces.size());
-  std::printf("  time: end %g s, step %g s (%s; critical %g s), %ld steps\n", scene.time.end,
-              sim->time_step(), scene.time.auto_step ? "auto" : "fixed", sim->critical_time_step(),
-              static_cast<long>(scene.time.end / sim->time_step() + 0.999999));
+  std::printf("  time: end %g s, step %g s (%s; critical %g s), %ld steps (limit %g)\n",
+              scene.time.end, sim->time_step(), scene.time.auto_step ? "auto" : "fixed",
+              sim->critical_time_step(),
+              fdem::checked_step_count(0.0, scene.time.end, sim->time_step()),
+              scene.limits.max_steps);
+  std::string ceiling_source;
+  const double ceiling = fdem::memory_ceiling_per_rank(scene.limits, 1, &ceiling_source);
+  std::printf("  memory: about %s per rank on 1 rank (limit %s, %s)\n",
+              fdem::format_bytes(
+                  fdem::estimated_bytes_per_rank(fdem::model_size(sim->model()), 1))
+                  .c_str(),
+              fdem::format_bytes(ceiling).c_str(), ceiling_source.c_str());
   if (const fdem::ContactStage* contact = sim->contact_stage()) {
     std::printf("  contact: buffer %g m, penalties", contact->buffer());
     for (std::size_t m = 0; m < model.materials.size(); ++m)
@@ -68,6 +85,7 @@ int main(int argc, char** argv) {
   // Under mpirun every rank runs the same command; one rank alone is a serial run.
   fdem::MpiEnvironment environment(&argc, &argv);
   const fdem::Communicator world = fdem::Communicator::world();
+  fdem::install_interrupt_handlers();  // after MPI_Init, so that these handlers are the ones kept
   return run_command(argc, argv, world);
 }
 
@@ -84,7 +102,7 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     std::fputs(usage, stderr);
-    return 2;
+    return exit_bad_input;
   }
   if (args[0] == "--version" || args[0] == "version") {
     std::printf("fdem %s\n", FDEM_VERSION);
@@ -97,7 +115,7 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
   const std::string command = args[0];
   if (command != "run" && command != "check") {
     std::fprintf(stderr, "fdem: unknown command '%s'\n%s", command.c_str(), usage);
-    return 2;
+    return exit_bad_input;
   }
   std::string scene_path;
   fdem::RunOptions options;
@@ -107,7 +125,7 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
     auto value = [&](const char* flag) -> std::string {
       if (i + 1 >= args.size()) {
         std::fprintf(stderr, "fdem: %s needs a value\n%s", flag, usage);
-        std::exit(2);
+        std::exit(exit_bad_input);
       }
       return args[++i];
     };
@@ -123,18 +141,18 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
       options.restart_path = value("--restart");
     else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "fdem: unknown option '%s'\n%s", a.c_str(), usage);
-      return 2;
+      return exit_bad_input;
     } else if (scene_path.empty())
       scene_path = a;
     else {
       std::fprintf(stderr, "fdem: unexpected argument '%s' (one scene per run)\n%s", a.c_str(),
                    usage);
-      return 2;
+      return exit_bad_input;
     }
   }
   if (scene_path.empty()) {
     std::fprintf(stderr, "fdem: %s needs a scene file\n%s", command.c_str(), usage);
-    return 2;
+    return exit_bad_input;
   }
   try {
     fdem::Scene scene;
@@ -144,21 +162,33 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
     if (world.rank() != 0) options.quiet = true;
     auto sim = fdem::make_simulation(scene, options, &world);
     const fdem::RunReport report = sim->run();
+    if (report.status == "interrupted") {
+      if (world.rank() == 0)
+        std::fprintf(stderr, "fdem: %s.\nThe last frame and summary.json are in %s.\n",
+                     report.reason.c_str(), options.output_dir.c_str());
+      return exit_interrupted;
+    }
     if (report.status != "completed") {
       if (world.rank() == 0)
-        std::fprintf(stderr, "fdem: %s\nThe last good frame and summary.json are in %s.\n",
-                     report.reason.c_str(), options.output_dir.c_str());
-      return 3;
+        std::fprintf(stderr, "fdem: %s\n%s are in %s.\n", report.reason.c_str(),
+                     report.io_failure ? "The frames written and summary.json (when the disk allowed)"
+                                       : "The last good frame and summary.json",
+                     options.output_dir.c_str());
+      return report.io_failure ? exit_io_failure : exit_numerical_failure;
     }
     if (!options.quiet)
       std::fprintf(stderr, "results in %s (open frames.pvd in ParaView)\n",
                    options.output_dir.c_str());
     return 0;
   } catch (const fdem::InputError& e) {
-    return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr, 2,
-                "error: ");
+    return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr,
+                exit_bad_input, "error: ");
   } catch (const fdem::NumericalFailure& e) {
-    return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr, 3, "");
+    return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr,
+                exit_numerical_failure, "");
+  } catch (const fdem::IoError& e) {
+    return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr,
+                exit_io_failure, "I/O failure: ");
   } catch (const std::exception& e) {
     return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr, 1,
                 "error: ");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numeric>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -91,6 +92,8 @@ BodyMesh unit_box(const Vec3& lo, const Vec3& size, int cx, int cy, int cz) {
 // give its node and tet counts without making it, and how to make it.
 struct MeshUnit {
   int cells[3];
+  Vec3 centre;  // m, a point inside it
+  Vec3 lo, hi;  // m, box of its corners
   std::function<BodyMesh()> make;
   std::int64_t n_nodes() const {
     return std::int64_t{cells[0] + 1} * (cells[1] + 1) * (cells[2] + 1);
@@ -99,11 +102,17 @@ struct MeshUnit {
 };
 
 MeshUnit box_unit(const Vec3& lo, const Vec3& size, int cx, int cy, int cz) {
-  return {{cx, cy, cz}, [=] { return unit_box(lo, size, cx, cy, cz); }};
+  return {
+      {cx, cy, cz}, lo + 0.5 * size, lo, lo + size, [=] { return unit_box(lo, size, cx, cy, cz); }};
 }
 
 MeshUnit mapped_unit(const int cells[3], std::function<Vec3(double, double, double)> map) {
-  MeshUnit unit{{cells[0], cells[1], cells[2]}, {}};
+  MeshUnit unit{{cells[0], cells[1], cells[2]}, map(0.5, 0.5, 0.5), map(0, 0, 0), map(0, 0, 0), {}};
+  for (int corner = 1; corner < 8; ++corner) {
+    const Vec3 x = map(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+    unit.lo = unit.lo.cwiseMin(x);
+    unit.hi = unit.hi.cwiseMax(x);
+  }
   const int c[3] = {cells[0], cells[1], cells[2]};
   unit.make = [c0 = c[0], c1 = c[1], c2 = c[2], map = std::move(map)] {
     const int n[3] = {c0, c1, c2};
@@ -216,65 +225,81 @@ BodyChunks unit_chunks(std::vector<MeshUnit> units) {
   BodyChunks chunks;
   auto node_offset = std::make_shared<std::vector<std::int64_t>>();
   auto tet_offset = std::make_shared<std::vector<std::int64_t>>();
+  std::int64_t tets = 0;
+  chunks.lo = Vec3::Constant(1e300);
+  chunks.hi = Vec3::Constant(-1e300);
   for (const MeshUnit& unit : units) {
+    chunks.lo = chunks.lo.cwiseMin(unit.lo);
+    chunks.hi = chunks.hi.cwiseMax(unit.hi);
     node_offset->push_back(chunks.n_nodes);
-    tet_offset->push_back(
-        chunks.chunk_tets.empty() ? 0 : tet_offset->back() + chunks.chunk_tets.back());
+    tet_offset->push_back(tets);
     chunks.n_nodes += unit.n_nodes();
+    tets += unit.n_tets();
     chunks.chunk_tets.push_back(unit.n_tets());
+    chunks.chunk_centre.push_back(unit.centre);
   }
   chunks.n_pieces = static_cast<std::int32_t>(units.size());
   auto shared_units = std::make_shared<std::vector<MeshUnit>>(std::move(units));
   chunks.generate = [shared_units, node_offset, tet_offset](std::int64_t u) {
+    const auto i = static_cast<std::size_t>(u);
     MeshChunk chunk;
-    chunk.mesh = (*shared_units)[static_cast<std::size_t>(u)].make();
-    const std::size_t n = chunk.mesh.coords.size() / 3;
-    chunk.node_id.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-      chunk.node_id[i] = (*node_offset)[static_cast<std::size_t>(u)] + static_cast<std::int64_t>(i);
-    chunk.first_tet = (*tet_offset)[static_cast<std::size_t>(u)];
+    chunk.mesh = (*shared_units)[i].make();
+    chunk.node_id.resize(chunk.mesh.coords.size() / 3);
+    std::iota(chunk.node_id.begin(), chunk.node_id.end(), (*node_offset)[i]);
+    chunk.tet_id.resize(chunk.mesh.tets.size() / 4);
+    std::iota(chunk.tet_id.begin(), chunk.tet_id.end(), (*tet_offset)[i]);
     chunk.piece = static_cast<std::int32_t>(u);
     return chunk;
   };
   return chunks;
 }
 
-// One row of cells (j, k) of a box: the nodes of its two node rows in j and k, numbered as
-// box_mesh numbers them, and its 6·nx tets in box_mesh's order.
-MeshChunk box_row(const BoxMeshSpec& box, std::int64_t row) {
+// One block of up to block_cells³ cells of a box (blocks numbered x fastest): its nodes numbered
+// as box_mesh numbers them, its tets with their box_mesh numbers and corners.
+MeshChunk box_block(const BoxMeshSpec& box, int block_cells, std::int64_t block) {
+  const auto blocks_along = [&](int cells) { return (cells + block_cells - 1) / block_cells; };
   const int nx = box.cells[0], ny = box.cells[1], nz = box.cells[2];
-  const int j = static_cast<int>(row % ny), k = static_cast<int>(row / ny);
+  const std::int64_t bx = blocks_along(nx), by = blocks_along(ny);
+  const int i0 = static_cast<int>(block % bx) * block_cells;
+  const int j0 = static_cast<int>(block / bx % by) * block_cells;
+  const int k0 = static_cast<int>(block / (bx * by)) * block_cells;
+  const int i1 = std::min(nx, i0 + block_cells), j1 = std::min(ny, j0 + block_cells),
+            k1 = std::min(nz, k0 + block_cells);
   const Vec3 h = (box.max - box.min).cwiseQuotient(Vec3(nx, ny, nz));
   MeshChunk chunk;
   chunk.mesh.source = "box generator";
-  chunk.first_tet = row * nx * 6;
-  const auto local = [&](int i, int jj, int kk) {
-    return static_cast<LocalIndex>(((kk - k) * 2 + (jj - j)) * (nx + 1) + i);
+  const int sx = i1 - i0 + 1, sy = j1 - j0 + 1;
+  const auto local = [&](int i, int j, int k) {
+    return static_cast<LocalIndex>(((k - k0) * sy + (j - j0)) * sx + (i - i0));
   };
-  for (int kk = k; kk <= k + 1; ++kk)
-    for (int jj = j; jj <= j + 1; ++jj)
-      for (int i = 0; i <= nx; ++i) {
+  for (int k = k0; k <= k1; ++k)
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        // The same expressions as box_mesh: nodes shared with other blocks match bit for bit.
         chunk.mesh.coords.push_back(i == nx ? box.max.x() : box.min.x() + i * h.x());
-        chunk.mesh.coords.push_back(jj == ny ? box.max.y() : box.min.y() + jj * h.y());
-        chunk.mesh.coords.push_back(kk == nz ? box.max.z() : box.min.z() + kk * h.z());
-        chunk.node_id.push_back((std::int64_t{kk} * (ny + 1) + jj) * (nx + 1) + i);
+        chunk.mesh.coords.push_back(j == ny ? box.max.y() : box.min.y() + j * h.y());
+        chunk.mesh.coords.push_back(k == nz ? box.max.z() : box.min.z() + k * h.z());
+        chunk.node_id.push_back((std::int64_t{k} * (ny + 1) + j) * (nx + 1) + i);
       }
   static const int permutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
                                          {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int i = 0; i < nx; ++i)
-    for (const auto& perm : permutations) {
-      int corner[3] = {0, 0, 0};
-      LocalIndex tet[4];
-      tet[0] = local(i, j, k);
-      for (int s = 0; s < 3; ++s) {
-        corner[perm[s]] = 1;
-        tet[s + 1] = local(i + corner[0], j + corner[1], k + corner[2]);
-      }
-      Vec3 X[4];
-      for (int c = 0; c < 4; ++c) X[c] = vec3_at(chunk.mesh.coords.data(), tet[c]);
-      if (tet_reference(X).volume < 0.0) std::swap(tet[2], tet[3]);
-      chunk.mesh.tets.insert(chunk.mesh.tets.end(), tet, tet + 4);
-    }
+  for (int k = k0; k < k1; ++k)
+    for (int j = j0; j < j1; ++j)
+      for (int i = i0; i < i1; ++i)
+        for (int p = 0; p < 6; ++p) {
+          int corner[3] = {0, 0, 0};
+          LocalIndex tet[4];
+          tet[0] = local(i, j, k);
+          for (int s = 0; s < 3; ++s) {
+            corner[permutations[p][s]] = 1;
+            tet[s + 1] = local(i + corner[0], j + corner[1], k + corner[2]);
+          }
+          Vec3 X[4];
+          for (int c = 0; c < 4; ++c) X[c] = vec3_at(chunk.mesh.coords.data(), tet[c]);
+          if (tet_reference(X).volume < 0.0) std::swap(tet[2], tet[3]);
+          chunk.mesh.tets.insert(chunk.mesh.tets.end(), tet, tet + 4);
+          chunk.tet_id.push_back(((std::int64_t{k} * ny + j) * nx + i) * 6 + p);
+        }
   return chunk;
 }
 
@@ -294,16 +319,32 @@ BodyMesh arch_mesh(const ArchMeshSpec& arch) {
   return join_units(arch_units(arch), "arch generator");
 }
 
-BodyChunks body_chunks(const MeshSpec& mesh) {
+BodyChunks body_chunks(const MeshSpec& mesh, int ranks) {
   switch (mesh.kind) {
     case MeshSpec::Kind::box: {
       const BoxMeshSpec box = mesh.box;
-      const std::int64_t nx = box.cells[0], ny = box.cells[1], nz = box.cells[2];
+      const int nx = box.cells[0], ny = box.cells[1], nz = box.cells[2];
+      // Blocks of b³ cells, b in [2, 8], about 64 per rank.
+      const double cells_per_chunk = double(nx) * ny * nz / (64.0 * std::max(ranks, 1));
+      const int block_cells = std::clamp(static_cast<int>(std::cbrt(cells_per_chunk)), 2, 8);
       BodyChunks chunks;
-      chunks.n_nodes = (nx + 1) * (ny + 1) * (nz + 1);
+      chunks.lo = box.min;
+      chunks.hi = box.max;
+      chunks.n_nodes = std::int64_t{nx + 1} * (ny + 1) * (nz + 1);
       chunks.n_pieces = 1;
-      chunks.chunk_tets.assign(static_cast<std::size_t>(ny * nz), 6 * nx);
-      chunks.generate = [box](std::int64_t row) { return box_row(box, row); };
+      const Vec3 h = (box.max - box.min).cwiseQuotient(Vec3(nx, ny, nz));
+      for (int k = 0; k < nz; k += block_cells)
+        for (int j = 0; j < ny; j += block_cells)
+          for (int i = 0; i < nx; i += block_cells) {
+            const int cx = std::min(block_cells, nx - i), cy = std::min(block_cells, ny - j),
+                      cz = std::min(block_cells, nz - k);
+            chunks.chunk_tets.push_back(std::int64_t{6} * cx * cy * cz);
+            chunks.chunk_centre.push_back(
+                box.min + h.cwiseProduct(Vec3(i + 0.5 * cx, j + 0.5 * cy, k + 0.5 * cz)));
+          }
+      chunks.generate = [box, block_cells](std::int64_t block) {
+        return box_block(box, block_cells, block);
+      };
       return chunks;
     }
     case MeshSpec::Kind::wall:

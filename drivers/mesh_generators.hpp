@@ -34,7 +34,10 @@ void append_piece(BodyMesh& mesh, const BodyMesh& piece);
 // wall, tower or arch into its units (one piece each).  Chunk by chunk the same nodes, tets and
 // corner order as box_mesh / wall_mesh / tower_mesh / arch_mesh.  Throws InputError for a mesh
 // read from a file (it has no chunked form).
-BodyChunks body_chunks(const MeshSpec& mesh);
+// `ranks`: the rank count the chunks are dealt to; box bodies are cut into blocks of 2–8 cells a
+// side, small enough that each rank gets dozens of them (a finer deal follows the ranks' blocks of
+// the space-filling curve more closely), large enough that the plan stays small.
+BodyChunks body_chunks(const MeshSpec& mesh, int ranks = 1);
 
 // Loads or generates the mesh of every body of the scene, in scene order.
 std::vector<BodyMesh> load_body_meshes(const Scene& scene);

@@ -76,6 +76,7 @@ void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balanc
           << e.dissipated_damping << ',' << e.external_work << ',' << e.total() << ','
           << balance_error << '\n';
   energy_.flush();
+  if (!energy_) throw IoError("cannot write " + directory_ + "/energy.csv (disk full?)");
 }
 
 void RunFiles::write_bodies_rows(double time, const Model& model,
@@ -90,6 +91,7 @@ void RunFiles::write_bodies_rows(double time, const Model& model,
             << m.rotation.x() << ',' << m.rotation.y() << ',' << m.rotation.z() << '\n';
   }
   bodies_.flush();
+  if (!bodies_) throw IoError("cannot write " + directory_ + "/bodies.csv (disk full?)");
 }
 
 std::vector<double> tet_damage(const Model& model) {
@@ -222,6 +224,7 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
       << ", \"ghost_nodes_max\": " << r.ghost_nodes_max
       << ", \"ghost_nodes_mean\": " << r.ghost_nodes_mean
       << ", \"neighbours_max\": " << r.neighbours_max
+      << ", \"active_elements_max\": " << r.active_elements_max
       << ", \"communication_seconds\": " << JsonNumber{r.communication_seconds} << "},\n";
   j << "  \"memory\": {\"startup_peak_rss_kib_max\": " << r.startup_peak_rss_kib_max
     << ", \"startup_peak_rss_kib_mean\": " << r.startup_peak_rss_kib_mean

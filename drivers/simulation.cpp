@@ -17,10 +17,13 @@
 #include "core/model_builder.hpp"
 #include "core/state_hash.hpp"
 #include "core/time_step.hpp"
+#include "drivers/interrupt.hpp"
 #include "drivers/loads.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/process_memory.hpp"
+#include "drivers/restart_check.hpp"
 #include "drivers/run_files.hpp"
+#include "drivers/run_limits.hpp"
 #include "fracture/joint_kernels.hpp"
 #include "fracture/joint_stage.hpp"
 #include "parallel/checkpoint.hpp"
@@ -45,10 +48,46 @@ class Timed {
   std::chrono::steady_clock::time_point start_;
 };
 
+// The first of next, next + every, next + 2 every, ... after `now` (s).  Many intervals within
+// one step are skipped at once (the scene reader guarantees every ≥ 1e-12 time.end, so that
+// next + every > next); the same sums as adding `every` one at a time when they are few.
+double next_output_time(double next, double now, double every) {
+  if (next <= now) {
+    const double skipped = std::floor((now - next) / every);
+    if (skipped > 16) next += (skipped - 1) * every;
+  }
+  while (next <= now) next += every;
+  return next;
+}
+
+// Steps between two checks of the deformed mesh's stable step against the time step (the
+// minimum-step guard, LS-DYNA's DTMIN idea): a pass over the tets like one internal-force pass,
+// so about 1 % of the run time; every 10 steps once the bound is below 0.8 of the step, every
+// step below 0.6, so that a crushing element is caught before it inverts.
+long steps_to_next_stability_check(double bound_over_step) {
+  return bound_over_step < 0.6 ? 1 : bound_over_step < 0.8 ? 10 : 100;
+}
+// The guard fires when the deformed mesh's stable-step bound is below this fraction of the time
+// step.  The bound is conservative (the auto step sits at 0.7–0.9 of the limit found by
+// bisection, docs/architecture.md), so at half the step the true limit is surely passed: no run
+// that would stay stable is stopped.
+constexpr double stable_step_margin = 0.5;
+
 // A run whose energy balance error exceeds this has blown up (well-resolved runs stay below 1 %).
 constexpr double runaway_balance_error = 0.2;
 // Stored energy above this multiple of the energy put in means a mode is growing (see check_state).
 constexpr double runaway_energy_growth = 100.0;
+
+// The distribution's settings from the scene's `parallel` block.
+DistributionSettings distribution_settings(const ParallelSpec& spec) {
+  DistributionSettings settings;
+  settings.rebalance_threshold = spec.rebalance_threshold;
+  settings.partitioner = spec.partitioner == "rcb"    ? GeometricMethod::rcb
+                         : spec.partitioner == "hsfc" ? GeometricMethod::hsfc
+                                                      : GeometricMethod::rib;
+  settings.random_parts = spec.partitioner == "random";
+  return settings;
+}
 
 }  // namespace
 
@@ -142,11 +181,11 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
     restore_checkpoint(options_.restart_path);
     mark_phase(CommPhase::startup);
   }
+  check_run_limits();
   // N ranks, whole-model start: everything above came from the whole model (the same on every
   // rank); now keep this rank's part and halo.
   if (!distributed && comm_ && comm_->size() > 1) {
-    DistributionSettings settings;
-    settings.rebalance_threshold = scene_.parallel.rebalance_threshold;
+    const DistributionSettings settings = distribution_settings(scene_.parallel);
     // Blocks that touch at the start should share a rank: the first detection, on the whole
     // model, gives the partitioner those pairs (one rank detects at the same positions in step 0).
     std::vector<std::pair<LocalIndex, LocalIndex>> touching;
@@ -167,6 +206,43 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   startup_peak_rss_kib_ = peak_rss_kib();
   release_free_memory();
   reset_peak_rss();
+}
+
+// Refuses a run that cannot advance (a restart past time.end) or needs more steps than the
+// scene's limits allow; decided from the whole model, so every rank throws alike.
+void Simulation::check_run_limits() const {
+  if (!options_.restart_path.empty() && !(scene_.time.end > time_)) {
+    std::ostringstream msg;
+    msg << scene_.source_path << ": time.end = " << scene_.time.end
+        << " s is not after the time of the checkpoint '" << options_.restart_path << "' (" << time_
+        << " s, step " << steps_
+        << "): there is nothing to continue. Set a later time.end (--set time.end=...).";
+    throw InputError(msg.str());
+  }
+  check_step_limit(scene_, time_, dt_, step_origin());
+}
+
+// Where the time step comes from, for messages: the element that sets the elastic critical step
+// and the contact and joint stiffness bounds.
+std::string Simulation::step_origin() const {
+  std::ostringstream out;
+  out.precision(3);
+  if (scene_.time.auto_step)
+    out << "The step is time.safety " << scene_.time.safety << " x the critical step "
+        << dt_critical_ << " s, set by:";
+  else
+    out << "The step is time.step (the critical step is " << dt_critical_ << " s:";
+  const CriticalStep elastic = fdem::critical_time_step(model_);
+  out << " elastic " << elastic.dt << " s at " << describe_tet(model_, elastic.limiting_tet);
+  if (contact_) {
+    out << ", contact " << contact_->critical_time_step(model_) << " s (contact penalties";
+    for (std::size_t m = 0; m < model_.materials.size(); ++m)
+      out << " " << model_.materials[m].name << " " << contact_->material_penalty()[m] << " Pa";
+    out << ")";
+  }
+  if (joints_) out << ", cohesive joints " << joints_->critical_time_step(model_) << " s";
+  out << (scene_.time.auto_step ? "." : ").");
+  return out.str();
 }
 
 bool Simulation::is_root() const {
@@ -361,7 +437,17 @@ void Simulation::step() {
     halo_in_flight_ = true;
   }
 
+  // Minimum-step guard: has an element been deformed so far that the time step is above its
+  // stable step?  (Checked on x_{n+1}; reported below with the other checks.)
+  CriticalStep deformed;
+  if (steps_ >= next_stability_check_) {
+    deformed = fdem::critical_time_step(model_);
+    next_stability_check_ = steps_ + steps_to_next_stability_check(deformed.dt / dt_);
+  }
+  const bool step_too_large = deformed.limiting_tet >= 0 && deformed.dt < stable_step_margin * dt_;
+
   double bad_tet_ranks = 0.0;  // N ranks: ranks holding an inverted or NaN tet
+  double crushed_ranks = step_too_large ? 1.0 : 0.0;
   // The energy terms of every rank (each counts what it owns) in one reduction.
   if (distribution_) {
     const auto start = std::chrono::steady_clock::now();
@@ -387,7 +473,9 @@ void Simulation::step() {
                   motion.momentum_after.y(),
                   motion.momentum_after.z(),
                   motion.finite ? 0.0 : 1.0,
-                  forces.min_jacobian > 0.0 ? 0.0 : 1.0});
+                  forces.min_jacobian > 0.0 ? 0.0 : 1.0,
+                  interrupt_signal() != 0 ? 1.0 : 0.0,
+                  crushed_ranks});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
@@ -401,6 +489,9 @@ void Simulation::step() {
     motion.momentum_after = Vec3(terms[17], terms[18], terms[19]);
     motion.finite = terms[20] == 0.0;
     bad_tet_ranks = terms[21];
+    // A signal on any rank ends the run after this step on every rank (no extra collective).
+    if (terms[22] > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
+    crushed_ranks = terms[23];
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -442,7 +533,12 @@ void Simulation::step() {
     comm_->run_collectively([&] { check_state(forces, motion.finite); });
   else
     check_state(forces, motion.finite);
+  if (distribution_ && crushed_ranks > 0)
+    comm_->run_collectively([&] { check_stable_step(deformed); });
+  else if (step_too_large)
+    check_stable_step(deformed);
 
+  if (!distribution_) interrupt_ = interrupt_signal();
   time_ += dt_;
   ++steps_;
 }
@@ -454,7 +550,8 @@ void Simulation::start_half_step(NodeArrays& nodes) const {
         nodes.v[3 * n + k] -= 0.5 * dt_ * nodes.f[3 * n + k] / nodes.mass[n];
 }
 
-void Simulation::check_state(const InternalForceSummary& forces, bool velocities_finite) const {
+// What to try after a numerical failure, from the time step against the critical step.
+std::string Simulation::step_advice() const {
   std::ostringstream advice;
   const double ratio = dt_ / dt_critical_;
   advice << " The time step is " << dt_ << " s = " << ratio << " x the critical step "
@@ -465,6 +562,11 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
   else
     advice << ". Try a smaller time.safety (e.g. " << std::min(0.5, 0.5 * scene_.time.safety)
            << "), check for very distorted elements, or slow down prescribed velocities.";
+  return advice.str();
+}
+
+void Simulation::check_state(const InternalForceSummary& forces, bool velocities_finite) const {
+  const std::string advice = step_advice();
   if (!(forces.min_jacobian > 0.0)) {
     const LocalIndex t = forces.min_jacobian_tet;
     const PieceInfo& piece = model_.pieces[model_.tets.piece[t]];
@@ -473,13 +575,13 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
         << model_.tets.gid[t] << " of body '" << model_.body_names[piece.body] << "' (piece "
         << piece.index_in_body << ") "
         << (std::isnan(forces.min_jacobian) ? "has NaN coordinates" : "inverted")
-        << " (det F = " << forces.min_jacobian << ")." << advice.str();
+        << " (det F = " << forces.min_jacobian << ")." << advice;
     throw NumericalFailure(msg.str());
   }
   if (!velocities_finite) {
     std::ostringstream msg;
     msg << "numerical failure at step " << steps_ << " (t = " << time_
-        << " s): velocities became NaN or infinite." << advice.str();
+        << " s): velocities became NaN or infinite." << advice;
     throw NumericalFailure(msg.str());
   }
   // Central difference conserves ½m·v⁻·v⁺ + U even past the stability limit (the kinetic term
@@ -494,7 +596,7 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
     msg << "numerical failure at step " << steps_ << " (t = " << time_
         << " s): the run is unstable — the stored energy " << stored << " J grew to "
         << stored / energy_input_ << " x the energy put in (" << energy_input_
-        << " J): a mode beyond the stability limit is growing." << advice.str();
+        << " J): a mode beyond the stability limit is growing." << advice;
     throw NumericalFailure(msg.str());
   }
   if (steps_ > 10 && ledger_.balance_error() > runaway_balance_error &&
@@ -504,9 +606,21 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
         << " s): the run is unstable — the energy "
         << "balance error reached " << ledger_.balance_error() * 100 << " % (total energy "
         << ledger_.current().total() << " J, initially " << ledger_.initial_total() << " J)."
-        << advice.str();
+        << advice;
     throw NumericalFailure(msg.str());
   }
+}
+
+// Throws NumericalFailure when `deformed` (the stable step of the current shapes) fell below the
+// time step: the run is past its stability limit and would blow up within some steps.
+void Simulation::check_stable_step(const CriticalStep& deformed) const {
+  if (deformed.limiting_tet < 0 || !(deformed.dt < stable_step_margin * dt_)) return;
+  std::ostringstream msg;
+  msg << "numerical failure at step " << steps_ << " (t = " << time_ << " s): the stable time "
+      << "step of the " << (steps_ > 0 ? "deformed " : "") << "mesh is " << deformed.dt
+      << " s, below half the time step (minimum-step guard), set by "
+      << describe_tet(model_, deformed.limiting_tet) << "." << step_advice();
+  throw NumericalFailure(msg.str());
 }
 
 RunReport Simulation::report() const {
@@ -559,6 +673,7 @@ RunReport Simulation::report() const {
     r.ghost_nodes_max = d.ghost_nodes_max;
     r.ghost_nodes_mean = d.ghost_nodes_sum / comm_->size();
     r.neighbours_max = d.neighbours_max;
+    r.active_elements_max = comm_->max(static_cast<std::int64_t>(model_.tet_force_order.size()));
     r.communication_seconds =
         clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;
   } else {
@@ -581,14 +696,36 @@ void Simulation::write_outputs(bool force) {
   const double energy_time = steps_ > 0 ? time_ - dt_ : 0.0;
   const double energy_every =
       scene_.output.energy_every > 0 ? scene_.output.energy_every : scene_.output.every;
-  if (steps_ > 0 && (force || energy_time >= next_energy_time_ - 1e-12 * dt_)) {
-    files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());
+  const bool energy_row = steps_ > 0 && (force || energy_time >= next_energy_time_ - 1e-12 * dt_);
+  if (energy_row) {
     if (energy_every > 0)
-      while (next_energy_time_ <= energy_time + 1e-12 * dt_) next_energy_time_ += energy_every;
+      next_energy_time_ =
+          next_output_time(next_energy_time_, energy_time + 1e-12 * dt_, energy_every);
     else
       next_energy_time_ = scene_.time.end;
   }
-  if (force || time_ >= next_frame_time_ - 1e-12 * dt_) {
+  const bool frame = force || time_ >= next_frame_time_ - 1e-12 * dt_;
+  if (frame) {
+    if (scene_.output.every > 0)
+      next_frame_time_ =
+          next_output_time(next_frame_time_, time_ + 1e-12 * dt_, scene_.output.every);
+    else
+      next_frame_time_ = scene_.time.end;
+  }
+  if (energy_row || frame) write_files(frame, energy_row, energy_time);
+  const double every = scene_.output.checkpoint_every;
+  if (comm_ && every > 0 && steps_ > 0 && time_ >= next_checkpoint_time_ - 1e-12 * dt_) {
+    next_checkpoint_time_ = next_output_time(next_checkpoint_time_, time_ + 1e-12 * dt_, every);
+    mark_phase(CommPhase::checkpoint);
+    write_checkpoint();
+  }
+  mark_phase(CommPhase::step);
+}
+
+// The energy row and/or the frame (with contacts, cracks and bodies.csv rows) of this step.
+void Simulation::write_files(bool frame, bool energy_row, double energy_time) {
+  std::vector<PieceMotion> motion;
+  if (frame) {
     std::function<void(std::vector<double>&)> sum_over_ranks;
     if (distribution_) {
       if (halo_in_flight_) {  // frames show ghost nodes of owned tets: complete the exchange
@@ -597,22 +734,63 @@ void Simulation::write_outputs(bool force) {
       }
       sum_over_ranks = [this](std::vector<double>& v) { comm_->sum_in_place(v); };
     }
-    files_->write_frame(time_, model_, {}, plan_.joints,
-                        distribution_ ? distribution_->node_owners() : std::vector<std::int32_t>{});
+    motion = piece_motions(model_, sum_over_ranks);
+  }
+  // The frame first: with output.format xdmf it is written collectively, so no rank may leave
+  // this lambda before it (rank 0 alone failing on energy.csv would leave the others waiting in
+  // the frame's collectives).
+  const auto write = [&] {
+    if (frame)
+      files_->write_frame(
+          time_, model_, {}, plan_.joints,
+          distribution_ ? distribution_->node_owners() : std::vector<std::int32_t>{});
+    if (energy_row)
+      files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());
+    if (!frame) return;
     if (contact_) files_->write_contacts(time_, contact_->records());
-    files_->write_bodies_rows(time_, model_, piece_motions(model_, sum_over_ranks));
-    if (scene_.output.every > 0)
-      while (next_frame_time_ <= time_ + 1e-12 * dt_) next_frame_time_ += scene_.output.every;
+    files_->write_bodies_rows(time_, model_, motion);
+  };
+  // A full disk is seen by the ranks that write: every rank stops together (IoError).
+  if (distribution_)
+    comm_->run_collectively(write);
+  else
+    write();
+}
+
+// After a signal: the frame and energy row of the step reached, a checkpoint to continue from.
+void Simulation::finish_interrupted(RunReport& result) {
+  write_outputs(true);
+  if (comm_ && scene_.output.checkpoint_every > 0 && checkpoint_step_ != steps_) write_checkpoint();
+  result = report();
+  result.status = "interrupted";
+  std::ostringstream reason;
+  reason << "interrupted by " << (interrupt_ > 0 ? signal_name(interrupt_) : "a signal")
+         << (interrupt_ > 0 ? "" : " received by another rank") << " at step " << steps_
+         << " (t = " << time_ << " s); ";
+  if (checkpoint_step_ == steps_)
+    reason << "continue with --restart " << checkpoints_.back();
+  else
+    reason << "no checkpoint written (output.checkpoint_every is 0)";
+  result.reason = reason.str();
+}
+
+// summary.json whenever the disk allows; when it does not, the run's status says so.
+void Simulation::write_summary(RunReport& result) {
+  const auto write = [&] { files_->write_summary(result, model_, scene_.name); };
+  try {
+    if (distribution_)
+      comm_->run_collectively(write);
     else
-      next_frame_time_ = scene_.time.end;
+      write();
+  } catch (const IoError& failure) {
+    if (result.status == "completed" || result.status == "interrupted") {
+      result.status = "failed";
+      result.io_failure = true;
+      result.reason = std::string("I/O failure: ") + failure.what();
+    } else if (is_root()) {
+      std::fprintf(stderr, "fdem: summary.json not written either: %s\n", failure.what());
+    }
   }
-  const double every = scene_.output.checkpoint_every;
-  if (comm_ && every > 0 && steps_ > 0 && time_ >= next_checkpoint_time_ - 1e-12 * dt_) {
-    while (next_checkpoint_time_ <= time_ + 1e-12 * dt_) next_checkpoint_time_ += every;
-    mark_phase(CommPhase::checkpoint);
-    write_checkpoint();
-  }
-  mark_phase(CommPhase::step);
 }
 
 RunReport Simulation::run() {
@@ -639,12 +817,12 @@ RunReport Simulation::run() {
           std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields,
                                      comm_ ? comm_->rank() : 0, comm_ ? comm_->size() : 1, xdmf);
   }
-  const long total_steps = static_cast<long>(std::ceil(scene_.time.end / dt_ - 1e-9));
+  const long total_steps = checked_step_count(0.0, scene_.time.end, dt_);
   RunReport result;
   auto last_progress = wall_start_;
   try {
     write_outputs(true);
-    while (steps_ < total_steps) {
+    while (steps_ < total_steps && interrupt_ == 0) {
       step();
       write_outputs(steps_ == total_steps);
       const auto now = std::chrono::steady_clock::now();
@@ -663,16 +841,27 @@ RunReport Simulation::run() {
       }
     }
     mark_phase(CommPhase::finish);
-    result = report();
-    result.status = "completed";
+    if (steps_ < total_steps) {
+      if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+      finish_interrupted(result);
+    } else {
+      result = report();
+      result.status = "completed";
+    }
   } catch (const NumericalFailure& failure) {
     if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
     mark_phase(CommPhase::finish);
     result = report();
     result.status = "failed";
     result.reason = failure.what();
+  } catch (const IoError& failure) {
+    if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+    result = report();
+    result.status = "failed";
+    result.io_failure = true;
+    result.reason = std::string("I/O failure: ") + failure.what();
   }
-  if (files_) files_->write_summary(result, model_, scene_.name);
+  if (files_) write_summary(result);
   if (!options_.quiet && is_root()) {
     std::fprintf(stderr, "\n%-20s %12s %10s %8s\n", "stage", "seconds", "calls", "share");
     double total = 0.0;
@@ -708,16 +897,32 @@ bool distributed_start_possible(const Scene& scene) {
 
 std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options,
                                             const Communicator* comm) {
+  // Memory before any mesh is generated (from the specs), then on the built model (file meshes
+  // are only known once read).  Ranks on different nodes may see different ceilings: decided
+  // collectively.
+  const int ranks = comm ? comm->size() : 1;
+  const int ranks_on_node = comm ? comm->ranks_on_this_node() : 1;
+  const bool distributed = ranks > 1 && distributed_start_possible(scene);
+  const auto check_memory = [&](const ModelSize& size, const char* what) {
+    if (comm && comm->size() > 1)
+      comm->run_collectively(
+          [&] { check_memory_limit(scene, size, ranks, ranks_on_node, distributed, what); });
+    else
+      check_memory_limit(scene, size, ranks, ranks_on_node, distributed, what);
+  };
+  check_memory(estimate_generated_size(scene), "the generated meshes");
   if (!comm || comm->size() == 1) {
     Model model = build_model(scene, load_body_meshes(scene));
+    check_memory(model_size(model), "the model");
     return std::make_unique<Simulation>(scene, std::move(model), std::move(options), comm);
   }
-  if (distributed_start_possible(scene)) {
+  if (distributed) {
     // Each rank generates its chunks of the meshes and keeps its block
     // (parallel/distributed_build).
     std::vector<BodyChunks> chunks;
     comm->run_collectively([&] {
-      for (const BodySpec& body : scene.bodies) chunks.push_back(body_chunks(body.mesh));
+      for (const BodySpec& body : scene.bodies)
+        chunks.push_back(body_chunks(body.mesh, comm->size()));
     });
     DistributedModel start = build_distributed_model(scene, chunks, *comm);
     chunks.clear();
@@ -728,8 +933,7 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
         buffer = ContactStage::auto_buffer(
             distributed_nth_value(ContactStage::tet_sizes(start.model), start.n_tets / 2, *comm));
     }
-    DistributionSettings settings;
-    settings.rebalance_threshold = scene.parallel.rebalance_threshold;
+    const DistributionSettings settings = distribution_settings(scene.parallel);
     Model local;
     TravellingState local_state;
     auto distribution = std::make_unique<Distribution>(*comm, settings, std::move(start), buffer,
@@ -742,6 +946,7 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
   // rank throws alike there.
   Model model;
   comm->run_collectively([&] { model = build_model(scene, load_body_meshes(scene)); });
+  check_memory(model_size(model), "the model");
   return std::make_unique<Simulation>(scene, std::move(model), std::move(options), comm);
 }
 

@@ -48,8 +48,9 @@ struct StageClock {
 };
 
 struct RunReport {
-  std::string status = "running";  // completed | failed
-  std::string reason;              // message when failed
+  std::string status = "running";  // completed | failed | interrupted
+  std::string reason;              // message when failed or interrupted
+  bool io_failure = false;         // failed: an output file could not be written (else numerical)
   long steps = 0;
   double time = 0.0;                // simulated time reached (s)
   double time_step = 0.0;           // s
@@ -69,6 +70,7 @@ struct RunReport {
   double imbalance = 1.0, max_imbalance = 1.0;
   long redistributions = 0, rebalances = 0, migrated_elements = 0;
   long halo_elements_max = 0, ghost_nodes_max = 0, ghost_nodes_mean = 0, neighbours_max = 0;
+  long active_elements_max = 0;  // tets a rank computes internal forces for (owned + halo)
   double communication_seconds = 0.0;  // halo exchange + redistribution + reductions (rank 0)
   // Peak resident set size per rank (KiB, largest and mean over ranks): start-up (scene, model,
   // distribution) and the step loop after it (counted afresh once start-up memory is freed).
@@ -87,8 +89,10 @@ class Simulation {
              std::unique_ptr<Distribution> distribution, double contact_buffer);
   ~Simulation();
 
-  // Runs to scene.time.end (writing outputs); never throws NumericalFailure: a failure is
-  // reported in the returned status and in summary.json.
+  // Runs to scene.time.end (writing outputs); never throws NumericalFailure or IoError: a
+  // failure is reported in the returned status and in summary.json (when the disk allows).  A
+  // signal (drivers/interrupt.hpp) ends the run after the step it arrived in, with a checkpoint
+  // (when checkpoints are enabled) and the status "interrupted".
   RunReport run();
 
   // One time step (stages 1–8).  Throws NumericalFailure on blow-up.
@@ -123,6 +127,10 @@ class Simulation {
     n_stages
   };
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
+  void check_run_limits() const;
+  std::string step_advice() const;
+  void check_stable_step(const struct CriticalStep& deformed) const;
+  std::string step_origin() const;
   void redistribute();
   TravellingState travelling_state() const;
   void rebind_stages(TravellingState& state, bool detected);
@@ -131,6 +139,9 @@ class Simulation {
   void restore_checkpoint(const std::string& path);
   bool is_root() const;
   void write_outputs(bool force);
+  void write_files(bool frame, bool energy_row, double energy_time);
+  void finish_interrupted(RunReport& result);
+  void write_summary(RunReport& result);
   void start_half_step(NodeArrays& nodes) const;
 
   Scene scene_;
@@ -162,6 +173,9 @@ class Simulation {
   InternalForceSplit split_;  // N ranks: interior tets computed while the ghost exchange travels
   double next_checkpoint_time_ = 0.0;
   std::vector<std::string> checkpoints_;  // written so far; the last two are kept
+  long checkpoint_step_ = -1;             // step of the newest checkpoint written
+  long next_stability_check_ = 0;         // step of the next minimum-step guard check
+  int interrupt_ = 0;  // signal that ends the run after this step (-1: received by another rank)
   long whole_nodes_ = 0, whole_tets_ = 0, whole_joints_ = 0;  // counts of the whole model
   std::uint64_t reference_hash_ = 0;                          // of the whole model's x0
   long startup_peak_rss_kib_ = 0;                             // this rank, end of start-up

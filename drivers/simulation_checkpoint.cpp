@@ -9,11 +9,14 @@
 
 #include "contact/contact_stage.hpp"
 #include "core/error.hpp"
+#include "core/state_hash.hpp"
+#include "drivers/restart_check.hpp"
 #include "drivers/simulation.hpp"
 #include "fracture/joint_kernels.hpp"
 #include "fracture/joint_stage.hpp"
 #include "parallel/checkpoint.hpp"
 #include "parallel/communicator.hpp"
+#include "parallel/distribution.hpp"
 
 namespace fdem {
 
@@ -55,9 +58,15 @@ void Simulation::write_checkpoint() {
                     {"joint_friction_started", joint_friction_.started ? 1.0 : 0.0}};
   for (const auto& [name, value] : ledger_.saved_state())
     header.doubles.emplace_back("ledger_" + name, value);
+  for (const auto& [key, value] : restart_scene_values(scene_))  // compared on a restart
+    header.doubles.emplace_back(restart_scene_prefix + key, value);
+  // The state_hash of the state it holds (as summary.json would give it): verified on restart.
+  const std::uint64_t hash =
+      distribution_ ? global_state_hash(model_.nodes, *comm_) : state_hash(model_.nodes);
   header.integers = {{"steps", steps_},
                      {"contact_detected", contact_ && contact_->detected() ? 1 : 0},
-                     {"contact_detections", contact_ ? contact_->detections() : 0}};
+                     {"contact_detections", contact_ ? contact_->detections() : 0},
+                     {"state_hash", static_cast<std::int64_t>(hash)}};
 
   CheckpointRows rows;
   const NodeArrays& nodes = model_.nodes;
@@ -99,6 +108,7 @@ void Simulation::write_checkpoint() {
   const std::string path = (std::filesystem::path(options_.output_dir) / name).string();
   fdem::write_checkpoint(path, *comm_, header, rows);
   checkpoints_.push_back(path);
+  checkpoint_step_ = steps_;
   // Keep the newest two: the one just written and the previous one.
   if (checkpoints_.size() > 2 && comm_->rank() == 0) {
     std::error_code ignored;
@@ -122,8 +132,13 @@ void Simulation::restore_checkpoint(const std::string& path) {
     throw InputError("checkpoint '" + path + "' holds joint histories of " +
                      std::to_string(rows.joint_history_bytes) + " bytes; this fdem uses " +
                      std::to_string(sizeof(JointHistory)));
-  std::map<std::string, double> doubles;
+  std::map<std::string, double> doubles, scene_values;
   for (const auto& [name, value] : header.doubles) doubles[name] = value;
+  const std::string prefix = restart_scene_prefix;
+  for (const auto& [name, value] : header.doubles)
+    if (name.rfind(prefix, 0) == 0) scene_values[name.substr(prefix.size())] = value;
+  for (const std::string& warning : compare_restart_scene(scene_, scene_values, path))
+    if (is_root()) std::fprintf(stderr, "fdem: warning: restart: %s\n", warning.c_str());
   std::map<std::string, std::int64_t> integers;
   for (const auto& [name, value] : header.integers) integers[name] = value;
   const auto number = [&](const std::string& name) {
@@ -152,6 +167,13 @@ void Simulation::restore_checkpoint(const std::string& path) {
       at_detection[3 * n + k] = rows.node_x_at_detection[3 * i + k];
     }
   }
+  // Every node of the model is restored (on N ranks, by the ranks that own them).
+  const std::uint64_t restored =
+      distribution_ ? global_state_hash(nodes, *comm_) : state_hash(nodes);
+  if (static_cast<std::uint64_t>(integer("state_hash")) != restored)
+    throw InputError("checkpoint corrupt: the restored state has state_hash " +
+                     hash_to_hex(restored) + ", the checkpoint '" + path + "' holds " +
+                     hash_to_hex(static_cast<std::uint64_t>(integer("state_hash"))));
   JointArrays& joint_rows = model_.joints;
   std::vector<JointHistory> history(static_cast<std::size_t>(joint_rows.size()));
   for (std::size_t i = 0; i < rows.joint_gid.size(); ++i) {

@@ -619,7 +619,11 @@ std::string list_groups(const RawMesh& mesh) {
 }  // namespace
 
 GmshMesh read_gmsh(const std::string& path, const std::string& physical) {
-  const std::string data = read_whole_file(path);
+  return parse_gmsh(read_whole_file(path), path, physical);
+}
+
+GmshMesh parse_gmsh(const std::string& data, const std::string& path,
+                    const std::string& physical) {
   MshCursor cur(path, data);
   RawMesh mesh;
 

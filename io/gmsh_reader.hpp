@@ -37,4 +37,8 @@ struct GmshMesh {
 // physical group, physical group without tetrahedra.
 GmshMesh read_gmsh(const std::string& path, const std::string& physical = "");
 
+// The same from the file's bytes (`path` names it in messages): the fuzzing entry point.
+GmshMesh parse_gmsh(const std::string& data, const std::string& path,
+                    const std::string& physical = "");
+
 }  // namespace fdem

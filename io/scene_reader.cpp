@@ -11,6 +11,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/checked_cast.hpp"
 #include "core/error.hpp"
 
 namespace fdem {
@@ -389,7 +390,12 @@ WallMeshSpec read_wall(const Reader& r, const YAML::Node& w, const std::string& 
   } else if (w["length"]) {
     const double length = r.positive(w["length"], path + ".length", "wall length (m)");
     // n units and n − 1 gaps make the length.
-    const long n = std::max(1L, std::lround((length + g) / (lx + g)));
+    const double units = std::max(1.0, std::round((length + g) / (lx + g)));
+    if (!fits_integer<int>(units))
+      r.fail(w["length"], path + ".length",
+             Reader::format(length) + " m is " + Reader::format(units) + " units of " +
+                 Reader::format(lx) + " m: more than a wall can have");
+    const long n = static_cast<long>(units);
     const double made = n * lx + (n - 1) * g;
     if (std::abs(made - length) > 1e-6 * length) {
       const double below = (n > 1 ? n - 1 : 1) * lx + (n > 1 ? n - 2 : 0) * g;
@@ -607,6 +613,34 @@ LoadSpec read_ramp(const Reader& r, const YAML::Node& node, const std::string& p
   return load;
 }
 
+void read_limits(const Reader& r, const YAML::Node& node, LimitsSpec& limits) {
+  r.check_keys(node, "limits", {"max_steps", "max_memory_per_rank"});
+  if (node["max_steps"])
+    limits.max_steps = r.positive(node["max_steps"], "limits.max_steps",
+                                  "the largest number of time steps of a run");
+  if (node["max_memory_per_rank"] && !r.is_auto(node["max_memory_per_rank"]))
+    limits.max_memory_per_rank =
+        r.positive(node["max_memory_per_rank"], "limits.max_memory_per_rank",
+                   "the memory one rank may use (bytes) or 'auto'");
+}
+
+// An interval must move time forward: t + every must differ from t up to time.end (and a frame
+// every 1e-12 of the run is already more than any step count allows), else the loop that
+// advances the next output time never ends.
+void check_intervals(const Reader& r, const YAML::Node& output, const Scene& scene) {
+  const double shortest = 1e-12 * scene.time.end;  // s
+  const std::pair<const char*, double> intervals[] = {
+      {"every", scene.output.every},
+      {"energy_every", scene.output.energy_every},
+      {"checkpoint_every", scene.output.checkpoint_every}};
+  for (const auto& [key, every] : intervals)
+    if (every > 0.0 && every < shortest)
+      r.fail(output[key], std::string("output.") + key,
+             Reader::format(every) + " s cannot advance time: it is below 1e-12 x time.end (" +
+                 Reader::format(scene.time.end) + " s). Use 0 (first and last only) or at least " +
+                 Reader::format(shortest) + " s.");
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& yaml_text, const std::string& path,
@@ -630,7 +664,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   scene.source_path = path;
   r.check_keys(root, "",
                {"name", "time", "gravity", "materials", "bodies", "interfaces", "loads", "output",
-                "contact", "parallel"},
+                "contact", "parallel", "limits"},
                {"time", "materials", "bodies"});
   scene.name =
       root["name"] ? r.string(root["name"], "name") : std::filesystem::path(path).stem().string();
@@ -836,7 +870,10 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
 
   if (const YAML::Node parallel = root["parallel"]) {
     r.check_keys(parallel, "parallel",
-                 {"rebalance_threshold", "redistribute_every", "distributed_start"});
+                 {"rebalance_threshold", "redistribute_every", "distributed_start", "partitioner"});
+    if (parallel["partitioner"])
+      scene.parallel.partitioner = r.choice(parallel["partitioner"], "parallel.partitioner",
+                                            {"rib", "rcb", "hsfc", "random"});
     if (parallel["distributed_start"])
       scene.parallel.distributed_start =
           r.boolean(parallel["distributed_start"], "parallel.distributed_start");
@@ -852,6 +889,9 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
       scene.parallel.redistribute_every = every;
     }
   }
+
+  if (const YAML::Node limits = root["limits"]) read_limits(r, limits, scene.limits);
+  check_intervals(r, root["output"], scene);
 
   if (const YAML::Node contact = root["contact"]) {
     r.check_keys(contact, "contact", {"buffer"});

@@ -18,6 +18,8 @@
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -28,14 +30,39 @@
 
 namespace fdem {
 
+namespace {
+
+// Removes a partial file, keeping errno (the reason the write failed) for the message.
+void remove_partial(const std::string& path) {
+  const int saved = errno;
+  std::error_code ignored;
+  std::filesystem::remove(path, ignored);
+  errno = saved;
+}
+
+std::string system_reason() {
+  return errno != 0 ? std::strerror(errno) : "disk full or no permission?";
+}
+
+}  // namespace
+
 void write_file_atomically(const std::string& path, const std::string& content) {
   const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << content;
-    if (!out) throw std::runtime_error("cannot write " + tmp + " (disk full or no permission?)");
+  errno = 0;
+  std::ofstream out(tmp, std::ios::binary);
+  out << content;
+  out.close();  // the last bytes reach the disk here: check after closing
+  if (!out) {
+    const std::string reason = system_reason();
+    remove_partial(tmp);
+    throw IoError("cannot write " + path + ": " + reason);
   }
-  std::filesystem::rename(tmp, path);
+  std::error_code error;
+  std::filesystem::rename(tmp, path, error);
+  if (error) {
+    remove_partial(tmp);
+    throw IoError("cannot rename " + tmp + " to " + path + ": " + error.message());
+  }
 }
 
 std::string frame_file_name(const std::string& stem, const std::string& extension, int ranks) {
@@ -193,8 +220,30 @@ vtkSmartPointer<vtkPolyData> triangle_poly(const std::vector<double>& points,
   return poly;
 }
 
-bool write_succeeded(vtkXMLWriter* writer) {
-  return writer->Write() == 1 && writer->GetErrorCode() == vtkErrorCode::NoError;
+// Writes and reports failure by the return value only: VTK's own error dump (object addresses,
+// source lines) is silenced, fdem reports the failure as one message.
+// `system_error` receives errno as the write left it (0 if it set none).
+bool write_succeeded(vtkXMLWriter* writer, int& system_error) {
+  const int warnings = vtkObject::GetGlobalWarningDisplay();
+  vtkObject::GlobalWarningDisplayOff();
+  errno = 0;
+  const bool ok = writer->Write() == 1 && writer->GetErrorCode() == vtkErrorCode::NoError;
+  system_error = errno;
+  vtkObject::SetGlobalWarningDisplay(warnings);
+  return ok;
+}
+
+// The reason of a failed VTK write: the system's when it set one, else VTK's error code.
+std::string write_failure(vtkXMLWriter* writer, int system_error) {
+  if (system_error != 0) return std::strerror(system_error);
+  switch (writer->GetErrorCode()) {
+    case vtkErrorCode::OutOfDiskSpaceError:
+      return "out of disk space";
+    case vtkErrorCode::CannotOpenFileError:
+      return "cannot open the file";
+    default:
+      return "VTK error code " + std::to_string(writer->GetErrorCode());
+  }
 }
 
 // One-rank frame: `data` to `path` through `<path>.tmp`.
@@ -206,8 +255,18 @@ void write_serial(const std::string& path, vtkDataObject* data) {
   writer->SetInputData(data);
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
-  if (!write_succeeded(writer)) throw std::runtime_error("VTK could not write " + tmp);
-  std::filesystem::rename(tmp, path);
+  int system_error = 0;
+  if (!write_succeeded(writer, system_error)) {
+    const std::string reason = write_failure(writer, system_error);
+    remove_partial(tmp);
+    throw IoError("cannot write the frame " + path + ": " + reason);
+  }
+  std::error_code error;
+  std::filesystem::rename(tmp, path, error);
+  if (error) {
+    remove_partial(tmp);
+    throw IoError("cannot rename " + tmp + " to " + path + ": " + error.message());
+  }
 }
 
 // VTK's parallel XML writer (vtkXMLPUnstructuredGridWriter, vtkXMLPPolyDataWriter) adapted to
@@ -220,6 +279,8 @@ void write_serial(const std::string& path, vtkDataObject* data) {
 template <class ParallelWriter>
 class EveryPieceWriter : public ParallelWriter {
  public:
+  int SystemError = 0;  // errno of a failed piece write (its reason), 0 if none
+
   static EveryPieceWriter* New() {
     auto* writer = new EveryPieceWriter;
     writer->InitializeObjectBase();
@@ -252,14 +313,20 @@ class EveryPieceWriter : public ParallelWriter {
     piece->SetEncodeAppendedData(this->GetEncodeAppendedData());
     piece->SetHeaderType(this->GetHeaderType());
     piece->SetBlockSize(this->GetBlockSize());
+    errno = 0;
     int result = piece->Write();
+    if (errno != 0) this->SystemError = errno;
     const unsigned long error = piece->GetErrorCode();
     piece->Delete();
     this->SetErrorCode(error);
-    if (result != 1 || error != vtkErrorCode::NoError) return 0;
+    if (result != 1 || error != vtkErrorCode::NoError) {
+      remove_partial(tmp);
+      return 0;
+    }
     std::error_code renamed;
     std::filesystem::rename(tmp, path, renamed);
     if (renamed) {
+      remove_partial(tmp);
       this->SetErrorCode(vtkErrorCode::CannotOpenFileError);
       result = 0;
     }
@@ -286,8 +353,10 @@ void write_piece(const std::string& stem, const std::string& extension, vtkDataO
   writer->SetWriteToOutputString(rank == 0);  // the summary goes to a string, then atomically out
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
-  if (!write_succeeded(writer))
-    throw std::runtime_error("VTK could not write " + frame_piece_name(stem, extension, rank));
+  int system_error = 0;
+  if (!write_succeeded(writer, system_error))
+    throw IoError("cannot write the frame piece " + frame_piece_name(stem, extension, rank) + ": " +
+                  write_failure(writer, writer->SystemError ? writer->SystemError : system_error));
   if (rank == 0) write_file_atomically(summary, writer->GetOutputString());
 }
 

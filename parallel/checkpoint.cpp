@@ -5,15 +5,19 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <numeric>
 #include <set>
 #include <sstream>
 #include <type_traits>
 
 #include "core/error.hpp"
+#include "parallel/checkpoint_checksum.hpp"
+#include "parallel/checkpoint_seal.hpp"
 #include "parallel/hdf5_support.hpp"
 
 namespace fdem {
@@ -210,7 +214,47 @@ class BlockExchange {
 struct FileBlock {
   Run nodes, joints;
   CheckpointRows rows;
+  hsize_t friction_offset = 0, friction_total = 0;  // this rank's first friction row, all rows
+  std::map<std::string, std::uint64_t> checksums;   // of every dataset, over all ranks
 };
+
+// Every dataset's checksum (checkpoint_checksum.hpp): this rank's rows, summed over the ranks.
+// Collective.
+void compute_checksums(const Communicator& comm, FileBlock& block) {
+  const CheckpointRows& r = block.rows;
+  const std::uint64_t node0 = block.nodes.start, joint0 = block.joints.start;
+  const std::uint64_t pair0 = block.friction_offset;
+  const std::vector<std::pair<std::string, std::uint64_t>> local = {
+      {"/nodes/gid", rows_checksum("/nodes/gid", r.node_gid, 1, node0)},
+      {"/nodes/x", rows_checksum("/nodes/x", r.node_x, 3, node0)},
+      {"/nodes/v", rows_checksum("/nodes/v", r.node_v, 3, node0)},
+      {"/nodes/x_at_detection",
+       rows_checksum("/nodes/x_at_detection", r.node_x_at_detection, 3, node0)},
+      {"/nodes/prescribed_velocity",
+       rows_checksum("/nodes/prescribed_velocity", r.node_prescribed_velocity, 3, node0)},
+      {"/joints/gid", rows_checksum("/joints/gid", r.joint_gid, 1, joint0)},
+      {"/joints/broken", rows_checksum("/joints/broken", r.joint_broken, 1, joint0)},
+      {"/joints/mode", rows_checksum("/joints/mode", r.joint_mode, 1, joint0)},
+      {"/joints/failure_time",
+       rows_checksum("/joints/failure_time", r.joint_failure_time, 1, joint0)},
+      {"/joints/damage", rows_checksum("/joints/damage", r.joint_damage, 1, joint0)},
+      {"/joints/history",
+       rows_checksum("/joints/history", r.joint_history, r.joint_history_bytes, joint0)},
+      {"/friction/a", rows_checksum("/friction/a", r.friction_a, 1, pair0)},
+      {"/friction/b", rows_checksum("/friction/b", r.friction_b, 1, pair0)},
+      {"/friction/spring", rows_checksum("/friction/spring", r.friction_spring, 3, pair0)},
+      {"/friction/stiffness",
+       rows_checksum("/friction/stiffness", r.friction_stiffness, 1, pair0)}};
+  std::vector<std::uint64_t> sums;
+  for (const auto& entry : local) sums.push_back(entry.second);
+  comm.sum_in_place(sums);  // unsigned: wraps mod 2^64, the same on any rank count
+  for (std::size_t i = 0; i < local.size(); ++i) block.checksums[local[i].first] = sums[i];
+}
+
+// The checksum of the header (root counts and /run values).
+std::uint64_t header_checksum(const std::string& serialized_header, std::int64_t history_bytes) {
+  return text_checksum(serialized_header + " h:" + std::to_string(history_bytes));
+}
 
 // ---------------------------------------------------------------------------------------------
 // Writing.
@@ -225,12 +269,33 @@ std::vector<T> permuted(const std::vector<T>& values, const std::vector<std::siz
   return out;
 }
 
-void write_file(const Context& ctx, const std::string& tmp_path, const Communicator& comm,
-                const CheckpointHeader& header, const FileBlock& block) {
+// Where every dataset's raw data lies in the file (for the seal).  Collective (metadata reads).
+std::vector<FileRegion> data_regions(const Context& ctx, hid_t file) {
+  std::vector<FileRegion> regions;
+  for (const char* name :
+       {"/nodes/gid", "/nodes/x", "/nodes/v", "/nodes/x_at_detection", "/nodes/prescribed_velocity",
+        "/joints/gid", "/joints/broken", "/joints/mode", "/joints/failure_time", "/joints/damage",
+        "/joints/history", "/friction/a", "/friction/b", "/friction/spring",
+        "/friction/stiffness"}) {
+    Handle dataset =
+        ctx.own(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, std::string("cannot open ") + name);
+    const haddr_t address = H5Dget_offset(dataset.get());  // from the start of the file
+    const hsize_t size = H5Dget_storage_size(dataset.get());
+    if (address != HADDR_UNDEF && size > 0) regions.push_back({address, size});
+  }
+  return regions;
+}
+
+// Writes the file; returns where its datasets' raw data lie.
+std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_path,
+                                   const Communicator& comm, const CheckpointHeader& header,
+                                   const FileBlock& block) {
   Handle file;
   comm.run_collectively([&] {
     Handle fapl = make_mpio_access(ctx, comm);
-    file = ctx.own(H5Fcreate(tmp_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
+    Handle fcpl = make_plist(ctx, H5P_FILE_CREATE);  // the userblock holds the seal
+    ctx.check_status(H5Pset_userblock(fcpl.get(), checkpoint_seal_bytes), "cannot set userblock");
+    file = ctx.own(H5Fcreate(tmp_path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), H5Fclose,
                    "cannot create '" + tmp_path + "'");
   });
 
@@ -249,6 +314,8 @@ void write_file(const Context& ctx, const std::string& tmp_path, const Communica
     write.attribute(root, "reference_hash", H5T_STD_U64LE, H5T_NATIVE_UINT64,
                     &header.reference_hash);
     write.attribute(root, "joint_history_bytes", H5T_STD_I64LE, H5T_NATIVE_INT64, &history_bytes);
+    const std::uint64_t checksum = header_checksum(serialized(header), history_bytes);
+    write.attribute(root, "header_checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &checksum);
     Handle run = write.group("run", /*track_attribute_order=*/true);
     for (const auto& [name, value] : header.doubles)
       write.attribute(run.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
@@ -264,11 +331,13 @@ void write_file(const Context& ctx, const std::string& tmp_path, const Communica
     std::vector<Run> runs;
     if (block.nodes.count > 0) runs.push_back(block.nodes);
     Handle nodes = write.group("nodes");
-    write.rows(nodes.get(), "gid", n, 0, rows.node_gid, runs);
-    write.rows(nodes.get(), "x", n, 3, rows.node_x, runs);
-    write.rows(nodes.get(), "v", n, 3, rows.node_v, runs);
-    write.rows(nodes.get(), "x_at_detection", n, 3, rows.node_x_at_detection, runs);
-    write.rows(nodes.get(), "prescribed_velocity", n, 3, rows.node_prescribed_velocity, runs);
+    write.rows(nodes.get(), "gid", n, 0, rows.node_gid, runs, block.checksums.at("/nodes/gid"));
+    write.rows(nodes.get(), "x", n, 3, rows.node_x, runs, block.checksums.at("/nodes/x"));
+    write.rows(nodes.get(), "v", n, 3, rows.node_v, runs, block.checksums.at("/nodes/v"));
+    write.rows(nodes.get(), "x_at_detection", n, 3, rows.node_x_at_detection, runs,
+               block.checksums.at("/nodes/x_at_detection"));
+    write.rows(nodes.get(), "prescribed_velocity", n, 3, rows.node_prescribed_velocity, runs,
+               block.checksums.at("/nodes/prescribed_velocity"));
   });
 
   comm.run_collectively([&] {
@@ -278,11 +347,15 @@ void write_file(const Context& ctx, const std::string& tmp_path, const Communica
     std::vector<Run> runs;
     if (block.joints.count > 0) runs.push_back(block.joints);
     Handle joints = write.group("joints");
-    write.rows(joints.get(), "gid", n, 0, rows.joint_gid, runs);
-    write.rows(joints.get(), "broken", n, 0, rows.joint_broken, runs);
-    write.rows(joints.get(), "mode", n, 0, rows.joint_mode, runs);
-    write.rows(joints.get(), "failure_time", n, 0, rows.joint_failure_time, runs);
-    write.rows(joints.get(), "damage", n, 0, rows.joint_damage, runs);
+    write.rows(joints.get(), "gid", n, 0, rows.joint_gid, runs, block.checksums.at("/joints/gid"));
+    write.rows(joints.get(), "broken", n, 0, rows.joint_broken, runs,
+               block.checksums.at("/joints/broken"));
+    write.rows(joints.get(), "mode", n, 0, rows.joint_mode, runs,
+               block.checksums.at("/joints/mode"));
+    write.rows(joints.get(), "failure_time", n, 0, rows.joint_failure_time, runs,
+               block.checksums.at("/joints/failure_time"));
+    write.rows(joints.get(), "damage", n, 0, rows.joint_damage, runs,
+               block.checksums.at("/joints/damage"));
     // history is n × bytes even for bytes = 0, so the record size is visible in the file.
     if (bytes == 0) {
       Handle history_space = make_space(ctx, {n, bytes});
@@ -290,35 +363,48 @@ void write_file(const Context& ctx, const std::string& tmp_path, const Communica
           ctx.own(H5Dcreate2(joints.get(), "history", H5T_STD_U8LE, history_space.get(),
                              H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
                   H5Dclose, "cannot create dataset history");
+      const std::uint64_t none = 0;  // no rows
+      write.attribute(empty_history.get(), "checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &none);
     } else {
-      write.rows(joints.get(), "history", n, bytes, rows.joint_history, runs);
+      write.rows(joints.get(), "history", n, bytes, rows.joint_history, runs,
+                 block.checksums.at("/joints/history"));
     }
   });
 
   // Friction pairs: this rank's rows after those of the lower ranks.
-  const std::vector<std::int64_t> pair_counts =
-      comm.allgather(static_cast<std::int64_t>(rows.friction_a.size()));
   comm.run_collectively([&] {
     const Writer write(ctx, file.get());
-    hsize_t offset = 0, total = 0;
-    for (int r = 0; r < comm.size(); ++r) {
-      if (r < comm.rank()) offset += static_cast<hsize_t>(pair_counts[r]);
-      total += static_cast<hsize_t>(pair_counts[r]);
-    }
+    const hsize_t offset = block.friction_offset, total = block.friction_total;
     std::vector<Run> runs;
     if (!rows.friction_a.empty()) runs.push_back({offset, rows.friction_a.size()});
     Handle friction = write.group("friction");
-    write.rows(friction.get(), "a", total, 0, rows.friction_a, runs);
-    write.rows(friction.get(), "b", total, 0, rows.friction_b, runs);
-    write.rows(friction.get(), "spring", total, 3, rows.friction_spring, runs);
-    write.rows(friction.get(), "stiffness", total, 0, rows.friction_stiffness, runs);
+    write.rows(friction.get(), "a", total, 0, rows.friction_a, runs,
+               block.checksums.at("/friction/a"));
+    write.rows(friction.get(), "b", total, 0, rows.friction_b, runs,
+               block.checksums.at("/friction/b"));
+    write.rows(friction.get(), "spring", total, 3, rows.friction_spring, runs,
+               block.checksums.at("/friction/spring"));
+    write.rows(friction.get(), "stiffness", total, 0, rows.friction_stiffness, runs,
+               block.checksums.at("/friction/stiffness"));
   });
 
+  std::vector<FileRegion> regions;
+  comm.run_collectively([&] { regions = data_regions(ctx, file.get()); });
   // Flush to storage (MPI_File_sync), then close: only a complete file gets the final name.
   comm.run_collectively([&] {
-    ctx.check_status(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "cannot flush '" + tmp_path + "'");
-    ctx.check_status(file.close(), "cannot close '" + tmp_path + "'");
+    ctx.check_collective_write(H5Fflush(file.get(), H5F_SCOPE_GLOBAL),
+                               "cannot flush '" + tmp_path + "'");
+    ctx.check_collective_write(file.close(), "cannot close '" + tmp_path + "'");
   });
+  return regions;
+}
+
+// The file's size, about: its datasets (bytes per row) and 1 MiB for metadata.
+double estimated_file_bytes(const CheckpointHeader& header, std::size_t history_bytes,
+                            std::int64_t friction_pairs) {
+  return double(header.n_nodes) * (8 + 4 * 24) +
+         double(header.n_joints) * (8 + 1 + 1 + 8 + 8 + double(history_bytes)) +
+         double(friction_pairs) * (8 + 8 + 24 + 8) + 1048576.0;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -424,10 +510,13 @@ class Reader {
     hsize_t count = 1;
     for (hsize_t d : dims) count *= d;
     std::vector<T> values(static_cast<std::size_t>(count));
-    if (count == 0) return values;  // the same on every rank
-    ctx_.check_status(
-        H5Dread(dataset.get(), native_type<T>(), H5S_ALL, H5S_ALL, dxpl_.get(), values.data()),
-        "cannot read " + full);
+    if (count > 0)
+      ctx_.check_status(
+          H5Dread(dataset.get(), native_type<T>(), H5S_ALL, H5S_ALL, dxpl_.get(), values.data()),
+          "cannot read " + full);
+    const auto stored = number_attribute<std::uint64_t>(dataset.get(), full, "checksum");
+    const std::size_t width = dims.size() > 1 ? static_cast<std::size_t>(dims[1]) : 1;
+    if (rows_checksum(full, values, width, 0) != stored) ctx_.corrupt("dataset " + full);
     return values;
   }
 
@@ -471,7 +560,8 @@ void sort_friction(CheckpointRows& rows) {
 // ---------------------------------------------------------------------------------------------
 void write_checkpoint(const std::string& path, const Communicator& comm,
                       const CheckpointHeader& header, const CheckpointRows& owned) {
-  const Context ctx(path);
+  Context ctx(path, "checkpoint", Context::Mode::write);
+  ctx.abort_on(comm);
   const std::string tmp_path = path + ".tmp";
 
   // 1. The caller's rows, first each rank's own, then across ranks (all before any file I/O, so
@@ -514,22 +604,42 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
   rows.friction_b = owned.friction_b;
   rows.friction_spring = owned.friction_spring;
   rows.friction_stiffness = owned.friction_stiffness;
+  const std::vector<std::int64_t> pair_counts =
+      comm.allgather(static_cast<std::int64_t>(rows.friction_a.size()));
+  for (int r = 0; r < comm.size(); ++r) {
+    if (r < comm.rank()) block.friction_offset += static_cast<hsize_t>(pair_counts[r]);
+    block.friction_total += static_cast<hsize_t>(pair_counts[r]);
+  }
+  compute_checksums(comm, block);
 
-  // 2. The file under its temporary name.  A failure is collective: every rank unwinds (closing
-  //    the file together) and rank 0 removes the partial file.
+  // 2. The file under its temporary name, its space claimed first.  A failure is collective:
+  //    every rank unwinds (closing the file together) and rank 0 removes the partial file.
+  comm.run_collectively([&] {
+    if (comm.is_root())
+      reserve_space(ctx, tmp_path,
+                    estimated_file_bytes(header, owned.joint_history_bytes,
+                                         static_cast<std::int64_t>(block.friction_total)));
+  });
+  std::vector<FileRegion> regions;
   {
     const SilenceHdf5Errors silence;
     try {
-      write_file(ctx, tmp_path, comm, header, block);
+      regions = write_file(ctx, tmp_path, comm, header, block);
     } catch (const CollectiveFailure&) {
       if (comm.is_root()) std::remove(tmp_path.c_str());
       throw;
     }
   }
 
-  // 3. The final name: an atomic replace by rank 0, which every rank waits for.
+  // 3. The seal, then the final name: an atomic replace by rank 0, which every rank waits for.
   comm.run_collectively([&] {
     if (!comm.is_root()) return;
+    try {
+      write_checkpoint_seal(tmp_path, regions);
+    } catch (const IoError&) {
+      std::remove(tmp_path.c_str());
+      throw;
+    }
     if (std::rename(tmp_path.c_str(), path.c_str()) != 0) {
       const std::string reason = std::strerror(errno);
       std::remove(tmp_path.c_str());
@@ -541,15 +651,20 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
 
 std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& path,
                                                             const Communicator& comm) {
-  const Context ctx(path);
+  const Context ctx(path, "checkpoint", Context::Mode::read);
   const SilenceHdf5Errors silence;
   CheckpointHeader header;
   CheckpointRows rows;
 
+  SealState sealed = SealState::absent;
   comm.run_collectively([&] {
     std::error_code error;
     if (!std::filesystem::exists(path, error)) ctx.fail("file does not exist");
     if (!std::filesystem::is_regular_file(path, error)) ctx.fail("is not a regular file");
+    // The seal first (rank 0): damaged metadata must not reach HDF5's parser.
+    std::string problem;
+    if (comm.is_root()) sealed = check_checkpoint_seal(path, problem);
+    if (sealed == SealState::damaged) ctx.corrupt(problem);
     const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
     if (is_hdf5 < 0) ctx.fail_hdf5("cannot be opened");
     if (is_hdf5 == 0) ctx.fail("is not an HDF5 file, so not an fdem checkpoint");
@@ -577,6 +692,8 @@ std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& p
     if (version != checkpoint_format_version)
       ctx.fail("has format version " + std::to_string(version) + "; this fdem reads version " +
                std::to_string(checkpoint_format_version));
+    if (comm.is_root() && sealed != SealState::intact)
+      ctx.corrupt("its checksum block (the HDF5 userblock) is missing");
     header.ranks = read.number_attribute<std::int32_t>(root, "/", "ranks");
     header.n_nodes = read.number_attribute<std::int64_t>(root, "/", "n_nodes");
     header.n_tets = read.number_attribute<std::int64_t>(root, "/", "n_tets");
@@ -599,6 +716,9 @@ std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& p
       else
         ctx.fail("value /run/" + name + " is neither a floating-point number nor an integer");
     }
+    const auto stored = read.number_attribute<std::uint64_t>(root, "/", "header_checksum");
+    if (header_checksum(serialized(header), history_bytes) != stored)
+      ctx.corrupt("header (the root attributes and /run values)");
   });
 
   comm.run_collectively([&] {

@@ -2,8 +2,9 @@
 // rank (each writes the rows it owns) and readable by any number of ranks.
 //
 // Layout (self-describing; `h5dump -A` shows the header):
-//   /                 attributes format = "fdem-checkpoint", version = 1, ranks, n_nodes, n_tets,
-//                     n_joints, reference_hash, joint_history_bytes
+//   /                 attributes format = "fdem-checkpoint", version = 2, ranks, n_nodes, n_tets,
+//                     n_joints, reference_hash, joint_history_bytes, header_checksum (of the
+//                     counts and the /run values)
 //   /run/<name>       one scalar dataset per named value: float64 for header.doubles, int64 for
 //                     header.integers, in the order the driver gave them (creation order tracked)
 //   /nodes/gid        int64[n_nodes] = 0..n_nodes-1 (row i is the node of gid i)
@@ -14,6 +15,10 @@
 //   /joints/history   uint8[n_joints][joint_history_bytes] (opaque per-joint history records)
 //   /friction/{a, b}  int64[m] (a < b), /friction/spring float64[m][3], /friction/stiffness
 //                     float64[m]; written in rank order, read back sorted by (a, b)
+//
+// Every dataset has a uint64 attribute `checksum` (parallel/checkpoint_checksum.hpp: a sum over
+// its rows, so each rank adds its block); reading verifies each one and the header's, and a
+// mismatch is an InputError "checkpoint corrupt: dataset /nodes/x ...".
 //
 // The write goes to `path + ".tmp"`, is flushed to storage and closed, and only then renamed to
 // `path` by rank 0 (an atomic replace on POSIX file systems), so a crash during the write never
@@ -32,7 +37,7 @@
 namespace fdem {
 
 // Format version written into and required from every checkpoint file.
-constexpr int checkpoint_format_version = 1;
+constexpr int checkpoint_format_version = 2;  // 2: checksums
 
 // The run state a restart needs, beside the rows: named scalars chosen by the driver.
 struct CheckpointHeader {
@@ -68,14 +73,15 @@ struct CheckpointRows {
 // have matching lengths, friction pairs have a < b, joint_history_bytes agrees, and the owned
 // node / joint gids of all ranks form exactly 0..n-1 once each.  A violation is a bug of the
 // caller and throws CollectiveInternalError on every rank.  A file that cannot be created or an
-// HDF5 failure throws CollectiveInputError on every rank, naming the file; the .tmp file is then
-// removed and an existing file at `path` is left as it was.
+// HDF5 failure (disk full) throws CollectiveIoError on every rank, naming the file; the .tmp file
+// is then removed and an existing file at `path` is left as it was.
 void write_checkpoint(const std::string& path, const Communicator& comm,
                       const CheckpointHeader& header, const CheckpointRows& owned);
 
 // Collective.  Every rank reads the whole file: rows sorted by gid (the file stores them so),
 // friction pairs sorted by (a, b).  A missing file, a file that is not an fdem checkpoint, a
-// different format version, or a dataset of the wrong size or type throws CollectiveInputError
+// different format version, a dataset of the wrong size or type, or one that does not match its
+// checksum ("checkpoint corrupt: dataset X") throws CollectiveInputError
 // on every rank naming the file and what is wrong.
 std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& path,
                                                             const Communicator& comm);

@@ -70,6 +70,8 @@ LocalError LocalError::from(std::exception_ptr error) {
     local = {ErrorKind::input, e.what()};
   } catch (const NumericalFailure& e) {
     local = {ErrorKind::numerical, e.what()};
+  } catch (const IoError& e) {
+    local = {ErrorKind::io, e.what()};
   } catch (const std::exception& e) {
     local = {ErrorKind::internal, e.what()};
   } catch (...) {
@@ -110,6 +112,15 @@ void Communicator::barrier() const {
   MPI_Barrier(comm_);
 }
 
+int Communicator::ranks_on_this_node() const {
+  MPI_Comm node = MPI_COMM_NULL;
+  MPI_Comm_split_type(comm_, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &node);
+  int ranks = 1;
+  MPI_Comm_size(node, &ranks);
+  MPI_Comm_free(&node);
+  return ranks;
+}
+
 std::string Communicator::broadcast(const std::string& text, int root) const {
   std::uint64_t length = rank_ == root ? text.size() : 0;
   MPI_Bcast(&length, 1, MPI_UINT64_T, root, comm_);
@@ -140,6 +151,8 @@ void Communicator::check_errors(const LocalError& local) const {
       throw CollectiveInputError(message, first, failed_ranks);
     case ErrorKind::numerical:
       throw CollectiveNumericalFailure(message, first, failed_ranks);
+    case ErrorKind::io:
+      throw CollectiveIoError(message, first, failed_ranks);
     default:
       throw CollectiveInternalError(message, first, failed_ranks);
   }

@@ -51,15 +51,15 @@ class MpiEnvironment {
 };
 
 // What one rank found before a synchronisation point.
-enum class ErrorKind : std::int32_t { none = 0, input = 1, numerical = 2, internal = 3 };
+enum class ErrorKind : std::int32_t { none = 0, input = 1, numerical = 2, internal = 3, io = 4 };
 
 struct LocalError {
   ErrorKind kind = ErrorKind::none;
   std::string message;
 
   bool failed() const { return kind != ErrorKind::none; }
-  // Classifies a caught exception: InputError → input, NumericalFailure → numerical, anything
-  // else → internal (its what(), or "unknown exception").
+  // Classifies a caught exception: InputError → input, NumericalFailure → numerical, IoError →
+  // io, anything else → internal (its what(), or "unknown exception").
   static LocalError from(std::exception_ptr error);
 };
 
@@ -88,6 +88,12 @@ class CollectiveNumericalFailure : public NumericalFailure, public CollectiveFai
  public:
   CollectiveNumericalFailure(const std::string& what, int first_rank, int failed_ranks)
       : NumericalFailure(what), CollectiveFailure(first_rank, failed_ranks) {}
+};
+
+class CollectiveIoError : public IoError, public CollectiveFailure {
+ public:
+  CollectiveIoError(const std::string& what, int first_rank, int failed_ranks)
+      : IoError(what), CollectiveFailure(first_rank, failed_ranks) {}
 };
 
 class CollectiveInternalError : public std::logic_error, public CollectiveFailure {
@@ -156,6 +162,10 @@ class Communicator {
   bool is_root() const { return rank_ == 0; }
 
   void barrier() const;
+
+  // How many ranks of this communicator share this rank's node (shared-memory domain): they
+  // share its memory.
+  int ranks_on_this_node() const;
 
   // Reductions of one value (double, float, int32, int64, uint64).  min/max are order-free, so
   // the same on any rank count; a floating-point sum depends on the rank count (use it for

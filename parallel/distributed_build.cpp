@@ -104,53 +104,97 @@ struct NodeMass {
   double mass;
 };
 
-// Directory rank of a mesh node (equal ranges of the whole model's mesh node numbers).
-int directory_rank(std::int64_t mesh_node, std::int64_t n_mesh_nodes, int ranks) {
-  return static_cast<int>(static_cast<__int128>(mesh_node) * ranks / n_mesh_nodes);
-}
+// Directory rank of a node: the rank whose stretch of the Morton curve (its block of tets, sorted
+// by key) holds the key of the node's position.  Every user of a node computes the same rank, and
+// most nodes are their users' own rank: only nodes along the blocks' borders travel.
+class NodeDirectory {
+ public:
+  NodeDirectory(const std::vector<TetRecord>& block, const Vec3& lo, const Vec3& hi,
+                const Communicator& comm)
+      : lo_(lo), hi_(hi) {
+    const std::uint64_t none = std::numeric_limits<std::uint64_t>::max();
+    const std::vector<std::uint64_t> first = comm.allgather(block.empty() ? none : block[0].key);
+    for (int r = 0; r < comm.size(); ++r)
+      if (first[r] != none) {
+        first_key_.push_back(first[r]);
+        rank_.push_back(r);
+      }
+  }
+  int rank_of(const double x[3]) const {
+    const std::uint64_t key = morton_key(Vec3(x[0], x[1], x[2]), lo_, hi_);
+    const auto it = std::upper_bound(first_key_.begin(), first_key_.end(), key);
+    return rank_[it == first_key_.begin() ? 0
+                                          : static_cast<std::size_t>(it - first_key_.begin()) - 1];
+  }
+
+ private:
+  Vec3 lo_, hi_;
+  std::vector<std::uint64_t> first_key_;  // of each rank that holds tets, ascending
+  std::vector<int> rank_;
+};
 
 // Steps 1–2: this rank's chunks generated, shapes checked, keys given.
 std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<BodyChunks>& chunks,
                                         const std::vector<std::int64_t>& node_base,
                                         const std::vector<std::int32_t>& piece_base,
-                                        const Communicator& comm) {
+                                        const Communicator& comm, Vec3* node_lo, Vec3* node_hi) {
   std::int64_t total = 0;
   for (const BodyChunks& body : chunks)
     for (std::int64_t n : body.chunk_tets) total += n;
   if (total == 0) throw InputError(scene.source_path + ": the scene has no tetrahedra");
+  // Chunks are dealt along a Morton curve of their centres, in equal shares of tets, so that most
+  // tets are generated on the rank whose block (a stretch of the same kind of curve) they join.
+  struct ChunkRef {
+    std::uint64_t key;
+    std::int32_t body;
+    std::int64_t chunk;
+  };
+  std::vector<ChunkRef> deal;
+  Vec3 centre_lo = Vec3::Constant(1e300), centre_hi = Vec3::Constant(-1e300);
+  for (const BodyChunks& body : chunks) {  // ≈ the box of all nodes, as the tets' keys use
+    centre_lo = centre_lo.cwiseMin(body.lo);
+    centre_hi = centre_hi.cwiseMax(body.hi);
+  }
+  for (std::size_t b = 0; b < chunks.size(); ++b)
+    for (std::size_t c = 0; c < chunks[b].chunk_tets.size(); ++c)
+      deal.push_back({morton_key(chunks[b].chunk_centre[c], centre_lo, centre_hi),
+                      static_cast<std::int32_t>(b), static_cast<std::int64_t>(c)});
+  std::stable_sort(deal.begin(), deal.end(),
+                   [](const ChunkRef& a, const ChunkRef& b) { return a.key < b.key; });
   std::vector<TetRecord> records;
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   comm.run_collectively([&] {
-    std::int64_t before = 0;  // tets of the chunks before this one
-    for (std::size_t b = 0; b < chunks.size(); ++b)
-      for (std::size_t c = 0; c < chunks[b].chunk_tets.size(); ++c) {
-        const std::int64_t tets = chunks[b].chunk_tets[c];
-        // Chunks are dealt in order, each to the rank whose share of the tets it starts in.
-        const int rank = static_cast<int>(static_cast<__int128>(before) * comm.size() / total);
-        before += tets;
-        if (rank != comm.rank()) continue;
-        const MeshChunk chunk = chunks[b].generate(static_cast<std::int64_t>(c));
-        const std::vector<double>& coords = chunk.mesh.coords;
-        for (std::size_t n = 0; n < coords.size() / 3; ++n) {
-          lo = lo.cwiseMin(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
-          hi = hi.cwiseMax(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
-        }
-        for (std::size_t t = 0; t < chunk.mesh.tets.size() / 4; ++t) {
-          TetRecord r{};
-          r.body = static_cast<std::int32_t>(b);
-          r.piece = piece_base[b] + chunk.piece;
-          r.mesh_tet = chunk.first_tet + static_cast<std::int64_t>(t);
-          Vec3 X[4];
-          for (int k = 0; k < 4; ++k) {
-            const LocalIndex n = chunk.mesh.tets[4 * t + k];
-            r.node[k] = node_base[b] + chunk.node_id[static_cast<std::size_t>(n)];
-            X[k] = vec3_at(coords.data(), n);
-            for (int d = 0; d < 3; ++d) r.x[3 * k + d] = X[k][d];
-          }
-          check_tet_shape(X, scene.bodies[b].name, chunk.mesh.source, r.mesh_tet + 1);
-          records.push_back(r);
-        }
+    std::int64_t before = 0;  // tets of the chunks dealt before this one
+    for (const ChunkRef& ref : deal) {
+      const std::size_t b = static_cast<std::size_t>(ref.body);
+      const std::size_t c = static_cast<std::size_t>(ref.chunk);
+      const std::int64_t tets = chunks[b].chunk_tets[c];
+      // Each chunk goes to the rank whose share of the tets it starts in.
+      const int rank = static_cast<int>(mul_div(before, comm.size(), total));
+      before += tets;
+      if (rank != comm.rank()) continue;
+      const MeshChunk chunk = chunks[b].generate(static_cast<std::int64_t>(c));
+      const std::vector<double>& coords = chunk.mesh.coords;
+      for (std::size_t n = 0; n < coords.size() / 3; ++n) {
+        lo = lo.cwiseMin(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
+        hi = hi.cwiseMax(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
       }
+      for (std::size_t t = 0; t < chunk.mesh.tets.size() / 4; ++t) {
+        TetRecord r{};
+        r.body = static_cast<std::int32_t>(b);
+        r.piece = piece_base[b] + chunk.piece;
+        r.mesh_tet = chunk.tet_id[t];
+        Vec3 X[4];
+        for (int k = 0; k < 4; ++k) {
+          const LocalIndex n = chunk.mesh.tets[4 * t + k];
+          r.node[k] = node_base[b] + chunk.node_id[static_cast<std::size_t>(n)];
+          X[k] = vec3_at(coords.data(), n);
+          for (int d = 0; d < 3; ++d) r.x[3 * k + d] = X[k][d];
+        }
+        check_tet_shape(X, scene.bodies[b].name, chunk.mesh.source, r.mesh_tet + 1);
+        records.push_back(r);
+      }
+    }
   });
   std::vector<double> low(lo.data(), lo.data() + 3), high(hi.data(), hi.data() + 3);
   comm.min_in_place(low);
@@ -162,21 +206,34 @@ std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<Bo
     for (int k = 0; k < 4; ++k) c += Vec3(r.x[3 * k], r.x[3 * k + 1], r.x[3 * k + 2]);
     r.key = morton_key(0.25 * c, lo, hi);
   }
+  *node_lo = lo;
+  *node_hi = hi;
   return records;
 }
 
 // Step 4: node gids by first use.  Returns, per corner of the local tets, its node's number.
 std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalId first_tet,
-                                     const std::vector<GlobalId>& block, std::int64_t n_mesh_nodes,
-                                     const Communicator& comm, GlobalId* n_nodes) {
+                                     const std::vector<GlobalId>& block,
+                                     const NodeDirectory& directory, const Communicator& comm,
+                                     GlobalId* n_nodes) {
   const int ranks = comm.size();
-  std::vector<std::vector<NodeUse>> uses(static_cast<std::size_t>(ranks));
+  // This rank's first use of each node it uses (one message per node, not per corner).
+  std::vector<std::pair<std::int64_t, std::int64_t>> corner;  // (mesh node, use)
+  corner.reserve(4 * tets.size());
   for (std::size_t t = 0; t < tets.size(); ++t)
-    for (int c = 0; c < 4; ++c) {
-      NodeUse u{tets[t].node[c], 4 * (first_tet + static_cast<GlobalId>(t)) + c, {}};
-      std::copy_n(&tets[t].x[3 * c], 3, u.x);
-      uses[static_cast<std::size_t>(directory_rank(u.mesh_node, n_mesh_nodes, ranks))].push_back(u);
-    }
+    for (int c = 0; c < 4; ++c)
+      corner.emplace_back(tets[t].node[c], 4 * (first_tet + static_cast<GlobalId>(t)) + c);
+  std::sort(corner.begin(), corner.end());
+  std::vector<std::vector<NodeUse>> uses(static_cast<std::size_t>(ranks));
+  for (std::size_t i = 0; i < corner.size(); ++i) {
+    if (i > 0 && corner[i].first == corner[i - 1].first) continue;
+    NodeUse u{corner[i].first, corner[i].second, {}};
+    const TetRecord& r = tets[static_cast<std::size_t>(corner[i].second / 4 - first_tet)];
+    std::copy_n(&r.x[3 * (corner[i].second % 4)], 3, u.x);
+    uses[static_cast<std::size_t>(directory.rank_of(u.x))].push_back(u);
+  }
+  corner.clear();
+  corner.shrink_to_fit();
   // Directory: the first use of each node, and who asked.
   std::vector<int> asker;
   std::vector<NodeUse> seen = comm.exchange(uses, &asker);
@@ -203,8 +260,8 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
   *n_nodes = std::accumulate(counts.begin(), counts.end(), std::int64_t{0});
   std::vector<std::vector<NodeNumber>> numbers(static_cast<std::size_t>(ranks));
   for (std::size_t i = 0; i < owned.size(); ++i)
-    numbers[static_cast<std::size_t>(directory_rank(owned[i].mesh_node, n_mesh_nodes, ranks))]
-        .push_back({owned[i].mesh_node, base + static_cast<GlobalId>(i), owned[i].use / 4});
+    numbers[static_cast<std::size_t>(directory.rank_of(owned[i].x))].push_back(
+        {owned[i].mesh_node, base + static_cast<GlobalId>(i), owned[i].use / 4});
   // Back to the directory, which answers every rank that used the node.
   std::vector<NodeNumber> known = comm.exchange(numbers);
   numbers.assign(static_cast<std::size_t>(ranks), {});
@@ -212,11 +269,7 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
             [](const NodeNumber& a, const NodeNumber& b) { return a.mesh_node < b.mesh_node; });
   for (std::size_t i = 0; i < order.size(); ++i) {
     const NodeUse& u = seen[order[i]];
-    const int to = asker[order[i]];
-    bool answered = false;  // one answer per (node, rank): uses of a node are adjacent
-    for (std::size_t j = i; j-- > 0 && seen[order[j]].mesh_node == u.mesh_node;)
-      if (asker[order[j]] == to) answered = true;
-    if (answered) continue;
+    const int to = asker[order[i]];  // each rank sent each of its nodes once
     const auto it =
         std::lower_bound(known.begin(), known.end(), u.mesh_node,
                          [](const NodeNumber& a, std::int64_t m) { return a.mesh_node < m; });
@@ -285,18 +338,19 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   }
 
   // Steps 1–3: records generated here, sorted into equal blocks of gids.
-  std::vector<TetRecord> records = generate_records(scene, chunks, node_base, piece_base, comm);
+  Vec3 lo, hi;  // box of all nodes (m)
+  std::vector<TetRecord> records =
+      generate_records(scene, chunks, node_base, piece_base, comm, &lo, &hi);
   out.tet_block.resize(static_cast<std::size_t>(ranks) + 1);
-  for (int r = 0; r <= ranks; ++r)
-    out.tet_block[r] = static_cast<GlobalId>(static_cast<__int128>(out.n_tets) * r / ranks);
+  for (int r = 0; r <= ranks; ++r) out.tet_block[r] = mul_div(out.n_tets, r, ranks);
   records = sort_into_blocks(std::move(records), out.tet_block, comm);
   const GlobalId first_tet = out.tet_block[me];
   FDEM_VERIFY(static_cast<GlobalId>(records.size()) == out.tet_block[me + 1] - first_tet,
               "a rank receives its block of tets");
 
   // Step 4: node numbers; local nodes = owned (first used here) then the others, each by gid.
-  const std::vector<NodeNumber> numbers =
-      number_nodes(records, first_tet, out.tet_block, node_base.back(), comm, &out.n_nodes);
+  const std::vector<NodeNumber> numbers = number_nodes(
+      records, first_tet, out.tet_block, NodeDirectory(records, lo, hi, comm), comm, &out.n_nodes);
   const auto number_of = [&](std::int64_t mesh_node) -> const NodeNumber& {
     const auto it =
         std::lower_bound(numbers.begin(), numbers.end(), mesh_node,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -12,6 +13,7 @@
 #include "core/error.hpp"
 #include "core/state_hash.hpp"
 #include "parallel/partition.hpp"
+#include "parallel/zoltan_partition.hpp"
 
 namespace fdem {
 
@@ -305,6 +307,23 @@ class OwnerGrid {
   std::unordered_map<std::uint64_t, std::vector<std::int32_t>> owners_;
 };
 
+// The test partitioner: each tet to a rank drawn from its gid and the redistribution cycle, so
+// every re-partition scatters the tets anew (results must not depend on it).
+std::vector<std::int32_t> random_parts(const std::vector<PartitionPoint>& points, long cycle,
+                                       int ranks) {
+  std::vector<std::int32_t> parts;
+  parts.reserve(points.size());
+  for (const PartitionPoint& p : points) {
+    std::uint64_t h = static_cast<std::uint64_t>(p.gid) * 0x9E3779B97F4A7C15ULL +
+                      static_cast<std::uint64_t>(cycle) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= h >> 31;
+    h *= 0xbf58476d1ce4e5b9ULL;
+    h ^= h >> 29;
+    parts.push_back(static_cast<std::int32_t>(h % static_cast<std::uint64_t>(ranks)));
+  }
+  return parts;
+}
+
 // A claimed cell of the owner grid (integer cell coordinates) and the rank that claims it.
 struct CellClaim {
   std::int64_t cell[3];
@@ -330,6 +349,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
       first = std::min(first, tets.gid[t]);
     }
 
+  n_tets_ = tets.size();
   // Initial partition: METIS on the element graph (faces and joints, weighted by cost), on rank 0.
   tet_owner_.assign(static_cast<std::size_t>(tets.size()), 0);
   if (ranks > 1) {
@@ -361,7 +381,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   local.body_fixed = global.body_fixed;
   local.gravity = global.gravity;
   local.joint_laws = global.joint_laws;
-  assemble(rows, local, local_state);
+  assemble({&rows}, local, local_state);
   build_exchange(local);
   report_.cycles = 1;
   update_report(local);
@@ -371,6 +391,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
                            DistributedModel start, double buffer, Model& local,
                            TravellingState& local_state)
     : comm_(comm), settings_(settings), buffer_(buffer) {
+  n_tets_ = start.n_tets;
   // The blocks are the initial partition: every local tet is owned here.
   tet_owner_.assign(static_cast<std::size_t>(start.model.tets.size()), comm_.rank());
   node_owner_ = std::move(start.node_owner);
@@ -391,23 +412,35 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
 
 // Sends every owned tet (with its rows) to its owner and to the ranks near it, and assembles what
 // arrives into `out` (which may be `model` itself).
-void Distribution::migrate(const Model& model, const TravellingState& state, Model& out,
+void Distribution::migrate(Model& model, TravellingState& state, Model& out,
                            TravellingState& out_state) {
-  const int ranks = comm_.size();
+  const int ranks = comm_.size(), me = comm_.rank();
   const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
-  std::vector<char> send;
+  // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
+  std::vector<char> send, own;
   std::vector<int> send_counts(ranks, 0), send_offsets(ranks, 0);
   {
     RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_);
     for (int p = 0; p < ranks; ++p) {
       send_offsets[p] = static_cast<int>(send.size());
-      if (!lists[p].empty()) packer.pack(lists[p], send);
+      if (lists[p].empty()) continue;
+      if (p == me) {
+        packer.pack(lists[p], own);
+        continue;
+      }
+      packer.pack(lists[p], send);
       const std::size_t bytes = send.size() - static_cast<std::size_t>(send_offsets[p]);
-      FDEM_VERIFY(bytes < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-                  "a migration message under 2 GiB");
+      FDEM_VERIFY(send.size() < static_cast<std::size_t>(std::numeric_limits<int>::max()),
+                  "migration data under 2 GiB per rank");
       send_counts[p] = static_cast<int>(bytes);
     }
   }
+  // The rows hold everything that travels: the source arrays can go before the new ones come.
+  model.nodes = NodeArrays{};
+  model.tets = TetArrays{};
+  model.joints = JointArrays{};
+  model.tet_force_order = {};
+  state = TravellingState{};
   std::vector<int> receive_counts(ranks, 0), receive_offsets(ranks, 0);
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
   std::size_t received = 0;
@@ -422,23 +455,27 @@ void Distribution::migrate(const Model& model, const TravellingState& state, Mod
                 receive_counts.data(), receive_offsets.data(), MPI_BYTE, comm_.handle());
   send.clear();
   send.shrink_to_fit();
-  assemble(receive, out, out_state);
+  assemble({&receive, &own}, out, out_state);
   build_exchange(out);
 }
 
-void Distribution::assemble(const std::vector<char>& rows, Model& model, TravellingState& state) {
+void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
+                            TravellingState& state) {
   const int me = comm_.rank();
   std::vector<TetRow> tet_rows;
   std::vector<NodeRow> node_rows;
   std::vector<JointRow> joint_rows;
   std::vector<FrictionRow> friction_rows;
-  for (const char* p = rows.data(); p < rows.data() + rows.size();) {
-    const BlockHeader header = take<BlockHeader>(p);
-    for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
-    for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
-    for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
-    for (std::int64_t i = 0; i < header.friction; ++i)
-      friction_rows.push_back(take<FrictionRow>(p));
+  for (std::vector<char>* rows : buffers) {
+    for (const char* p = rows->data(); p < rows->data() + rows->size();) {
+      const BlockHeader header = take<BlockHeader>(p);
+      for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
+      for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
+      for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
+      for (std::int64_t i = 0; i < header.friction; ++i)
+        friction_rows.push_back(take<FrictionRow>(p));
+    }
+    *rows = std::vector<char>{};  // parsed: its memory goes back before the arrays are built
   }
   const auto by_gid = [](const auto& a, const auto& b) { return a.gid < b.gid; };
   const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
@@ -691,37 +728,33 @@ void Distribution::redistribute(Model& model, TravellingState& state,
 
   long migrated = 0;
   if (ranks > 1 && before > settings_.rebalance_threshold) {
-    // Weighted recursive coordinate bisection over the current centroids of all tets; every rank
-    // runs it on the same gathered arrays, so every rank gets the same partition.
-    std::vector<double> centroids, weights;
-    std::vector<GlobalId> gids;
+    // Weighted recursive bisection over the current centroids of the owned tets (Zoltan, each
+    // rank with its own points).
+    std::vector<PartitionPoint> points;
+    std::vector<LocalIndex> point_tet;
     for (LocalIndex t = 0; t < tets.size(); ++t) {
       if (!tets.is_owned(t)) continue;
       Vec3 c = Vec3::Zero();
       for (int k = 0; k < 4; ++k) c += vec3_at(model.nodes.x.data(), tets.nodes[4 * t + k]);
       c *= 0.25;
-      for (int k = 0; k < 3; ++k) centroids.push_back(c[k]);
-      weights.push_back(cost[t]);
-      gids.push_back(tets.gid[t]);
+      points.push_back({tets.gid[t], {c[0], c[1], c[2]}, cost[t]});
+      point_tet.push_back(t);
     }
-    const std::vector<double> all_centroids = comm_.allgatherv(centroids);
-    const std::vector<double> all_weights = comm_.allgatherv(weights);
-    const std::vector<GlobalId> all_gids = comm_.allgatherv(gids);
     const std::vector<std::int32_t> parts =
-        partition_rcb(all_centroids, all_weights, all_gids, ranks);
-    // New owners of the held tets and of the first tets of the held nodes.
-    std::unordered_map<GlobalId, std::int32_t> part_of;
-    part_of.reserve(all_gids.size());
-    for (std::size_t i = 0; i < all_gids.size(); ++i) part_of.emplace(all_gids[i], parts[i]);
-    for (LocalIndex t = 0; t < tets.size(); ++t) {
-      const std::int32_t p = part_of.at(tets.gid[t]);
-      if (tets.is_owned(t) && p != tet_owner_[t]) ++migrated;
-      tet_owner_[t] = p;
+        settings_.random_parts ? random_parts(points, report_.cycles, ranks)
+                               : partition_geometric(points, comm_, settings_.partitioner);
+    std::vector<double> part_cost(static_cast<std::size_t>(ranks), 0.0);
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      std::int32_t& owner = tet_owner_[point_tet[i]];
+      if (owner != parts[i]) ++migrated;
+      owner = parts[i];
+      part_cost[static_cast<std::size_t>(parts[i])] += points[i].weight;
     }
     migrated = comm_.sum(static_cast<std::int64_t>(migrated));
-    for (std::size_t n = 0; n < node_owner_.size(); ++n)
-      node_owner_[n] = part_of.at(node_first_tet_[n]);
-    report_.imbalance = imbalance(all_weights, parts, ranks);
+    comm_.sum_in_place(part_cost);
+    report_.imbalance =
+        mean > 0.0 ? *std::max_element(part_cost.begin(), part_cost.end()) / mean : 1.0;
+    update_node_owners(model);
     ++report_.rebalances;
     report_.migrated_tets += migrated;
   }
@@ -731,6 +764,57 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   state = std::move(arrived);
   ++report_.cycles;
   update_report(model);
+}
+
+void Distribution::update_node_owners(const Model& model) {
+  // A node is owned by the owner of its first tet.  The new owner of a tet is known to the rank
+  // that owned it; a directory rank (by gid) collects them, and each rank asks for the first tets
+  // of the nodes of its owned tets — the nodes it will send.
+  struct TetOwner {
+    GlobalId tet;
+    std::int32_t owner;
+  };
+  const int ranks = comm_.size();
+  const auto directory = [&](GlobalId tet) {
+    return static_cast<int>(mul_div(tet, ranks, std::max<GlobalId>(n_tets_, 1)));
+  };
+  const TetArrays& tets = model.tets;
+  std::vector<std::vector<TetOwner>> posts(static_cast<std::size_t>(ranks));
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (tets.is_owned(t)) posts[directory(tets.gid[t])].push_back({tets.gid[t], tet_owner_[t]});
+  std::vector<TetOwner> book = comm_.exchange(posts);
+  std::sort(book.begin(), book.end(),
+            [](const TetOwner& a, const TetOwner& b) { return a.tet < b.tet; });
+  std::vector<std::uint8_t> asking(node_owner_.size(), 0);
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (tets.is_owned(t))
+      for (int c = 0; c < 4; ++c) asking[tets.nodes[4 * static_cast<std::size_t>(t) + c]] = 1;
+  std::vector<std::vector<GlobalId>> questions(static_cast<std::size_t>(ranks));
+  for (std::size_t n = 0; n < asking.size(); ++n)
+    if (asking[n]) questions[directory(node_first_tet_[n])].push_back(node_first_tet_[n]);
+  for (auto& q : questions) {
+    std::sort(q.begin(), q.end());
+    q.erase(std::unique(q.begin(), q.end()), q.end());
+  }
+  std::vector<int> asker;
+  const std::vector<GlobalId> asked = comm_.exchange(questions, &asker);
+  std::vector<std::vector<TetOwner>> answers(static_cast<std::size_t>(ranks));
+  for (std::size_t i = 0; i < asked.size(); ++i) {
+    const auto it = std::lower_bound(book.begin(), book.end(), asked[i],
+                                     [](const TetOwner& a, GlobalId gid) { return a.tet < gid; });
+    FDEM_VERIFY(it != book.end() && it->tet == asked[i], "every tet has an owner on record");
+    answers[static_cast<std::size_t>(asker[i])].push_back(*it);
+  }
+  std::vector<TetOwner> known = comm_.exchange(answers);
+  std::sort(known.begin(), known.end(),
+            [](const TetOwner& a, const TetOwner& b) { return a.tet < b.tet; });
+  for (std::size_t n = 0; n < asking.size(); ++n) {
+    if (!asking[n]) continue;
+    const auto it = std::lower_bound(known.begin(), known.end(), node_first_tet_[n],
+                                     [](const TetOwner& a, GlobalId gid) { return a.tet < gid; });
+    FDEM_VERIFY(it != known.end() && it->tet == node_first_tet_[n], "the directory answered");
+    node_owner_[n] = it->owner;
+  }
 }
 
 void Distribution::build_exchange(const Model& model) {

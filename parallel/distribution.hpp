@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 #include "contact/contact_stage.hpp"
@@ -24,6 +25,7 @@
 #include "fracture/joint_kernels.hpp"
 #include "parallel/communicator.hpp"
 #include "parallel/distributed_build.hpp"
+#include "parallel/zoltan_partition.hpp"
 
 namespace fdem {
 
@@ -38,6 +40,9 @@ struct TravellingState {
 struct DistributionSettings {
   double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this
   double joint_cost = 1.0;            // cost of an intact joint
+  GeometricMethod partitioner = GeometricMethod::rib;  // the re-partition at detection cycles
+  // Test mode: every re-partition deals the tets to ranks at random (by gid and cycle).
+  bool random_parts = false;
 };
 
 // What the last (re)distribution did, the same on every rank.
@@ -95,10 +100,16 @@ class Distribution {
     std::vector<LocalIndex> send, receive;  // local node indices
     std::vector<double> send_buffer, receive_buffer;
   };
-  void migrate(const Model& model, const TravellingState& state, Model& out,
-               TravellingState& out_state);
-  void assemble(const std::vector<char>& rows, Model& model, TravellingState& state);
+  // Sends the owned tets where destinations() says, frees `model`'s mesh arrays and `state` once
+  // packed, and assembles what arrives into `out` (which may be `model`).
+  void migrate(Model& model, TravellingState& state, Model& out, TravellingState& out_state);
+  // Builds `model` from packed rows; empties each buffer once parsed.
+  void assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
+                TravellingState& state);
   void build_exchange(const Model& model);
+  // After a re-partition: the new owner of each node of an owned tet (the new owner of its first
+  // tet), through a directory of tet owners keyed by gid.
+  void update_node_owners(const Model& model);
   // Per rank, the local tets to send it: each sending tet to its owner and to every rank that
   // claimed a cell its box grown by 2.5 buffers (+ the widest joint gap) touches; a rank claims
   // the cells within reach of each tet it will own.  `whole`: every rank holds the whole model
@@ -115,6 +126,7 @@ class Distribution {
   std::vector<std::int32_t> tet_owner_;
   std::vector<std::int32_t> node_owner_;
   std::vector<GlobalId> node_first_tet_;
+  GlobalId n_tets_ = 0;  // tets of the whole model
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
   DistributionReport report_;

@@ -3,6 +3,10 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 namespace fdem::hdf5 {
@@ -40,10 +44,24 @@ Handle make_mpio_access(const Context& ctx, const Communicator& comm, MPI_Info h
                    "cannot set up MPI-IO file access");
   ctx.check_status(H5Pset_all_coll_metadata_ops(fapl.get(), 1), "cannot set collective metadata");
   ctx.check_status(H5Pset_coll_metadata_write(fapl.get(), 1), "cannot set collective metadata");
+  // Closing the file closes whatever is still open in it, so that a damaged file left on an error
+  // path cannot keep the library from shutting down ("infinite loop closing library").
+  ctx.check_status(H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG), "cannot set close degree");
   // The 1.8 object format allows any number of /run attributes (dense attribute storage).
   ctx.check_status(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_LATEST),
                    "cannot set the file format bounds");
   return fapl;
+}
+
+void reserve_space(const Context& ctx, const std::string& path, double bytes) {
+  const int fd = ::open(path.c_str(), O_CREAT | O_WRONLY | O_TRUNC, 0644);
+  if (fd < 0) ctx.fail("cannot create '" + path + "': " + std::strerror(errno));
+  const int error = ::fallocate(fd, 0, 0, static_cast<off_t>(bytes)) == 0 ? 0 : errno;
+  ::close(fd);
+  std::remove(path.c_str());
+  if (error != 0 && error != EOPNOTSUPP && error != ENOSYS)
+    ctx.fail("no room for the " + ctx.kind() + " (about " +
+             std::to_string(std::llround(bytes / 1e6)) + " MB): " + std::strerror(error));
 }
 
 void sync_directory_of(const std::string& path) {

@@ -1,7 +1,9 @@
 // HDF5 plumbing shared by the collective parallel-HDF5 writers of parallel/ (checkpoint.cpp,
 // xdmf_output.cpp): owned identifiers, silenced automatic error printing, error text naming the
-// file, MPI-IO file access and collective transfer property lists, and a writer of datasets whose
-// rows each rank fills as hyperslabs with collective I/O.  Internal to parallel/.
+// file (a file being written fails as IoError, one being read as InputError), MPI-IO file access
+// and collective transfer property lists, a writer of datasets whose rows each rank fills as
+// hyperslabs with collective I/O, and the space claim made before a collective write.  Internal
+// to parallel/.
 #pragma once
 
 #include <hdf5.h>
@@ -9,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -80,17 +83,30 @@ class SilenceHdf5Errors {
 // The two most specific causes on the current HDF5 error stack as one line; clears the stack.
 std::string hdf5_error_text();
 
-// Messages name the file the user gave (the final path, also while writing the .tmp).
+// Exit code of an I/O failure (README: exit codes), for the abort of a failed collective write.
+constexpr int io_failure_exit_code = 4;
+
+// Messages name the file the user gave (the final path, also while writing the .tmp).  A file
+// that cannot be read is bad input (the user named it); one that cannot be written is an I/O
+// failure (disk full, quota, permissions).
 class Context {
  public:
+  enum class Mode { read, write };
   // kind: what the file is, first word of every message ("checkpoint", "frame").
-  explicit Context(std::string path, std::string kind = "checkpoint")
-      : path_(std::move(path)), kind_(std::move(kind)) {}
+  Context(std::string path, std::string kind, Mode mode)
+      : path_(std::move(path)), kind_(std::move(kind)), mode_(mode) {}
   [[noreturn]] void fail(const std::string& what) const {
-    throw InputError(kind_ + " '" + path_ + "': " + what);
+    const std::string message = kind_ + " '" + path_ + "': " + what;
+    if (mode_ == Mode::write) throw IoError(message);
+    throw InputError(message);
   }
   [[noreturn]] void fail_hdf5(const std::string& what) const {
     fail(what + " (HDF5: " + hdf5_error_text() + ")");
+  }
+  // Data that does not match its checksum: the file was changed after it was written.
+  [[noreturn]] void corrupt(const std::string& what) const {
+    throw InputError(kind_ + " corrupt: " + what + " (file '" + path_ +
+                     "' does not hold what was written; use an earlier " + kind_ + ")");
   }
   hid_t check(hid_t id, const std::string& what) const {
     if (id < 0) fail_hdf5(what);
@@ -99,13 +115,31 @@ class Context {
   void check_status(herr_t status, const std::string& what) const {
     if (status < 0) fail_hdf5(what);
   }
+  // For the collective data writes, flush and close: the file system may fail them on some ranks
+  // only (the aggregators that write), which then leave the collective sequence at another point
+  // than the others.  A collective error report could pair with HDF5's own collectives and hang,
+  // so on N ranks (after abort_on) every rank ends here (exit code 4, I/O failure).  The writers
+  // claim the file's space first (reserve_space), so a full disk is normally reported
+  // collectively before this.
+  void check_collective_write(herr_t status, const std::string& what) const {
+    if (status >= 0) return;
+    if (abort_comm_ && abort_comm_->size() > 1)
+      abort_comm_->abort_all("I/O failure: " + kind_ + " '" + path_ + "': " + what +
+                                 " (HDF5: " + hdf5_error_text() + ")",
+                             io_failure_exit_code);
+    fail_hdf5(what);
+  }
+  void abort_on(const Communicator& comm) { abort_comm_ = &comm; }
   Handle own(hid_t id, Handle::Closer closer, const std::string& what) const {
     return Handle(check(id, what), closer);
   }
   const std::string& path() const { return path_; }
+  const std::string& kind() const { return kind_; }
 
  private:
   std::string path_, kind_;
+  Mode mode_;
+  const Communicator* abort_comm_ = nullptr;
 };
 
 inline Handle make_plist(const Context& ctx, hid_t cls) {
@@ -119,8 +153,9 @@ inline Handle make_space(const Context& ctx, const std::vector<hsize_t>& dims) {
 }
 
 // File access over `comm` with MPI-IO; metadata reads and writes done collectively (every rank
-// performs the same metadata operations in the same order here).  `hints`: MPI-IO hints
-// (MPI_Info, e.g. striping_factor) for the files opened with it; MPI_INFO_NULL for none.
+// performs the same metadata operations in the same order here), and closing the file closing
+// whatever is still open in it (H5F_CLOSE_STRONG).  `hints`: MPI-IO hints (MPI_Info, e.g.
+// striping_factor) for the files opened with it; MPI_INFO_NULL for none.
 Handle make_mpio_access(const Context& ctx, const Communicator& comm,
                         MPI_Info hints = MPI_INFO_NULL);
 
@@ -202,10 +237,13 @@ class Writer {
   }
 
   // Dataset of `n_rows` × `width` (width 0: one-dimensional) where this rank writes `data` (its
-  // rows in order, `width` or 1 values each) to the file rows `runs`.  Collective.
+  // rows in order, `width` or 1 values each) to the file rows `runs`; with `checksum`, a uint64
+  // attribute "checksum" of that value (the same on every rank).  Collective.  A failed data
+  // write ends every rank (Context::check_collective_write).
   template <class T>
   void rows(hid_t group, const char* name, hsize_t n_rows, hsize_t width,
-            const std::vector<T>& data, const std::vector<Run>& runs) const {
+            const std::vector<T>& data, const std::vector<Run>& runs,
+            std::optional<std::uint64_t> checksum = std::nullopt) const {
     const hsize_t columns = width == 0 ? 1 : width;
     std::vector<hsize_t> dims{n_rows};
     if (width != 0) dims.push_back(width);
@@ -214,6 +252,8 @@ class Writer {
     Handle dataset = ctx_.own(H5Dcreate2(group, name, file_type<T>(), file_space.get(), H5P_DEFAULT,
                                          dcpl_.get(), H5P_DEFAULT),
                               H5Dclose, "cannot create " + what);
+    if (checksum)
+      attribute(dataset.get(), "checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &*checksum);
     if (n_rows * columns == 0) return;  // the same on every rank: nothing to write
 
     ctx_.check_status(H5Sselect_none(file_space.get()), "cannot select in " + what);
@@ -232,9 +272,9 @@ class Writer {
       ctx_.check_status(H5Sselect_none(mem_space.get()), "cannot select in " + what);
     static const T dummy{};
     const void* buffer = data.empty() ? static_cast<const void*>(&dummy) : data.data();
-    ctx_.check_status(H5Dwrite(dataset.get(), native_type<T>(), mem_space.get(), file_space.get(),
-                               dxpl_.get(), buffer),
-                      "cannot write " + what);
+    ctx_.check_collective_write(H5Dwrite(dataset.get(), native_type<T>(), mem_space.get(),
+                                         file_space.get(), dxpl_.get(), buffer),
+                                "cannot write " + what);
   }
 
  private:
@@ -242,6 +282,12 @@ class Writer {
   hid_t file_;
   Handle dxpl_, dcpl_;
 };
+
+// Rank 0 (or a rank alone): claims `bytes` for `path` and frees them again, so that a full disk
+// (or a file size limit) is found before the collective write, where every rank can report it
+// together: ctx.fail "no room for the <kind> (about N MB): <reason>".  File systems without
+// fallocate are not probed.
+void reserve_space(const Context& ctx, const std::string& path, double bytes);
 
 // Best effort: make the rename of a file in `path`'s directory durable (fsync of the directory).
 void sync_directory_of(const std::string& path);

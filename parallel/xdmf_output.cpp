@@ -187,9 +187,19 @@ void write_file(const Context& ctx, const std::string& tmp_path, double time,
       if (a.per_cell) write_array(write, tets.get(), a, n, tet_runs);
   });
   comm.run_collectively([&] {
-    ctx.check_status(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "cannot flush '" + tmp_path + "'");
-    ctx.check_status(file.close(), "cannot close '" + tmp_path + "'");
+    ctx.check_collective_write(H5Fflush(file.get(), H5F_SCOPE_GLOBAL),
+                               "cannot flush '" + tmp_path + "'");
+    ctx.check_collective_write(file.close(), "cannot close '" + tmp_path + "'");
   });
+}
+
+// The file's size, about: its datasets (bytes per row) and 1 MiB for metadata.
+double estimated_file_bytes(const Layout& layout, const std::vector<FrameArray>& arrays) {
+  double node_row = 3 * 8, tet_row = 4 * 8;  // xyz, connectivity
+  for (const FrameArray& a : arrays)
+    (a.per_cell ? tet_row : node_row) +=
+        a.components * (a.type == FrameValue::f64 || a.type == FrameValue::i64 ? 8.0 : 4.0);
+  return double(layout.n_nodes) * node_row + double(layout.n_tets) * tet_row + 1048576.0;
 }
 
 FrameFileInfo frame_info(const std::string& file, double time, const Layout& layout,
@@ -250,7 +260,8 @@ FrameFileInfo write_xdmf_frame(const std::string& directory, const std::string& 
                                const MpiIoHints& hints) {
   const std::string path = (std::filesystem::path(directory) / file).string();
   const std::string tmp_path = path + ".tmp";
-  const Context ctx(path, "frame");
+  Context ctx(path, "frame", Context::Mode::write);
+  ctx.abort_on(comm);
 
   // 1. The caller's rows, on each rank and across ranks, before any file I/O.
   comm.run_collectively([&] { check_rows(rows); });
@@ -279,7 +290,11 @@ FrameFileInfo write_xdmf_frame(const std::string& directory, const std::string& 
   for (std::size_t k = 0; k < connectivity.size(); ++k)
     connectivity[k] = node_row[static_cast<std::size_t>(rows.tet_nodes[k])];
 
-  // 3. The file under its temporary name; on a failure every rank unwinds, rank 0 removes it.
+  // 3. The file under its temporary name, its space claimed first (a full disk is then found
+  //    where every rank can report it); on a failure every rank unwinds, rank 0 removes it.
+  comm.run_collectively([&] {
+    if (comm.is_root()) reserve_space(ctx, tmp_path, estimated_file_bytes(layout, rows.arrays));
+  });
   {
     const SilenceHdf5Errors silence;
     try {

@@ -56,8 +56,9 @@ struct XdmfFrameRows {
 // "frames/frames_000003.h5") through its .tmp with MPI-IO `hints`, and returns what the series
 // file needs (the same on every rank).  Every rank must pass arrays with the same names, types
 // and components.  A violation (a ghost node its owner does not know, mismatched arrays) throws
-// CollectiveInternalError on every rank; a file that cannot be written throws
-// CollectiveInputError on every rank naming it (the .tmp is removed).
+// CollectiveInternalError on every rank; a file that cannot be written (no room for it, no
+// permission) throws CollectiveIoError on every rank naming it (the .tmp is removed).  A data
+// write that fails on some ranks only, past the space claim, ends every rank (exit code 4).
 FrameFileInfo write_xdmf_frame(const std::string& directory, const std::string& file, double time,
                                const Communicator& comm, const XdmfFrameRows& rows,
                                const MpiIoHints& hints = {});

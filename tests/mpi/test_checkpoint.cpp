@@ -18,6 +18,7 @@
 
 #include "core/error.hpp"
 #include "parallel/checkpoint.hpp"
+#include "parallel/checkpoint_seal.hpp"
 #include "parallel/communicator.hpp"
 
 using namespace fdem;
@@ -206,7 +207,7 @@ void check_header_equal(const CheckpointHeader& got, const CheckpointHeader& wan
 }
 
 // Runs `body` and returns what this rank caught: "input:<message>", "internal:<message>",
-// "other" or "none".
+// "io:<message>", "other" or "none".
 template <class Body>
 std::string caught(Body&& body) {
   try {
@@ -216,9 +217,32 @@ std::string caught(Body&& body) {
     return std::string("input:") + e.what();
   } catch (const CollectiveInternalError& e) {
     return std::string("internal:") + e.what();
+  } catch (const CollectiveIoError& e) {
+    return std::string("io:") + e.what();
   } catch (...) {
     return "other";
   }
+}
+
+// Writes the seal of an HDF5 file edited after fdem wrote it (every dataset's raw data found).
+void reseal(const std::string& path) {
+  std::vector<FileRegion> regions;
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  for (const char* group : {"/nodes", "/joints", "/friction"})
+    for (const char* name : {"gid", "x", "v", "x_at_detection", "prescribed_velocity", "broken",
+                             "mode", "failure_time", "damage", "history", "a", "b", "spring",
+                             "stiffness"}) {
+      const std::string full = std::string(group) + "/" + name;
+      if (H5Lexists(file, group, H5P_DEFAULT) <= 0 ||
+          H5Lexists(file, full.c_str(), H5P_DEFAULT) <= 0)
+        continue;
+      const hid_t set = H5Dopen2(file, full.c_str(), H5P_DEFAULT);
+      const haddr_t offset = H5Dget_offset(set);
+      if (offset != HADDR_UNDEF) regions.push_back({offset, H5Dget_storage_size(set)});
+      H5Dclose(set);
+    }
+  H5Fclose(file);
+  write_checkpoint_seal(path, regions);
 }
 
 bool same_on_all_ranks(const Communicator& comm, const std::string& text) {
@@ -390,12 +414,15 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
     CHECK(caught([&] { write_checkpoint(path, comm, header, owned); }) == "none");
     return path;
   };
+  // The edit changes the HDF5 metadata: the file is sealed again afterwards (as a tool that
+  // rewrote it would), so that the reader's own checks are what the section tests.
   auto alter = [&](const std::string& path, auto&& edit) {
     if (comm.is_root()) {
       const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
       CHECK(file >= 0);
       edit(file);
       CHECK(H5Fclose(file) >= 0);
+      reseal(path);
     }
     comm.barrier();
   };
@@ -446,15 +473,74 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
     CHECK(message.find("/joints/damage") != std::string::npos);
   }
   SECTION("another format version") {
-    const std::string path = good_copy("version2.h5");
+    const std::string path = good_copy("version1.h5");
     alter(path, [](hid_t file) {
       const hid_t attr = H5Aopen(file, "version", H5P_DEFAULT);
-      const std::int32_t two = 2;
-      CHECK(H5Awrite(attr, H5T_NATIVE_INT32, &two) >= 0);
+      const std::int32_t one = 1;  // before checksums
+      CHECK(H5Awrite(attr, H5T_NATIVE_INT32, &one) >= 0);
       H5Aclose(attr);
     });
     const std::string message = read_error(path);
-    CHECK(message.find("version 2") != std::string::npos);
+    CHECK(message.find("version 1") != std::string::npos);
+  }
+  // Flips bit 4 of the byte at `offset` of the file (rank 0), then waits for it.
+  auto flip = [&](const std::string& path, std::uint64_t offset) {
+    if (comm.is_root()) {
+      std::fstream bytes(path, std::ios::in | std::ios::out | std::ios::binary);
+      bytes.seekg(static_cast<std::streamoff>(offset));
+      char byte = 0;
+      bytes.read(&byte, 1);
+      byte = static_cast<char>(byte ^ 0x10);
+      bytes.seekp(static_cast<std::streamoff>(offset));
+      bytes.write(&byte, 1);
+      CHECK(bytes.good());
+    }
+    comm.barrier();
+  };
+  SECTION("one flipped bit in a dataset: checkpoint corrupt, naming the dataset") {
+    for (const char* dataset : {"/nodes/x", "/nodes/v", "/joints/damage", "/joints/history"}) {
+      const std::string path = good_copy("flipped.h5");
+      haddr_t offset = HADDR_UNDEF;  // the dataset's bytes in the file (contiguous layout)
+      hsize_t size = 0;
+      if (comm.is_root()) {
+        const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+        const hid_t set = H5Dopen2(file, dataset, H5P_DEFAULT);
+        offset = H5Dget_offset(set);  // from the start of the file (userblock included)
+        size = H5Dget_storage_size(set);
+        H5Dclose(set);
+        H5Fclose(file);
+        REQUIRE(offset != HADDR_UNDEF);
+        REQUIRE(size > 0);
+      }
+      flip(path, offset + size / 2);
+      const std::string message = read_error(path);
+      INFO(message);
+      CHECK(message.find(std::string("checkpoint corrupt: dataset ") + dataset) !=
+            std::string::npos);
+    }
+  }
+  SECTION("one flipped bit in the HDF5 metadata or the seal: refused before HDF5 parses it") {
+    for (const std::uint64_t offset : {checkpoint_seal_bytes + 40, checkpoint_seal_bytes + 700,
+                                       std::uint64_t{30}}) {
+      const std::string path = good_copy("metadata.h5");
+      flip(path, offset);
+      const std::string message = read_error(path);
+      INFO("byte " << offset << ": " << message);
+      CHECK(message.find("checkpoint corrupt: its ") != std::string::npos);
+    }
+  }
+  SECTION("a changed run value: checkpoint corrupt (header)") {
+    const std::string path = good_copy("run_value.h5");
+    alter(path, [&](hid_t file) {
+      const hid_t run = H5Gopen2(file, "/run", H5P_DEFAULT);
+      const hid_t attr = H5Aopen(run, header.doubles.front().first.c_str(), H5P_DEFAULT);
+      const double changed = header.doubles.front().second + 1.0;
+      CHECK(H5Awrite(attr, H5T_NATIVE_DOUBLE, &changed) >= 0);
+      H5Aclose(attr);
+      H5Gclose(run);
+    });
+    const std::string message = read_error(path);
+    CHECK(message.find("checkpoint corrupt: header") != std::string::npos);
   }
   SECTION("a file cut short") {
     const std::string path = good_copy("cut.h5");
@@ -466,7 +552,7 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
     const std::string path = dir.file("no/such/dir/state.h5");
     const std::string result = caught([&] { write_checkpoint(path, comm, header, owned); });
     CHECK(same_on_all_ranks(comm, result));
-    CHECK(result.rfind("input:", 0) == 0);
+    CHECK(result.rfind("io:", 0) == 0);  // writing: an I/O failure
     CHECK(result.find("'" + path + "'") != std::string::npos);
   }
   SECTION("rows that are not a partition are an internal error on every rank") {
@@ -520,7 +606,7 @@ TEST_CASE("checkpoint: written through a temporary name; other files untouched",
   header.integers[0].second = 400;
   const std::string result = caught([&] { write_checkpoint(newer, comm, header, owned); });
   CHECK(same_on_all_ranks(comm, result));
-  CHECK(result.rfind("input:", 0) == 0);
+  CHECK(result.rfind("io:", 0) == 0);  // a write failure is I/O, not bad input
   CHECK(result.find(newer) != std::string::npos);
   comm.barrier();
   CHECK(file_bytes(newer) == newer_bytes);

@@ -349,14 +349,14 @@ TEST_CASE("xdmf frames: every node and tet of a distributed model, exactly, in o
   }
 }
 
-TEST_CASE("xdmf frames: an unwritable frame file is an InputError on every rank naming it",
+TEST_CASE("xdmf frames: an unwritable frame file is an IoError on every rank naming it",
           "[mpi][xdmf]") {
   const Communicator comm = Communicator::world();
   XdmfFrameRows rows;  // nothing to write: the file creation fails first
   std::string message;
   try {
     write_xdmf_frame("/nonexistent-fdem-dir", "frames/frames_000000.h5", 0.0, comm, rows);
-  } catch (const InputError& e) {
+  } catch (const IoError& e) {
     message = e.what();
   }
   CHECK_THAT(message, Catch::Matchers::Contains(

@@ -22,68 +22,22 @@
 #include <string>
 #include <vector>
 
+#include "cli_test_support.hpp"
 #include "json_test_support.hpp"
 
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
 using Catch::Matchers::StartsWith;
 using fdem_test::Json;
+using fdem_test::Outcome;
+using fdem_test::read_text;
+using fdem_test::run_fdem;
+using fdem_test::TempDir;
+using fdem_test::write_text;
 
 namespace {
 
 constexpr double kGravity = 9.81;  // m/s^2, as in the scenes below
-
-// A fresh directory under the system temp folder, removed with everything in it at the end.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "fdem_cli_XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw std::runtime_error("cannot create a temp directory");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  const fs::path& path() const { return path_; }
-  std::string operator/(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  REQUIRE(out.good());
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct Outcome {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-// Runs `fdem ARGS` inside `dir` (so relative paths and the default output land there).
-Outcome run_fdem(const TempDir& dir, const std::string& args) {
-  INFO("the fdem executable must be built first: " << FDEM_BINARY);
-  REQUIRE(fs::exists(FDEM_BINARY));
-  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command = "cd '" + dir.path().string() + "' && '" + FDEM_BINARY + "' " + args +
-                              " >'" + out + "' 2>'" + err + "'";
-  const int status = std::system(command.c_str());
-  Outcome o;
-  o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  o.out = read_text(out);
-  o.err = read_text(err);
-  return o;
-}
 
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> parts;

@@ -344,16 +344,19 @@ TEST_CASE("scene reader: wall, arch and tower keys and their messages", "[driver
 
 namespace {
 
-// The whole body mesh put together from its chunks (nodes by their whole-mesh number).
+// The whole body mesh put together from its chunks (nodes and tets by their whole-mesh number).
 BodyMesh mesh_from_chunks(const BodyChunks& chunks, std::vector<std::int32_t>* tet_piece) {
   BodyMesh whole;
   whole.coords.assign(3 * static_cast<std::size_t>(chunks.n_nodes), std::nan(""));
-  std::int64_t next_tet = 0;
+  std::int64_t n_tets = 0;
+  for (std::int64_t n : chunks.chunk_tets) n_tets += n;
+  whole.tets.assign(4 * static_cast<std::size_t>(n_tets), -1);
+  tet_piece->assign(static_cast<std::size_t>(n_tets), -1);
+  REQUIRE(chunks.chunk_centre.size() == chunks.chunk_tets.size());
   for (std::size_t c = 0; c < chunks.chunk_tets.size(); ++c) {
     const MeshChunk chunk = chunks.generate(static_cast<std::int64_t>(c));
-    REQUIRE(chunk.first_tet == next_tet);
     REQUIRE(static_cast<std::int64_t>(chunk.mesh.tets.size() / 4) == chunks.chunk_tets[c]);
-    next_tet += chunks.chunk_tets[c];
+    REQUIRE(chunk.tet_id.size() == chunk.mesh.tets.size() / 4);
     for (std::size_t n = 0; n < chunk.node_id.size(); ++n)
       for (int k = 0; k < 3; ++k) {
         double& x = whole.coords[3 * static_cast<std::size_t>(chunk.node_id[n]) + k];
@@ -361,15 +364,20 @@ BodyMesh mesh_from_chunks(const BodyChunks& chunks, std::vector<std::int32_t>* t
         if (!std::isnan(x)) REQUIRE(x == chunk.mesh.coords[3 * n + k]);
         x = chunk.mesh.coords[3 * n + k];
       }
-    for (LocalIndex n : chunk.mesh.tets)
-      whole.tets.push_back(static_cast<LocalIndex>(chunk.node_id[static_cast<std::size_t>(n)]));
-    tet_piece->insert(tet_piece->end(), chunk.mesh.tets.size() / 4, chunk.piece);
+    for (std::size_t t = 0; t < chunk.tet_id.size(); ++t) {
+      const auto id = static_cast<std::size_t>(chunk.tet_id[t]);
+      REQUIRE((*tet_piece)[id] == -1);  // every tet in exactly one chunk
+      (*tet_piece)[id] = chunk.piece;
+      for (int c = 0; c < 4; ++c)
+        whole.tets[4 * id + c] = static_cast<LocalIndex>(
+            chunk.node_id[static_cast<std::size_t>(chunk.mesh.tets[4 * t + c])]);
+    }
   }
   return whole;
 }
 
-void require_chunks_give(const MeshSpec& spec, const BodyMesh& expected) {
-  const BodyChunks chunks = body_chunks(spec);
+void require_chunks_give(const MeshSpec& spec, const BodyMesh& expected, int ranks = 1) {
+  const BodyChunks chunks = body_chunks(spec, ranks);
   std::vector<std::int32_t> tet_piece;
   const BodyMesh whole = mesh_from_chunks(chunks, &tet_piece);
   REQUIRE(whole.coords.size() == expected.coords.size());
@@ -391,10 +399,11 @@ TEST_CASE("chunked generation gives the whole generator's mesh, node for node an
   box.kind = MeshSpec::Kind::box;
   box.box.min = Vec3(-0.3, 0.1, -1.0 / 3.0);
   box.box.max = Vec3(0.7, 0.35, 0.2);
-  box.box.cells[0] = 5;
-  box.box.cells[1] = 3;
-  box.box.cells[2] = 4;
-  require_chunks_give(box, box_mesh(box.box));
+  box.box.cells[0] = 19;
+  box.box.cells[1] = 30;
+  box.box.cells[2] = 9;
+  require_chunks_give(box, box_mesh(box.box));      // blocks of 4 cells, partial ones at the ends
+  require_chunks_give(box, box_mesh(box.box), 64);  // blocks of 2 cells
 
   MeshSpec wall;
   wall.kind = MeshSpec::Kind::wall;

@@ -168,6 +168,7 @@ TEST_CASE("summary_json of an N-rank run reports the decomposition", "[cli]") {
   r.ghost_nodes_max = 64;
   r.ghost_nodes_mean = 60;
   r.neighbours_max = 1;
+  r.active_elements_max = 150;
   r.communication_seconds = 0.5;
   r.joints = 10;
   r.broken_joints = 3;
@@ -190,6 +191,7 @@ TEST_CASE("summary_json of an N-rank run reports the decomposition", "[cli]") {
   CHECK(d["ghost_nodes_max"].num() == 64);
   CHECK(d["ghost_nodes_mean"].num() == 60);
   CHECK(d["neighbours_max"].num() == 1);
+  CHECK(d["active_elements_max"].num() == 150);
   CHECK(d["communication_seconds"].num() == 0.5);
 }
 
