@@ -168,6 +168,13 @@ struct OutputSpec {
   std::vector<std::string> fields = {"displacement", "velocity", "stress"};
   double checkpoint_every = 0.0;  // s; 0: none
   double energy_every = 0.0;      // s between energy.csv rows; 0: same as frames
+  // Tet frames: vtu = a .vtu per rank and a .pvtu per frame (frames.pvd); xdmf = one HDF5 file
+  // per frame written collectively by every rank, listed in frames.xdmf (docs/parallel.md,
+  // "Frames at scale").  vtu stays the default; xdmf is the one to use on many ranks.
+  enum class FrameFormat { vtu, xdmf } format = FrameFormat::vtu;
+  // MPI-IO hints (MPI_Info key/value, e.g. striping_factor = 16) for the xdmf frames' HDF5 files;
+  // the FDEM_MPIIO_HINTS environment variable adds to and overrides these.
+  std::vector<std::pair<std::string, std::string>> mpi_io_hints;
 };
 
 // Parallel runs (docs/parallel.md): when the decomposition is revisited.

@@ -49,12 +49,14 @@ std::ostream& operator<<(std::ostream& out, JsonNumber n) {
 }  // namespace
 
 RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>& fields, int rank,
-                   int ranks)
+                   int ranks, std::optional<XdmfFrames> xdmf)
     : directory_(directory),
       fields_(fields),
       rank_(rank),
       ranks_(ranks),
-      frames_(create_output_directory(directory), "frames", rank, ranks) {
+      frames_(create_output_directory(directory), "frames", rank, ranks),
+      xdmf_(std::move(xdmf)) {
+  if (xdmf_) xdmf_series_ = std::make_unique<XdmfSeries>(directory, "frames", rank == 0);
   if (rank_ != 0) return;
   energy_.open(std::filesystem::path(directory) / "energy.csv");
   energy_ << "time,kinetic,strain,gravity,contact,joint,dissipated_fracture,dissipated_friction,"
@@ -106,15 +108,43 @@ std::vector<double> tet_damage(const Model& model) {
 }
 
 void RunFiles::write_frame(double time, const Model& model, const std::vector<FrameField>& extra,
-                           bool cracks) {
-  const std::string stem = frames_.next_frame_path();
+                           bool cracks, const std::vector<std::int32_t>& node_owner) {
   std::vector<FrameField> fields = extra;
   if (std::find(fields_.begin(), fields_.end(), "damage") != fields_.end())
     fields.push_back({"damage", 1, true, tet_damage(model)});
+  if (xdmf_) {
+    write_xdmf_tet_frame(time, model, fields, node_owner);
+    if (cracks) write_cracks(time, model);
+    return;
+  }
+  const std::string stem = frames_.next_frame_path();
   write_parallel_tet_frame((std::filesystem::path(directory_) / stem).string(), model, fields_,
                            fields, rank_, ranks_);
   frames_.add_frame(time, frames_.frame_file(stem, "vtu"));
   if (cracks) write_cracks(time, model);
+}
+
+void RunFiles::write_xdmf_tet_frame(double time, const Model& model,
+                                    const std::vector<FrameField>& extra,
+                                    const std::vector<std::int32_t>& node_owner) {
+  const NodeArrays& nodes = model.nodes;
+  XdmfFrameRows rows;
+  rows.n_owned = nodes.n_owned;
+  rows.node_gid = nodes.gid;
+  rows.node_owner = node_owner;
+  rows.node_x.assign(nodes.x.begin(), nodes.x.begin() + 3 * std::ptrdiff_t{nodes.n_owned});
+  const std::vector<LocalIndex> cells = owned_tets(model.tets);
+  rows.tet_nodes.reserve(4 * cells.size());
+  for (const LocalIndex t : cells)
+    for (int c = 0; c < 4; ++c) rows.tet_nodes.push_back(model.tets.nodes[4 * t + c]);
+  std::vector<LocalIndex> points(static_cast<std::size_t>(nodes.n_owned));  // the owned nodes
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) points[static_cast<std::size_t>(n)] = n;
+  rows.arrays = tet_frame_arrays(model, cells, points, fields_, extra);
+  const Communicator comm = xdmf_->comm ? *xdmf_->comm : process_communicator();
+  const std::string file = xdmf_series_->next_frame_file();
+  const FrameFileInfo written = write_xdmf_frame(directory_, file, time, comm, rows, xdmf_->hints);
+  // Rank 0 rewrites the .xdmf; a failure there (disk full) stops every rank, not rank 0 alone.
+  comm.run_collectively([&] { xdmf_series_->add_frame(written); });
 }
 
 void RunFiles::write_cracks(double time, const Model& model) {

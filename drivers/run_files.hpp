@@ -1,9 +1,11 @@
-// The files of an output directory: energy.csv, bodies.csv, frames.pvd (+ frames/*.vtu) and
-// summary.json.  CSV rows are flushed as they are written so a failed run keeps its history.
+// The files of an output directory: energy.csv, bodies.csv, frames.pvd (+ frames/*.vtu) or
+// frames.xdmf (+ frames/*.h5), and summary.json.  CSV rows are flushed as they are written so a
+// failed run keeps its history.
 #pragma once
 
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,25 +14,38 @@
 #include "core/energy.hpp"
 #include "core/model.hpp"
 #include "io/vtk_output.hpp"
+#include "io/xdmf_series.hpp"
+#include "parallel/xdmf_output.hpp"
 
 namespace fdem {
 
 struct RunReport;
 struct StagePlan;
 
+// Tet frames as one HDF5 file per frame written collectively over `comm` (nullptr: this process
+// alone), listed in frames.xdmf (parallel/xdmf_output, io/xdmf_series), instead of .vtu pieces.
+struct XdmfFrames {
+  const Communicator* comm = nullptr;
+  MpiIoHints hints;  // MPI-IO hints (scene output.mpi_io_hints + FDEM_MPIIO_HINTS)
+};
+
 class RunFiles {
  public:
   // On N ranks every rank makes one (frames are written in pieces by every rank); the CSV and
   // JSON files are written by rank 0 alone.
+  // With `xdmf`, tet frames go to frames.xdmf + frames/frames_<n>.h5 (collective: every rank
+  // calls write_frame); else to frames.pvd + .vtu / .pvtu pieces.
   RunFiles(const std::string& directory, const std::vector<std::string>& fields, int rank = 0,
-           int ranks = 1);
+           int ranks = 1, std::optional<XdmfFrames> xdmf = std::nullopt);
   void write_energy_row(double time, const EnergyTerms& e, double balance_error);
   void write_bodies_rows(double time, const Model& model, const std::vector<PieceMotion>& motion);
   // A frame of the tets; with `damage` in the fields, the per-tet damage; in a model with joints
   // also a frame of the "cracks" series (broken joint faces).
   // `cracks`: the scene has joints (the same answer on every rank: each writes a piece).
+  // `node_owner`: per local node its owning rank (Distribution::node_owners), read by xdmf frames
+  // on N ranks for the ghost nodes of owned tets; empty on one rank.
   void write_frame(double time, const Model& model, const std::vector<FrameField>& extra = {},
-                   bool cracks = false);
+                   bool cracks = false, const std::vector<std::int32_t>& node_owner = {});
   // Broken joint faces as triangles (face A's current position) with mode (FailureMode code),
   // failure_time (s) and opening (mean gap |b_i − a_i|, m), as the "cracks" series.
   void write_cracks(double time, const Model& model);
@@ -40,11 +55,15 @@ class RunFiles {
   const std::string& directory() const { return directory_; }
 
  private:
+  void write_xdmf_tet_frame(double time, const Model& model, const std::vector<FrameField>& extra,
+                            const std::vector<std::int32_t>& node_owner);
   std::string directory_;
   std::vector<std::string> fields_;
   int rank_ = 0, ranks_ = 1;
   std::ofstream energy_, bodies_;
   SeriesWriter frames_;
+  std::optional<XdmfFrames> xdmf_;
+  std::unique_ptr<XdmfSeries> xdmf_series_;
   std::unique_ptr<SeriesWriter> contacts_, cracks_;
 };
 

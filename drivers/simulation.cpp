@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "contact/contact_stage.hpp"
@@ -734,11 +736,17 @@ void Simulation::write_files(bool frame, bool energy_row, double energy_time) {
     }
     motion = piece_motions(model_, sum_over_ranks);
   }
+  // The frame first: with output.format xdmf it is written collectively, so no rank may leave
+  // this lambda before it (rank 0 alone failing on energy.csv would leave the others waiting in
+  // the frame's collectives).
   const auto write = [&] {
+    if (frame)
+      files_->write_frame(
+          time_, model_, {}, plan_.joints,
+          distribution_ ? distribution_->node_owners() : std::vector<std::int32_t>{});
     if (energy_row)
       files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());
     if (!frame) return;
-    files_->write_frame(time_, model_, {}, plan_.joints);
     if (contact_) files_->write_contacts(time_, contact_->records());
     files_->write_bodies_rows(time_, model_, motion);
   };
@@ -788,15 +796,26 @@ void Simulation::write_summary(RunReport& result) {
 RunReport Simulation::run() {
   wall_start_ = std::chrono::steady_clock::now();
   if (options_.write_output) {
+    std::optional<XdmfFrames> xdmf;
+    const auto frame_format = [&] {  // a bad FDEM_MPIIO_HINTS stops every rank with one message
+      if (scene_.output.format == OutputSpec::FrameFormat::xdmf)
+        xdmf = XdmfFrames{
+            comm_, merge_mpi_io_hints(scene_.output.mpi_io_hints, std::getenv("FDEM_MPIIO_HINTS"))};
+    };
+    if (comm_)
+      comm_->run_collectively(frame_format);
+    else
+      frame_format();
     if (comm_)  // rank 0 creates the directory first: every rank writes its frame pieces there
       comm_->run_collectively([&] {
         if (comm_->rank() == 0)
           files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields, 0,
-                                              comm_->size());
+                                              comm_->size(), xdmf);
       });
     if (!files_)
-      files_ = std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields,
-                                          comm_ ? comm_->rank() : 0, comm_ ? comm_->size() : 1);
+      files_ =
+          std::make_unique<RunFiles>(options_.output_dir, scene_.output.fields,
+                                     comm_ ? comm_->rank() : 0, comm_ ? comm_->size() : 1, xdmf);
   }
   const long total_steps = checked_step_count(0.0, scene_.time.end, dt_);
   RunReport result;

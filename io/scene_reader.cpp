@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -823,7 +824,32 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   }
 
   if (const YAML::Node out = root["output"]) {
-    r.check_keys(out, "output", {"every", "fields", "checkpoint_every", "energy_every"});
+    r.check_keys(out, "output",
+                 {"every", "fields", "checkpoint_every", "energy_every", "format", "mpi_io_hints"});
+    if (out["format"])
+      scene.output.format = r.choice(out["format"], "output.format", {"vtu", "xdmf"}) == "xdmf"
+                                ? OutputSpec::FrameFormat::xdmf
+                                : OutputSpec::FrameFormat::vtu;
+    if (const YAML::Node hints = out["mpi_io_hints"]) {
+      // Passed to MPI_Info_set as given: MPI-IO ignores keys it does not know, so only the form
+      // is checked here (a key is a plain name, a value one scalar).
+      if (!hints.IsMap())
+        r.fail(hints, "output.mpi_io_hints",
+               "expected a mapping of MPI-IO hint names to values, e.g. {striping_factor: 16, "
+               "romio_cb_write: enable}");
+      for (auto it = hints.begin(); it != hints.end(); ++it) {
+        const std::string key = r.key_name(it->first, "output.mpi_io_hints");
+        const std::string hint_path = "output.mpi_io_hints." + key;
+        if (key.empty() || !std::all_of(key.begin(), key.end(), [](char c) {
+              return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+            }))
+          r.fail(it->first, hint_path, "an MPI-IO hint name is letters, digits and '_'");
+        if (!it->second.IsScalar() || it->second.Scalar().empty())
+          r.fail(it->second, hint_path,
+                 "expected one value (a number or a word), e.g. 16 or enable");
+        scene.output.mpi_io_hints.emplace_back(key, it->second.Scalar());
+      }
+    }
     if (out["every"])
       scene.output.every = r.non_negative(out["every"], "output.every", "frame interval (s)");
     if (out["checkpoint_every"])

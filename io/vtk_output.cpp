@@ -27,7 +27,6 @@
 #include <sstream>
 
 #include "core/error.hpp"
-#include "core/tet_kernels.hpp"
 
 namespace fdem {
 
@@ -115,24 +114,28 @@ vtkNew<vtkDoubleArray> make_array(const std::string& name, int components, vtkId
   return a;
 }
 
-// Copies the tuples `kept` of a FrameField given for all `all_tuples` entries.
-vtkNew<vtkDoubleArray> filtered_array(const FrameField& f, vtkIdType all_tuples,
-                                      const std::vector<LocalIndex>& kept) {
-  FDEM_VERIFY(static_cast<vtkIdType>(f.values.size()) == all_tuples * f.components,
-              "frame field size");
-  auto a = make_array(f.name, f.components, static_cast<vtkIdType>(kept.size()));
-  for (std::size_t i = 0; i < kept.size(); ++i)
-    for (int c = 0; c < f.components; ++c)
-      a->SetComponent(static_cast<vtkIdType>(i), c,
-                      f.values[static_cast<std::size_t>(kept[i]) * f.components + c]);
-  return a;
-}
-
 vtkNew<vtkDoubleArray> full_array(const FrameField& f, vtkIdType tuples, const char* what) {
   FDEM_VERIFY(static_cast<vtkIdType>(f.values.size()) == tuples * f.components, what);
   auto a = make_array(f.name, f.components, tuples);
   for (vtkIdType i = 0; i < tuples * f.components; ++i) a->SetValue(i, f.values[i]);
   return a;
+}
+
+template <class Array, class Value>
+vtkSmartPointer<vtkDataArray> typed_array(const FrameArray& f, const std::vector<Value>& values) {
+  auto a = vtkSmartPointer<Array>::New();
+  a->SetName(f.name.c_str());
+  a->SetNumberOfComponents(f.components);
+  a->SetNumberOfTuples(static_cast<vtkIdType>(values.size() / f.components));
+  for (std::size_t i = 0; i < values.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), values[i]);
+  return a;
+}
+
+// A frame array as a VTK array of its type: f64 → Float64, i64 → Int64, i32 → Int32.
+vtkSmartPointer<vtkDataArray> vtk_array(const FrameArray& f) {
+  if (f.type == FrameValue::f64) return typed_array<vtkDoubleArray>(f, f.real);
+  if (f.type == FrameValue::i64) return typed_array<vtkTypeInt64Array>(f, f.integer);
+  return typed_array<vtkIntArray>(f, f.integer);
 }
 
 // The owned tets of `model` and the nodes they reference, renumbered in ascending local order
@@ -142,17 +145,10 @@ vtkSmartPointer<vtkUnstructuredGrid> owned_tet_grid(const Model& model,
                                                     const std::vector<FrameField>& extra) {
   const NodeArrays& nodes = model.nodes;
   const TetArrays& tets = model.tets;
-  const auto wants = [&](const char* f) {
-    return std::find(fields.begin(), fields.end(), f) != fields.end();
-  };
-
-  std::vector<LocalIndex> cells;  // local tets written, ascending (so ascending gid)
+  const std::vector<LocalIndex> cells = owned_tets(tets);  // ascending, so ascending gid
   std::vector<LocalIndex> renumbered(nodes.size(), -1);
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
-    if (!tets.is_owned(t)) continue;
-    cells.push_back(t);
+  for (const LocalIndex t : cells)
     for (int c = 0; c < 4; ++c) renumbered[tets.nodes[4 * t + c]] = 0;
-  }
   std::vector<LocalIndex> points;  // local nodes written, ascending
   for (LocalIndex i = 0; i < nodes.size(); ++i)
     if (renumbered[i] == 0) {
@@ -174,77 +170,11 @@ vtkSmartPointer<vtkUnstructuredGrid> owned_tet_grid(const Model& model,
                               renumbered[tets.nodes[4 * t + 2]], renumbered[tets.nodes[4 * t + 3]]};
     grid->InsertNextCell(VTK_TETRA, 4, ids);
   }
-
-  vtkNew<vtkTypeInt64Array> node_gid;
-  node_gid->SetName("gid");
-  node_gid->SetNumberOfTuples(n_points);
-  for (vtkIdType p = 0; p < n_points; ++p) node_gid->SetValue(p, nodes.gid[points[p]]);
-  grid->GetPointData()->AddArray(node_gid);
-  if (wants("displacement")) {
-    auto u = make_array("displacement", 3, n_points);
-    for (vtkIdType p = 0; p < n_points; ++p)
-      for (int k = 0; k < 3; ++k)
-        u->SetComponent(p, k, nodes.x[3 * points[p] + k] - nodes.x0[3 * points[p] + k]);
-    grid->GetPointData()->AddArray(u);
-  }
-  if (wants("velocity")) {
-    auto v = make_array("velocity", 3, n_points);
-    for (vtkIdType p = 0; p < n_points; ++p)
-      for (int k = 0; k < 3; ++k) v->SetComponent(p, k, nodes.v[3 * points[p] + k]);
-    grid->GetPointData()->AddArray(v);
-  }
-
-  vtkNew<vtkTypeInt64Array> tet_gid;
-  tet_gid->SetName("gid");
-  tet_gid->SetNumberOfTuples(n_cells);
-  vtkNew<vtkIntArray> piece, body, material;
-  piece->SetName("piece");
-  body->SetName("body");
-  material->SetName("material");
-  for (auto* a : {piece.GetPointer(), body.GetPointer(), material.GetPointer()})
-    a->SetNumberOfTuples(n_cells);
-  for (vtkIdType c = 0; c < n_cells; ++c) {
-    const LocalIndex t = cells[c];
-    tet_gid->SetValue(c, tets.gid[t]);
-    piece->SetValue(c, tets.piece[t]);
-    body->SetValue(c, model.pieces[tets.piece[t]].body);
-    material->SetValue(c, tets.material[t]);
-  }
-  grid->GetCellData()->AddArray(tet_gid);
-  grid->GetCellData()->AddArray(piece);
-  grid->GetCellData()->AddArray(body);
-  grid->GetCellData()->AddArray(material);
-
-  if (wants("stress")) {
-    auto sigma = make_array("stress", 9, n_cells);
-    auto mises = make_array("von_mises", 1, n_cells);
-    for (vtkIdType c = 0; c < n_cells; ++c) {
-      const LocalIndex t = cells[c];
-      Vec3 x[4];
-      for (int k = 0; k < 4; ++k) x[k] = vec3_at(nodes.x.data(), tets.nodes[4 * t + k]);
-      const Mat3 F = edge_matrix(x) * Eigen::Map<const Mat3>(tets.dm_inv.data() + 9 * t);
-      const MaterialProperties& mat = model.materials[tets.material[t]];
-      Mat3 cauchy = Mat3::Zero();
-      const double J = F.determinant();
-      if (J > 0.0) {
-        const Mat3 P = mat.model == ElasticModel::neo_hookean
-                           ? NeoHookean{mat.lame}.first_piola(F)
-                           : StVenantKirchhoff{mat.lame}.first_piola(F);
-        cauchy = P * F.transpose() / J;
-      }
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) sigma->SetComponent(c, 3 * i + j, cauchy(i, j));
-      const Mat3 dev = cauchy - cauchy.trace() / 3.0 * Mat3::Identity();
-      mises->SetValue(c, std::sqrt(1.5 * dev.squaredNorm()));
-    }
-    grid->GetCellData()->AddArray(sigma);
-    grid->GetCellData()->AddArray(mises);
-  }
-  for (const FrameField& f : extra) {
+  for (const FrameArray& f : tet_frame_arrays(model, cells, points, fields, extra)) {
     if (f.per_cell)
-      grid->GetCellData()->AddArray(filtered_array(f, tets.size(), cells));
+      grid->GetCellData()->AddArray(vtk_array(f));
     else
-      grid->GetPointData()->AddArray(filtered_array(f, nodes.size(), points));
+      grid->GetPointData()->AddArray(vtk_array(f));
   }
   return grid;
 }

@@ -18,19 +18,10 @@
 #include <string>
 #include <vector>
 
+#include "core/frame_arrays.hpp"  // FrameField
 #include "core/model.hpp"
 
 namespace fdem {
-
-// Extra per-cell or per-point arrays that stages contribute to a frame.  Tet frames: given per
-// local tet (per_cell) or per local node of the Model; the writer keeps the entries of the tets it
-// writes and of the nodes those reference.  Point/triangle frames: per written point/triangle.
-struct FrameField {
-  std::string name;
-  int components = 1;
-  bool per_cell = true;
-  std::vector<double> values;  // components × (cells or points)
-};
 
 // Name of the file that a series lists for frame `stem` ("frames/frames_000003"):
 // "<stem>.<extension>" on one rank, "<stem>.p<extension>" (the summary) on more.  extension:

@@ -1,8 +1,6 @@
 #include "parallel/checkpoint.hpp"
 
-#include <fcntl.h>
 #include <hdf5.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -20,182 +18,15 @@
 #include "core/error.hpp"
 #include "parallel/checkpoint_checksum.hpp"
 #include "parallel/checkpoint_seal.hpp"
+#include "parallel/hdf5_support.hpp"
 
 namespace fdem {
+
+using namespace hdf5;  // Handle, Context, Writer, ... (shared with parallel/xdmf_output.cpp)
 
 namespace {
 
 constexpr const char* format_name = "fdem-checkpoint";
-constexpr int io_failure_exit_code = 4;  // README: exit codes
-
-// ---------------------------------------------------------------------------------------------
-// HDF5 plumbing: owned identifiers, silenced automatic error printing, error text.
-
-// Owns one HDF5 identifier and closes it with the matching H5?close.
-class Handle {
- public:
-  using Closer = herr_t (*)(hid_t);
-  Handle() = default;
-  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
-  Handle(Handle&& other) noexcept : id_(other.id_), closer_(other.closer_) { other.id_ = -1; }
-  Handle& operator=(Handle&& other) noexcept {
-    if (this != &other) {
-      reset();
-      id_ = other.id_;
-      closer_ = other.closer_;
-      other.id_ = -1;
-    }
-    return *this;
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  ~Handle() { reset(); }
-
-  hid_t get() const { return id_; }
-  bool valid() const { return id_ >= 0; }
-  // Closes now and returns the status (for the file, whose close flushes and can fail).
-  herr_t close() {
-    herr_t status = 0;
-    if (id_ >= 0 && closer_) status = closer_(id_);
-    id_ = -1;
-    return status;
-  }
-  void reset() { close(); }
-
- private:
-  hid_t id_ = -1;
-  Closer closer_ = nullptr;
-};
-
-// HDF5 prints its error stack to stderr by default; fdem reports errors as messages instead.
-// Restores the previous setting at scope exit (other code may rely on it).
-class SilenceHdf5Errors {
- public:
-  SilenceHdf5Errors() {
-    saved_ = H5Eget_auto2(H5E_DEFAULT, &function_, &data_) >= 0;
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~SilenceHdf5Errors() {
-    if (saved_) H5Eset_auto2(H5E_DEFAULT, function_, data_);
-  }
-  SilenceHdf5Errors(const SilenceHdf5Errors&) = delete;
-  SilenceHdf5Errors& operator=(const SilenceHdf5Errors&) = delete;
-
- private:
-  bool saved_ = false;
-  H5E_auto2_t function_ = nullptr;
-  void* data_ = nullptr;
-};
-
-herr_t collect_error(unsigned, const H5E_error2_t* error, void* out) {
-  auto& lines = *static_cast<std::vector<std::string>*>(out);
-  std::string line = error->desc ? error->desc : "";
-  char minor[256] = {0};
-  if (H5Eget_msg(error->min_num, nullptr, minor, sizeof minor) > 0) {
-    if (!line.empty()) line += ": ";
-    line += minor;
-  }
-  std::replace(line.begin(), line.end(), '\n', ' ');
-  if (!line.empty() && std::find(lines.begin(), lines.end(), line) == lines.end())
-    lines.push_back(line);
-  return 0;
-}
-
-// The two most specific causes on the current HDF5 error stack as one line; clears the stack.
-std::string hdf5_error_text() {
-  std::vector<std::string> lines;
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, collect_error, &lines);
-  H5Eclear2(H5E_DEFAULT);
-  std::string text;
-  for (std::size_t i = 0; i < lines.size() && i < 2; ++i) text += (i ? "; " : "") + lines[i];
-  return text.empty() ? "no HDF5 error detail" : text;
-}
-
-// Messages name the file the user gave (the final path, also while writing the .tmp).  A file
-// that cannot be read is bad input (the user named it); one that cannot be written is an I/O
-// failure (disk full, quota, permissions).
-class Context {
- public:
-  enum class Mode { read, write };
-  Context(std::string path, Mode mode) : path_(std::move(path)), mode_(mode) {}
-  [[noreturn]] void fail(const std::string& what) const {
-    const std::string message = "checkpoint '" + path_ + "': " + what;
-    if (mode_ == Mode::write) throw IoError(message);
-    throw InputError(message);
-  }
-  [[noreturn]] void fail_hdf5(const std::string& what) const {
-    fail(what + " (HDF5: " + hdf5_error_text() + ")");
-  }
-  // Data that does not match its checksum: the file was changed after it was written.
-  [[noreturn]] void corrupt(const std::string& what) const {
-    throw InputError("checkpoint corrupt: " + what + " (file '" + path_ +
-                     "' does not hold what was written; use an earlier checkpoint)");
-  }
-  hid_t check(hid_t id, const std::string& what) const {
-    if (id < 0) fail_hdf5(what);
-    return id;
-  }
-  void check_status(herr_t status, const std::string& what) const {
-    if (status < 0) fail_hdf5(what);
-  }
-  // For the collective data writes, flush and close: the file system may fail them on some ranks
-  // only (the aggregators that write), which then leave the collective sequence at another point
-  // than the others.  A collective error report could pair with HDF5's own collectives and hang,
-  // so on N ranks every rank ends here (exit code 4, I/O failure).  write_checkpoint reserves
-  // the file's space first, so a full disk is normally reported collectively before this.
-  void check_collective_write(herr_t status, const std::string& what) const {
-    if (status >= 0) return;
-    if (abort_comm_ && abort_comm_->size() > 1)
-      abort_comm_->abort_all("I/O failure: checkpoint '" + path_ + "': " + what +
-                                 " (HDF5: " + hdf5_error_text() + ")",
-                             io_failure_exit_code);
-    fail_hdf5(what);
-  }
-  void abort_on(const Communicator& comm) { abort_comm_ = &comm; }
-  Handle own(hid_t id, Handle::Closer closer, const std::string& what) const {
-    return Handle(check(id, what), closer);
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-  Mode mode_;
-  const Communicator* abort_comm_ = nullptr;
-};
-
-Handle make_plist(const Context& ctx, hid_t cls) {
-  return ctx.own(H5Pcreate(cls), H5Pclose, "cannot create a property list");
-}
-
-Handle make_space(const Context& ctx, const std::vector<hsize_t>& dims) {
-  if (dims.empty()) return ctx.own(H5Screate(H5S_SCALAR), H5Sclose, "cannot create a dataspace");
-  return ctx.own(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose,
-                 "cannot create a dataspace");
-}
-
-// File access over `comm` with MPI-IO; metadata reads and writes done collectively (every rank
-// performs the same metadata operations in the same order here).
-Handle make_mpio_access(const Context& ctx, const Communicator& comm) {
-  Handle fapl = make_plist(ctx, H5P_FILE_ACCESS);
-  ctx.check_status(H5Pset_fapl_mpio(fapl.get(), comm.handle(), MPI_INFO_NULL),
-                   "cannot set up MPI-IO file access");
-  ctx.check_status(H5Pset_all_coll_metadata_ops(fapl.get(), 1), "cannot set collective metadata");
-  ctx.check_status(H5Pset_coll_metadata_write(fapl.get(), 1), "cannot set collective metadata");
-  // Closing the file closes whatever is still open in it, so that a damaged file left on an error
-  // path cannot keep the library from shutting down ("infinite loop closing library").
-  ctx.check_status(H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG), "cannot set close degree");
-  // The 1.8 object format allows any number of /run attributes (dense attribute storage).
-  ctx.check_status(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_LATEST),
-                   "cannot set the file format bounds");
-  return fapl;
-}
-
-Handle make_collective_transfer(const Context& ctx) {
-  Handle dxpl = make_plist(ctx, H5P_DATASET_XFER);
-  ctx.check_status(H5Pset_dxpl_mpio(dxpl.get(), H5FD_MPIO_COLLECTIVE),
-                   "cannot set collective transfer");
-  return dxpl;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Checks of the caller's rows (a violation is a bug of the caller: internal error).
@@ -269,10 +100,6 @@ void check_local_rows(const CheckpointHeader& header, const CheckpointRows& rows
 // per array), so that each rank writes one hyperslab with collective I/O.  (A union of one
 // hyperslab per run of owned gids costs HDF5 1.10 time growing faster than quadratically in the
 // number of runs: 7.5 s to build the selection of 20 000 runs, far more in the write.)
-
-struct Run {
-  hsize_t start = 0, count = 0;
-};
 
 class BlockExchange {
  public:
@@ -388,7 +215,7 @@ struct FileBlock {
   Run nodes, joints;
   CheckpointRows rows;
   hsize_t friction_offset = 0, friction_total = 0;  // this rank's first friction row, all rows
-  std::map<std::string, std::uint64_t> checksums;  // of every dataset, over all ranks
+  std::map<std::string, std::uint64_t> checksums;   // of every dataset, over all ranks
 };
 
 // Every dataset's checksum (checkpoint_checksum.hpp): this rank's rows, summed over the ranks.
@@ -401,20 +228,23 @@ void compute_checksums(const Communicator& comm, FileBlock& block) {
       {"/nodes/gid", rows_checksum("/nodes/gid", r.node_gid, 1, node0)},
       {"/nodes/x", rows_checksum("/nodes/x", r.node_x, 3, node0)},
       {"/nodes/v", rows_checksum("/nodes/v", r.node_v, 3, node0)},
-      {"/nodes/x_at_detection", rows_checksum("/nodes/x_at_detection", r.node_x_at_detection, 3, node0)},
+      {"/nodes/x_at_detection",
+       rows_checksum("/nodes/x_at_detection", r.node_x_at_detection, 3, node0)},
       {"/nodes/prescribed_velocity",
        rows_checksum("/nodes/prescribed_velocity", r.node_prescribed_velocity, 3, node0)},
       {"/joints/gid", rows_checksum("/joints/gid", r.joint_gid, 1, joint0)},
       {"/joints/broken", rows_checksum("/joints/broken", r.joint_broken, 1, joint0)},
       {"/joints/mode", rows_checksum("/joints/mode", r.joint_mode, 1, joint0)},
-      {"/joints/failure_time", rows_checksum("/joints/failure_time", r.joint_failure_time, 1, joint0)},
+      {"/joints/failure_time",
+       rows_checksum("/joints/failure_time", r.joint_failure_time, 1, joint0)},
       {"/joints/damage", rows_checksum("/joints/damage", r.joint_damage, 1, joint0)},
       {"/joints/history",
        rows_checksum("/joints/history", r.joint_history, r.joint_history_bytes, joint0)},
       {"/friction/a", rows_checksum("/friction/a", r.friction_a, 1, pair0)},
       {"/friction/b", rows_checksum("/friction/b", r.friction_b, 1, pair0)},
       {"/friction/spring", rows_checksum("/friction/spring", r.friction_spring, 3, pair0)},
-      {"/friction/stiffness", rows_checksum("/friction/stiffness", r.friction_stiffness, 1, pair0)}};
+      {"/friction/stiffness",
+       rows_checksum("/friction/stiffness", r.friction_stiffness, 1, pair0)}};
   std::vector<std::uint64_t> sums;
   for (const auto& entry : local) sums.push_back(entry.second);
   comm.sum_in_place(sums);  // unsigned: wraps mod 2^64, the same on any rank count
@@ -439,113 +269,6 @@ std::vector<T> permuted(const std::vector<T>& values, const std::vector<std::siz
   return out;
 }
 
-// HDF5 types of the values: native in memory, fixed little-endian in the file.
-template <class T>
-hid_t native_type() {
-  if constexpr (std::is_same_v<T, double>)
-    return H5T_NATIVE_DOUBLE;
-  else if constexpr (std::is_same_v<T, std::int64_t>)
-    return H5T_NATIVE_INT64;
-  else if constexpr (std::is_same_v<T, std::uint64_t>)
-    return H5T_NATIVE_UINT64;
-  else if constexpr (std::is_same_v<T, std::int32_t>)
-    return H5T_NATIVE_INT32;
-  else {
-    static_assert(std::is_same_v<T, std::uint8_t>, "checkpoint values are f64, i64, u64, i32, u8");
-    return H5T_NATIVE_UINT8;
-  }
-}
-template <class T>
-hid_t file_type() {
-  if constexpr (std::is_same_v<T, double>)
-    return H5T_IEEE_F64LE;
-  else if constexpr (std::is_same_v<T, std::int64_t>)
-    return H5T_STD_I64LE;
-  else {
-    static_assert(std::is_same_v<T, std::uint8_t>, "checkpoint datasets are f64, i64, u8");
-    return H5T_STD_U8LE;
-  }
-}
-
-class Writer {
- public:
-  Writer(const Context& ctx, hid_t file) : ctx_(ctx), file_(file) {
-    dxpl_ = make_collective_transfer(ctx);
-    dcpl_ = make_plist(ctx, H5P_DATASET_CREATE);
-    // Every row is written, so skip HDF5's fill pass over the file.
-    ctx.check_status(H5Pset_fill_time(dcpl_.get(), H5D_FILL_TIME_NEVER), "cannot set fill time");
-  }
-
-  Handle group(const char* name, bool track_attribute_order = false) const {
-    Handle gcpl = make_plist(ctx_, H5P_GROUP_CREATE);
-    if (track_attribute_order)
-      ctx_.check_status(
-          H5Pset_attr_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
-          "cannot track attribute order");
-    return ctx_.own(H5Gcreate2(file_, name, H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
-                    std::string("cannot create group ") + name);
-  }
-
-  // Scalar attribute (metadata: every rank passes the same value).
-  void attribute(hid_t object, const std::string& name, hid_t file_type, hid_t mem_type,
-                 const void* value) const {
-    Handle space = make_space(ctx_, {});
-    Handle attr =
-        ctx_.own(H5Acreate2(object, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-                 H5Aclose, "cannot create attribute " + name);
-    ctx_.check_status(H5Awrite(attr.get(), mem_type, value), "cannot write attribute " + name);
-  }
-  void string_attribute(hid_t object, const std::string& name, const std::string& text) const {
-    Handle type = ctx_.own(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create a string type");
-    ctx_.check_status(H5Tset_size(type.get(), text.size() + 1), "cannot size a string type");
-    ctx_.check_status(H5Tset_strpad(type.get(), H5T_STR_NULLTERM), "cannot pad a string type");
-    attribute(object, name, type.get(), type.get(), text.c_str());
-  }
-
-  // Dataset of `n_rows` × `width` (width 0: one-dimensional) where this rank writes `data` (its
-  // rows in order, `width` or 1 values each) to the file rows `runs`.  Collective.
-  template <class T>
-  void rows(hid_t group, const char* name, hsize_t n_rows, hsize_t width,
-            const std::vector<T>& data, const std::vector<Run>& runs,
-            std::uint64_t checksum) const {
-    const hsize_t columns = width == 0 ? 1 : width;
-    std::vector<hsize_t> dims{n_rows};
-    if (width != 0) dims.push_back(width);
-    Handle file_space = make_space(ctx_, dims);
-    const std::string what = std::string("dataset ") + name;
-    Handle dataset = ctx_.own(H5Dcreate2(group, name, file_type<T>(), file_space.get(), H5P_DEFAULT,
-                                         dcpl_.get(), H5P_DEFAULT),
-                              H5Dclose, "cannot create " + what);
-    attribute(dataset.get(), "checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &checksum);
-    if (n_rows * columns == 0) return;  // the same on every rank: nothing to write
-
-    ctx_.check_status(H5Sselect_none(file_space.get()), "cannot select in " + what);
-    hsize_t local_values = 0;
-    for (const Run& run : runs) {
-      const std::array<hsize_t, 2> start{run.start, 0}, count{run.count, columns};
-      ctx_.check_status(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_OR, start.data(), nullptr,
-                                            count.data(), nullptr),
-                        "cannot select rows in " + what);
-      local_values += run.count * columns;
-    }
-    FDEM_VERIFY(local_values == data.size(), "checkpoint rows do not match their selection");
-    // A rank without rows still takes part in the collective write, with empty selections.
-    Handle mem_space = make_space(ctx_, {std::max<hsize_t>(local_values, 1)});
-    if (local_values == 0)
-      ctx_.check_status(H5Sselect_none(mem_space.get()), "cannot select in " + what);
-    static const T dummy{};
-    const void* buffer = data.empty() ? static_cast<const void*>(&dummy) : data.data();
-    ctx_.check_collective_write(H5Dwrite(dataset.get(), native_type<T>(), mem_space.get(),
-                                         file_space.get(), dxpl_.get(), buffer),
-                                "cannot write " + what);
-  }
-
- private:
-  const Context& ctx_;
-  hid_t file_;
-  Handle dxpl_, dcpl_;
-};
-
 // Where every dataset's raw data lies in the file (for the seal).  Collective (metadata reads).
 std::vector<FileRegion> data_regions(const Context& ctx, hid_t file) {
   std::vector<FileRegion> regions;
@@ -554,12 +277,11 @@ std::vector<FileRegion> data_regions(const Context& ctx, hid_t file) {
         "/joints/gid", "/joints/broken", "/joints/mode", "/joints/failure_time", "/joints/damage",
         "/joints/history", "/friction/a", "/friction/b", "/friction/spring",
         "/friction/stiffness"}) {
-    Handle dataset = ctx.own(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose,
-                             std::string("cannot open ") + name);
+    Handle dataset =
+        ctx.own(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, std::string("cannot open ") + name);
     const haddr_t address = H5Dget_offset(dataset.get());  // from the start of the file
     const hsize_t size = H5Dget_storage_size(dataset.get());
-    if (address != HADDR_UNDEF && size > 0)
-      regions.push_back({address, size});
+    if (address != HADDR_UNDEF && size > 0) regions.push_back({address, size});
   }
   return regions;
 }
@@ -612,8 +334,10 @@ std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_pa
     write.rows(nodes.get(), "gid", n, 0, rows.node_gid, runs, block.checksums.at("/nodes/gid"));
     write.rows(nodes.get(), "x", n, 3, rows.node_x, runs, block.checksums.at("/nodes/x"));
     write.rows(nodes.get(), "v", n, 3, rows.node_v, runs, block.checksums.at("/nodes/v"));
-    write.rows(nodes.get(), "x_at_detection", n, 3, rows.node_x_at_detection, runs, block.checksums.at("/nodes/x_at_detection"));
-    write.rows(nodes.get(), "prescribed_velocity", n, 3, rows.node_prescribed_velocity, runs, block.checksums.at("/nodes/prescribed_velocity"));
+    write.rows(nodes.get(), "x_at_detection", n, 3, rows.node_x_at_detection, runs,
+               block.checksums.at("/nodes/x_at_detection"));
+    write.rows(nodes.get(), "prescribed_velocity", n, 3, rows.node_prescribed_velocity, runs,
+               block.checksums.at("/nodes/prescribed_velocity"));
   });
 
   comm.run_collectively([&] {
@@ -624,10 +348,14 @@ std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_pa
     if (block.joints.count > 0) runs.push_back(block.joints);
     Handle joints = write.group("joints");
     write.rows(joints.get(), "gid", n, 0, rows.joint_gid, runs, block.checksums.at("/joints/gid"));
-    write.rows(joints.get(), "broken", n, 0, rows.joint_broken, runs, block.checksums.at("/joints/broken"));
-    write.rows(joints.get(), "mode", n, 0, rows.joint_mode, runs, block.checksums.at("/joints/mode"));
-    write.rows(joints.get(), "failure_time", n, 0, rows.joint_failure_time, runs, block.checksums.at("/joints/failure_time"));
-    write.rows(joints.get(), "damage", n, 0, rows.joint_damage, runs, block.checksums.at("/joints/damage"));
+    write.rows(joints.get(), "broken", n, 0, rows.joint_broken, runs,
+               block.checksums.at("/joints/broken"));
+    write.rows(joints.get(), "mode", n, 0, rows.joint_mode, runs,
+               block.checksums.at("/joints/mode"));
+    write.rows(joints.get(), "failure_time", n, 0, rows.joint_failure_time, runs,
+               block.checksums.at("/joints/failure_time"));
+    write.rows(joints.get(), "damage", n, 0, rows.joint_damage, runs,
+               block.checksums.at("/joints/damage"));
     // history is n × bytes even for bytes = 0, so the record size is visible in the file.
     if (bytes == 0) {
       Handle history_space = make_space(ctx, {n, bytes});
@@ -638,7 +366,8 @@ std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_pa
       const std::uint64_t none = 0;  // no rows
       write.attribute(empty_history.get(), "checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &none);
     } else {
-      write.rows(joints.get(), "history", n, bytes, rows.joint_history, runs, block.checksums.at("/joints/history"));
+      write.rows(joints.get(), "history", n, bytes, rows.joint_history, runs,
+                 block.checksums.at("/joints/history"));
     }
   });
 
@@ -649,10 +378,14 @@ std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_pa
     std::vector<Run> runs;
     if (!rows.friction_a.empty()) runs.push_back({offset, rows.friction_a.size()});
     Handle friction = write.group("friction");
-    write.rows(friction.get(), "a", total, 0, rows.friction_a, runs, block.checksums.at("/friction/a"));
-    write.rows(friction.get(), "b", total, 0, rows.friction_b, runs, block.checksums.at("/friction/b"));
-    write.rows(friction.get(), "spring", total, 3, rows.friction_spring, runs, block.checksums.at("/friction/spring"));
-    write.rows(friction.get(), "stiffness", total, 0, rows.friction_stiffness, runs, block.checksums.at("/friction/stiffness"));
+    write.rows(friction.get(), "a", total, 0, rows.friction_a, runs,
+               block.checksums.at("/friction/a"));
+    write.rows(friction.get(), "b", total, 0, rows.friction_b, runs,
+               block.checksums.at("/friction/b"));
+    write.rows(friction.get(), "spring", total, 3, rows.friction_spring, runs,
+               block.checksums.at("/friction/spring"));
+    write.rows(friction.get(), "stiffness", total, 0, rows.friction_stiffness, runs,
+               block.checksums.at("/friction/stiffness"));
   });
 
   std::vector<FileRegion> regions;
@@ -672,30 +405,6 @@ double estimated_file_bytes(const CheckpointHeader& header, std::size_t history_
   return double(header.n_nodes) * (8 + 4 * 24) +
          double(header.n_joints) * (8 + 1 + 1 + 8 + 8 + double(history_bytes)) +
          double(friction_pairs) * (8 + 8 + 24 + 8) + 1048576.0;
-}
-
-// Rank 0: claims `bytes` for `path` and frees them again, so that a full disk (or a file size
-// limit) is found before the collective write, where every rank can report it together.  File
-// systems without fallocate are not probed.
-void reserve_space(const Context& ctx, const std::string& path, double bytes) {
-  const int fd = ::open(path.c_str(), O_CREAT | O_WRONLY | O_TRUNC, 0644);
-  if (fd < 0) ctx.fail("cannot create '" + path + "': " + std::strerror(errno));
-  const int error = ::fallocate(fd, 0, 0, static_cast<off_t>(bytes)) == 0 ? 0 : errno;
-  ::close(fd);
-  std::remove(path.c_str());
-  if (error != 0 && error != EOPNOTSUPP && error != ENOSYS)
-    ctx.fail("no room for the checkpoint (about " + std::to_string(std::llround(bytes / 1e6)) +
-             " MB): " + std::strerror(error));
-}
-
-// Best effort: make the rename itself durable.
-void sync_directory_of(const std::string& path) {
-  std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  if (dir.empty()) dir = ".";
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
-  if (fd < 0) return;
-  ::fsync(fd);
-  ::close(fd);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -851,7 +560,7 @@ void sort_friction(CheckpointRows& rows) {
 // ---------------------------------------------------------------------------------------------
 void write_checkpoint(const std::string& path, const Communicator& comm,
                       const CheckpointHeader& header, const CheckpointRows& owned) {
-  Context ctx(path, Context::Mode::write);
+  Context ctx(path, "checkpoint", Context::Mode::write);
   ctx.abort_on(comm);
   const std::string tmp_path = path + ".tmp";
 
@@ -942,7 +651,7 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
 
 std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& path,
                                                             const Communicator& comm) {
-  const Context ctx(path, Context::Mode::read);
+  const Context ctx(path, "checkpoint", Context::Mode::read);
   const SilenceHdf5Errors silence;
   CheckpointHeader header;
   CheckpointRows rows;

@@ -91,6 +91,8 @@ class Distribution {
   void finish_halo_exchange(NodeArrays& nodes);
 
   const DistributionReport& report() const { return report_; }
+  // Per local node: the rank that owns it (xdmf frames ask ghost nodes' owners for their rows).
+  const std::vector<std::int32_t>& node_owners() const { return node_owner_; }
 
  private:
   struct Neighbour {

@@ -635,3 +635,45 @@ TEST_CASE("errors in --set values point at the override, not at a line of the fi
                Contains("is past the end of the list"));
   }
 }
+
+TEST_CASE("output.format and output.mpi_io_hints: xdmf frames with MPI-IO hints", "[io]") {
+  const fdem::Scene d = fdem::parse_scene(join_lines(minimal_lines()), "scene.yaml");
+  CHECK(d.output.format == fdem::OutputSpec::FrameFormat::vtu);  // today's frames by default
+  CHECK(d.output.mpi_io_hints.empty());
+
+  const fdem::Scene x =
+      fdem::parse_scene(minimal_plus("output: {format: xdmf, mpi_io_hints: {striping_factor: 16, "
+                                     "striping_unit: 4194304, romio_cb_write: enable}}\n"),
+                        "scene.yaml");
+  CHECK(x.output.format == fdem::OutputSpec::FrameFormat::xdmf);
+  using Hints = std::vector<std::pair<std::string, std::string>>;
+  CHECK(x.output.mpi_io_hints == Hints{{"striping_factor", "16"},
+                                       {"striping_unit", "4194304"},
+                                       {"romio_cb_write", "enable"}});
+
+  const fdem::Scene v =
+      fdem::parse_scene(join_lines(minimal_lines()), "scene.yaml", {"output.format=xdmf"});
+  CHECK(v.output.format == fdem::OutputSpec::FrameFormat::xdmf);
+
+  SECTION("a bad format names the key, the valid values and the nearest one") {
+    const std::string msg = input_error(minimal_plus("output: {format: xdfm}\n"));
+    CHECK_THAT(msg, StartsWith("scene.yaml:10:18: output.format: 'xdfm' is not valid."));
+    CHECK_THAT(msg, Contains("Did you mean 'xdmf'?"));
+    CHECK_THAT(msg, Contains("Valid values: vtu, xdmf."));
+    CHECK_THAT(
+        input_error(join_lines(minimal_lines()), {"output.format=hdf5"}),
+        StartsWith("scene.yaml: --set output.format=hdf5: output.format: 'hdf5' is not valid."));
+  }
+  SECTION("hints must be a mapping of names to single values") {
+    CHECK_THAT(
+        input_error(minimal_plus("output: {mpi_io_hints: [striping_factor]}\n")),
+        StartsWith("scene.yaml:10:24: output.mpi_io_hints: expected a mapping of MPI-IO hint "
+                   "names to values"));
+    CHECK_THAT(input_error(minimal_plus("output: {mpi_io_hints: {striping_factor: [1, 2]}}\n")),
+               StartsWith("scene.yaml:10:42: output.mpi_io_hints.striping_factor: expected one "
+                          "value"));
+    CHECK_THAT(input_error(minimal_plus("output: {mpi_io_hints: {cb-nodes: 4}}\n")),
+               Contains("output.mpi_io_hints.cb-nodes: an MPI-IO hint name is letters, digits and "
+                        "'_'"));
+  }
+}

@@ -1,0 +1,119 @@
+#include "core/frame_arrays.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/tet_kernels.hpp"
+
+namespace fdem {
+
+namespace {
+
+FrameArray real_array(const std::string& name, bool per_cell, int components, std::size_t n) {
+  FrameArray a{name, per_cell, components, FrameValue::f64, {}, {}};
+  a.real.resize(n * static_cast<std::size_t>(components));
+  return a;
+}
+
+FrameArray integer_array(const std::string& name, bool per_cell, FrameValue type, std::size_t n) {
+  FrameArray a{name, per_cell, 1, type, {}, {}};
+  a.integer.resize(n);
+  return a;
+}
+
+// The entries `kept` of a field given for all `all_entries` local tets or nodes.
+FrameArray filtered(const FrameField& f, std::size_t all_entries,
+                    const std::vector<LocalIndex>& kept) {
+  FDEM_VERIFY(f.values.size() == all_entries * static_cast<std::size_t>(f.components),
+              "frame field size");
+  FrameArray a = real_array(f.name, f.per_cell, f.components, kept.size());
+  for (std::size_t i = 0; i < kept.size(); ++i)
+    for (int c = 0; c < f.components; ++c)
+      a.real[i * f.components + c] = f.values[static_cast<std::size_t>(kept[i]) * f.components + c];
+  return a;
+}
+
+}  // namespace
+
+std::vector<LocalIndex> owned_tets(const TetArrays& tets) {
+  std::vector<LocalIndex> cells;
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (tets.is_owned(t)) cells.push_back(t);
+  return cells;
+}
+
+std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<LocalIndex>& cells,
+                                         const std::vector<LocalIndex>& points,
+                                         const std::vector<std::string>& fields,
+                                         const std::vector<FrameField>& extra) {
+  const NodeArrays& nodes = model.nodes;
+  const TetArrays& tets = model.tets;
+  const auto wants = [&](const char* f) {
+    return std::find(fields.begin(), fields.end(), f) != fields.end();
+  };
+  const std::size_t n_points = points.size(), n_cells = cells.size();
+  std::vector<FrameArray> arrays;
+
+  FrameArray node_gid = integer_array("gid", false, FrameValue::i64, n_points);
+  for (std::size_t p = 0; p < n_points; ++p) node_gid.integer[p] = nodes.gid[points[p]];
+  arrays.push_back(std::move(node_gid));
+  if (wants("displacement")) {
+    FrameArray u = real_array("displacement", false, 3, n_points);
+    for (std::size_t p = 0; p < n_points; ++p)
+      for (int k = 0; k < 3; ++k)
+        u.real[3 * p + k] = nodes.x[3 * points[p] + k] - nodes.x0[3 * points[p] + k];
+    arrays.push_back(std::move(u));
+  }
+  if (wants("velocity")) {
+    FrameArray v = real_array("velocity", false, 3, n_points);
+    for (std::size_t p = 0; p < n_points; ++p)
+      for (int k = 0; k < 3; ++k) v.real[3 * p + k] = nodes.v[3 * points[p] + k];
+    arrays.push_back(std::move(v));
+  }
+
+  FrameArray tet_gid = integer_array("gid", true, FrameValue::i64, n_cells);
+  FrameArray piece = integer_array("piece", true, FrameValue::i32, n_cells);
+  FrameArray body = integer_array("body", true, FrameValue::i32, n_cells);
+  FrameArray material = integer_array("material", true, FrameValue::i32, n_cells);
+  for (std::size_t c = 0; c < n_cells; ++c) {
+    const LocalIndex t = cells[c];
+    tet_gid.integer[c] = tets.gid[t];
+    piece.integer[c] = tets.piece[t];
+    body.integer[c] = model.pieces[tets.piece[t]].body;
+    material.integer[c] = tets.material[t];
+  }
+  for (FrameArray* a : {&tet_gid, &piece, &body, &material}) arrays.push_back(std::move(*a));
+
+  if (wants("stress")) {
+    FrameArray sigma = real_array("stress", true, 9, n_cells);
+    FrameArray mises = real_array("von_mises", true, 1, n_cells);
+    for (std::size_t c = 0; c < n_cells; ++c) {
+      const LocalIndex t = cells[c];
+      Vec3 x[4];
+      for (int k = 0; k < 4; ++k) x[k] = vec3_at(nodes.x.data(), tets.nodes[4 * t + k]);
+      const Mat3 F = edge_matrix(x) * Eigen::Map<const Mat3>(tets.dm_inv.data() + 9 * t);
+      const MaterialProperties& mat = model.materials[tets.material[t]];
+      Mat3 cauchy = Mat3::Zero();  // an inverted tet (J <= 0) shows zero stress
+      const double J = F.determinant();
+      if (J > 0.0) {
+        const Mat3 P = mat.model == ElasticModel::neo_hookean
+                           ? NeoHookean{mat.lame}.first_piola(F)
+                           : StVenantKirchhoff{mat.lame}.first_piola(F);
+        cauchy = P * F.transpose() / J;
+      }
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) sigma.real[9 * c + 3 * i + j] = cauchy(i, j);
+      const Mat3 dev = cauchy - cauchy.trace() / 3.0 * Mat3::Identity();
+      mises.real[c] = std::sqrt(1.5 * dev.squaredNorm());
+    }
+    arrays.push_back(std::move(sigma));
+    arrays.push_back(std::move(mises));
+  }
+  for (const FrameField& f : extra)
+    arrays.push_back(f.per_cell ? filtered(f, static_cast<std::size_t>(tets.size()), cells)
+                                : filtered(f, static_cast<std::size_t>(nodes.size()), points));
+  return arrays;
+}
+
+}  // namespace fdem

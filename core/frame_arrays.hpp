@@ -1,0 +1,70 @@
+// The arrays of a tet frame as plain data, computed once from the model for every frame writer:
+// the .vtu pieces (io/vtk_output) and the collective HDF5 frames (parallel/xdmf_output, listed in
+// an .xdmf series by io/xdmf_series).  Nothing here knows a file format or MPI.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace fdem {
+
+// Extra per-cell or per-point arrays that stages contribute to a frame.  Tet frames: given per
+// local tet (per_cell) or per local node of the Model; the writer keeps the entries of the tets it
+// writes and of the nodes those reference.  Point/triangle frames: per written point/triangle.
+struct FrameField {
+  std::string name;
+  int components = 1;
+  bool per_cell = true;
+  std::vector<double> values;  // components × (cells or points)
+};
+
+// Value type of a frame array (and of its dataset in a file).
+enum class FrameValue { f64, i32, i64 };
+
+// One array of a frame: `components` values per written cell (per_cell) or per written point.
+struct FrameArray {
+  std::string name;
+  bool per_cell = true;
+  int components = 1;
+  FrameValue type = FrameValue::f64;
+  std::vector<double> real;           // f64 values
+  std::vector<std::int64_t> integer;  // i32 / i64 values (i32 ones fit 32 bits)
+
+  std::size_t values() const { return type == FrameValue::f64 ? real.size() : integer.size(); }
+};
+
+// Local tets this rank writes in a frame: the owned ones (TetArrays::is_owned), ascending, so in
+// ascending gid (all of them on one rank).
+std::vector<LocalIndex> owned_tets(const TetArrays& tets);
+
+// The arrays of a tet frame for the local tets `cells` and the local nodes `points`, in this
+// order: point data gid (i64), displacement (x − x0, m) and velocity (m/s) if in `fields`; cell
+// data gid (i64), piece, body, material (i32), stress (Cauchy, Pa, 9 row-major) and von_mises
+// (Pa) if "stress" is in `fields`; then the `extra` fields (filtered to cells / points).
+std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<LocalIndex>& cells,
+                                         const std::vector<LocalIndex>& points,
+                                         const std::vector<std::string>& fields,
+                                         const std::vector<FrameField>& extra);
+
+// A dataset of a written frame file: what the series file (.xdmf) needs to reference it.
+struct FrameDataset {
+  enum class Role { geometry, topology, point, cell } role = Role::point;
+  std::string name;  // array name shown in ParaView ("" for geometry and topology)
+  std::string path;  // inside the file, e.g. "/tets/stress"
+  std::int64_t rows = 0;
+  int components = 1;  // values per row (dataset shape rows × components; 1: one-dimensional)
+  FrameValue type = FrameValue::f64;
+};
+
+// One written frame: the file (relative to the series file), its time and datasets.
+struct FrameFileInfo {
+  std::string file;
+  double time = 0.0;  // s
+  std::int64_t n_nodes = 0, n_tets = 0;
+  std::vector<FrameDataset> datasets;
+};
+
+}  // namespace fdem
