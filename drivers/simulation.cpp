@@ -181,7 +181,11 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
     restore_checkpoint(options_.restart_path);
     mark_phase(CommPhase::startup);
   }
-  check_run_limits();
+  // Every rank decides alike; collectively, so that all leave with the message and exit code 2.
+  if (comm_ && comm_->size() > 1)
+    comm_->run_collectively([&] { check_run_limits(); });
+  else
+    check_run_limits();
   // N ranks, whole-model start: everything above came from the whole model (the same on every
   // rank); now keep this rank's part and halo.
   if (!distributed && comm_ && comm_->size() > 1) {
@@ -616,8 +620,9 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
 void Simulation::check_stable_step(const CriticalStep& deformed) const {
   if (deformed.limiting_tet < 0 || !(deformed.dt < stable_step_margin * dt_)) return;
   std::ostringstream msg;
-  msg << "numerical failure at step " << steps_ << " (t = " << time_ << " s): the stable time "
-      << "step of the " << (steps_ > 0 ? "deformed " : "") << "mesh is " << deformed.dt
+  msg << "numerical failure at step " << steps_ << " (t = " << time_
+      << " s): the run is unstable — the stable time step of the "
+      << (steps_ > 0 ? "deformed " : "") << "mesh is " << deformed.dt
       << " s, below half the time step (minimum-step guard), set by "
       << describe_tet(model_, deformed.limiting_tet) << "." << step_advice();
   throw NumericalFailure(msg.str());
