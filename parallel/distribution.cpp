@@ -6,10 +6,12 @@
 #include <initializer_list>
 #include <limits>
 #include <numeric>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <unordered_map>
 
+#include "core/checked_cast.hpp"
 #include "core/error.hpp"
 #include "core/state_hash.hpp"
 #include "parallel/partition.hpp"
@@ -269,7 +271,18 @@ class RowPacker {
 class OwnerGrid {
  public:
   OwnerGrid(const double origin[3], double cell) : cell_(cell) { std::copy_n(origin, 3, origin_); }
-  // The cells a box (lo xyz, hi xyz) grown by `grow` touches: first xyz, last xyz.
+  // Whether the grid can place a box (lo xyz, hi xyz) grown by `grow`: its cell indices fit in
+  // 64 bits (a node flown off to 1e19 m does not) and it spans at most 2^20 cells along an axis.
+  bool placeable(const double* box, double grow) const {
+    for (int k = 0; k < 3; ++k) {
+      const auto first = floor_to_integer<std::int64_t>((box[k] - grow - origin_[k]) / cell_);
+      const auto last = floor_to_integer<std::int64_t>((box[3 + k] + grow - origin_[k]) / cell_);
+      if (!first || !last || *last - *first > (std::int64_t{1} << 20)) return false;
+    }
+    return true;
+  }
+  // The cells a box (lo xyz, hi xyz) grown by `grow` touches: first xyz, last xyz (a box that
+  // placeable() accepted).
   void cell_range(const double* box, double grow, std::int64_t range[6]) const {
     for (int k = 0; k < 3; ++k) {
       range[k] = static_cast<std::int64_t>(std::floor((box[k] - grow - origin_[k]) / cell_));
@@ -635,6 +648,22 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(const Model& mod
   const std::vector<double> reach = tet_reach(model, tet_boxes);
   const double grow = 2.5 * buffer_ + joint_gap;
   OwnerGrid grid(origin.data(), 2.0 * sums[0] / std::max(sums[1], 1.0) + grow);
+  // Every sending tet must fit the grid; a tet that does not has flown off (or blown up) — every
+  // rank stops with its owner's message.
+  LocalError problem;
+  for (LocalIndex t = 0; t < tets.size() && !problem.failed(); ++t) {
+    const double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
+    if (!sends(t) || grid.placeable(b, std::max(reach[t], grow))) continue;
+    std::ostringstream msg;
+    msg << "tetrahedron " << tets.gid[t] << " spans (" << b[0] << ", " << b[1] << ", " << b[2]
+        << ") to (" << b[3] << ", " << b[4] << ", " << b[5]
+        << ") m: too far from the other elements (or too large) to place among the ranks. A node "
+           "has most likely flown off or blown up: check initial velocities, prescribed "
+           "velocities and loads, or try a smaller time.safety.";
+    problem = {ErrorKind::numerical, msg.str()};
+  }
+  if (whole && problem.failed()) throw NumericalFailure(problem.message);
+  if (!whole) comm_.check_errors(problem);
   // Claims: the cells within reach of each tet, for its (new) owner.
   std::vector<CellClaim> claims;
   {
