@@ -17,7 +17,7 @@ bool fits_integer(double value) {
   static_assert(std::numeric_limits<Int>::is_integer, "integer target");
   if (!std::isfinite(value)) return false;
   constexpr int digits = std::numeric_limits<Int>::digits;  // value bits (without the sign)
-  const double upper = std::ldexp(1.0, digits);              // max + 1
+  const double upper = std::ldexp(1.0, digits);             // max + 1
   if (std::numeric_limits<Int>::is_signed) return std::trunc(value) >= -upper && value < upper;
   return value > -1.0 && value < upper;
 }

@@ -9,7 +9,9 @@ namespace {
 
 volatile std::sig_atomic_t received_signal = 0;
 
-void record_signal(int signal) { received_signal = signal; }
+void record_signal(int signal) {
+  received_signal = signal;
+}
 
 }  // namespace
 
@@ -23,7 +25,9 @@ void install_interrupt_handlers() {
   for (int signal : {SIGTERM, SIGINT, SIGUSR1}) sigaction(signal, &action, nullptr);
 }
 
-int interrupt_signal() { return received_signal; }
+int interrupt_signal() {
+  return received_signal;
+}
 
 const char* signal_name(int signal) {
   switch (signal) {

@@ -50,18 +50,16 @@ int check(const fdem::Scene& scene) {
                 scene.bodies[b].fixed ? ", fixed" : "");
   std::printf("  mesh: %d nodes, %d tetrahedra, %zu discrete elements\n", model.nodes.size(),
               model.tets.size(), model.pieces.size());
-  std::printf("  time: end %g s, step %g s (%s; critical %g s), %ld steps (limit %g)\n",
-              scene.time.end, sim->time_step(), scene.time.auto_step ? "auto" : "fixed",
-              sim->critical_time_step(),
-              fdem::checked_step_count(0.0, scene.time.end, sim->time_step()),
-              scene.limits.max_steps);
+  std::printf(
+      "  time: end %g s, step %g s (%s; critical %g s), %ld steps (limit %g)\n", scene.time.end,
+      sim->time_step(), scene.time.auto_step ? "auto" : "fixed", sim->critical_time_step(),
+      fdem::checked_step_count(0.0, scene.time.end, sim->time_step()), scene.limits.max_steps);
   std::string ceiling_source;
   const double ceiling = fdem::memory_ceiling_per_rank(scene.limits, 1, &ceiling_source);
-  std::printf("  memory: about %s per rank on 1 rank (limit %s, %s)\n",
-              fdem::format_bytes(
-                  fdem::estimated_bytes_per_rank(fdem::model_size(sim->model()), 1))
-                  .c_str(),
-              fdem::format_bytes(ceiling).c_str(), ceiling_source.c_str());
+  std::printf(
+      "  memory: about %s per rank on 1 rank (limit %s, %s)\n",
+      fdem::format_bytes(fdem::estimated_bytes_per_rank(fdem::model_size(sim->model()), 1)).c_str(),
+      fdem::format_bytes(ceiling).c_str(), ceiling_source.c_str());
   if (const fdem::ContactStage* contact = sim->contact_stage()) {
     std::printf("  contact: buffer %g m, penalties", contact->buffer());
     for (std::size_t m = 0; m < model.materials.size(); ++m)
@@ -171,8 +169,9 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
     if (report.status != "completed") {
       if (world.rank() == 0)
         std::fprintf(stderr, "fdem: %s\n%s are in %s.\n", report.reason.c_str(),
-                     report.io_failure ? "The frames written and summary.json (when the disk allowed)"
-                                       : "The last good frame and summary.json",
+                     report.io_failure
+                         ? "The frames written and summary.json (when the disk allowed)"
+                         : "The last good frame and summary.json",
                      options.output_dir.c_str());
       return report.io_failure ? exit_io_failure : exit_numerical_failure;
     }

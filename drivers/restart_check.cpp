@@ -73,7 +73,8 @@ enum class Effect { refused, ignored, applied };
 
 Effect effect_of(const std::string& key) {
   const auto ends_with = [&](const std::string& tail) {
-    return key.size() >= tail.size() && key.compare(key.size() - tail.size(), tail.size(), tail) == 0;
+    return key.size() >= tail.size() &&
+           key.compare(key.size() - tail.size(), tail.size(), tail) == 0;
   };
   // The masses, the stored strain energy and the ledger depend on these: the stored state would
   // not be a state of the new scene.

@@ -70,7 +70,7 @@ struct RunReport {
   double imbalance = 1.0, max_imbalance = 1.0;
   long redistributions = 0, rebalances = 0, migrated_elements = 0;
   long halo_elements_max = 0, ghost_nodes_max = 0, ghost_nodes_mean = 0, neighbours_max = 0;
-  long active_elements_max = 0;  // tets a rank computes internal forces for (owned + halo)
+  long active_elements_max = 0;        // tets a rank computes internal forces for (owned + halo)
   double communication_seconds = 0.0;  // halo exchange + redistribution + reductions (rank 0)
   // Peak resident set size per rank (KiB, largest and mean over ranks): start-up (scene, model,
   // distribution) and the step loop after it (counted afresh once start-up memory is freed).

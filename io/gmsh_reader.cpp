@@ -622,8 +622,7 @@ GmshMesh read_gmsh(const std::string& path, const std::string& physical) {
   return parse_gmsh(read_whole_file(path), path, physical);
 }
 
-GmshMesh parse_gmsh(const std::string& data, const std::string& path,
-                    const std::string& physical) {
+GmshMesh parse_gmsh(const std::string& data, const std::string& path, const std::string& physical) {
   MshCursor cur(path, data);
   RawMesh mesh;
 

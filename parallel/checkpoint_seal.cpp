@@ -30,9 +30,8 @@ bool metadata_checksum(std::ifstream& in, std::uint64_t start, std::uint64_t end
       at = data[next].offset + data[next].size;
       continue;
     }
-    const std::uint64_t stop =
-        std::min<std::uint64_t>({end, next < data.size() ? data[next].offset : end,
-                                 at + buffer.size()});
+    const std::uint64_t stop = std::min<std::uint64_t>(
+        {end, next < data.size() ? data[next].offset : end, at + buffer.size()});
     in.seekg(static_cast<std::streamoff>(at));
     in.read(buffer.data(), static_cast<std::streamsize>(stop - at));
     if (!in) return false;
@@ -77,8 +76,8 @@ void write_checkpoint_seal(const std::string& path, std::vector<FileRegion> data
   out.write(seal.data(), static_cast<std::streamsize>(seal.size()));
   out.flush();
   if (!out)
-    throw IoError("checkpoint '" + path + "': cannot write its checksum block: " +
-                  std::strerror(errno));
+    throw IoError("checkpoint '" + path +
+                  "': cannot write its checksum block: " + std::strerror(errno));
 }
 
 SealState check_checkpoint_seal(const std::string& path, std::string& problem) {

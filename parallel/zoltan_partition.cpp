@@ -65,9 +65,10 @@ std::vector<std::int32_t> partition_geometric(const std::vector<PartitionPoint>&
   FDEM_VERIFY(zz != nullptr, "Zoltan_Create");
   const std::string gid_count = std::to_string(gid_entries);
   Zoltan_Set_Param(zz, "DEBUG_LEVEL", "0");
-  Zoltan_Set_Param(zz, "LB_METHOD", method == GeometricMethod::rib   ? "RIB"
-                                    : method == GeometricMethod::rcb ? "RCB"
-                                                                     : "HSFC");
+  Zoltan_Set_Param(zz, "LB_METHOD",
+                   method == GeometricMethod::rib   ? "RIB"
+                   : method == GeometricMethod::rcb ? "RCB"
+                                                    : "HSFC");
   Zoltan_Set_Param(zz, "NUM_GID_ENTRIES", gid_count.c_str());
   Zoltan_Set_Param(zz, "NUM_LID_ENTRIES", "1");
   Zoltan_Set_Param(zz, "OBJ_WEIGHT_DIM", "1");

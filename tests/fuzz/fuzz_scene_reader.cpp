@@ -20,10 +20,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string first = text.substr(0, text.find('\n'));
   if (first.size() < 200 && first.find('=') != std::string::npos) {
     try {
-      fdem::parse_scene("time: {end: 1}\nmaterials: {m: {density: 1, elastic: {young: 1, "
-                        "poisson: 0}}}\nbodies: [{mesh: {box: {min: [0,0,0], max: [1,1,1]}}, "
-                        "material: m}]\n",
-                        "fuzz.yaml", {first});
+      fdem::parse_scene(
+          "time: {end: 1}\nmaterials: {m: {density: 1, elastic: {young: 1, "
+          "poisson: 0}}}\nbodies: [{mesh: {box: {min: [0,0,0], max: [1,1,1]}}, "
+          "material: m}]\n",
+          "fuzz.yaml", {first});
     } catch (const fdem::InputError&) {
     }
   }

@@ -229,9 +229,9 @@ void reseal(const std::string& path) {
   std::vector<FileRegion> regions;
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   for (const char* group : {"/nodes", "/joints", "/friction"})
-    for (const char* name : {"gid", "x", "v", "x_at_detection", "prescribed_velocity", "broken",
-                             "mode", "failure_time", "damage", "history", "a", "b", "spring",
-                             "stiffness"}) {
+    for (const char* name :
+         {"gid", "x", "v", "x_at_detection", "prescribed_velocity", "broken", "mode",
+          "failure_time", "damage", "history", "a", "b", "spring", "stiffness"}) {
       const std::string full = std::string(group) + "/" + name;
       if (H5Lexists(file, group, H5P_DEFAULT) <= 0 ||
           H5Lexists(file, full.c_str(), H5P_DEFAULT) <= 0)
@@ -520,8 +520,8 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
     }
   }
   SECTION("one flipped bit in the HDF5 metadata or the seal: refused before HDF5 parses it") {
-    for (const std::uint64_t offset : {checkpoint_seal_bytes + 40, checkpoint_seal_bytes + 700,
-                                       std::uint64_t{30}}) {
+    for (const std::uint64_t offset :
+         {checkpoint_seal_bytes + 40, checkpoint_seal_bytes + 700, std::uint64_t{30}}) {
       const std::string path = good_copy("metadata.h5");
       flip(path, offset);
       const std::string message = read_error(path);

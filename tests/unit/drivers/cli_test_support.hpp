@@ -61,8 +61,8 @@ inline Outcome run_fdem(const TempDir& dir, const std::string& args,
   INFO("the fdem executable must be built first: " << FDEM_BINARY);
   REQUIRE(fs::exists(FDEM_BINARY));
   const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command = "cd '" + dir.path().string() + "' && " + setup + " '" +
-                              FDEM_BINARY + "' " + args + " >'" + out + "' 2>'" + err + "'";
+  const std::string command = "cd '" + dir.path().string() + "' && " + setup + " '" + FDEM_BINARY +
+                              "' " + args + " >'" + out + "' 2>'" + err + "'";
   const int status = std::system(command.c_str());
   Outcome o;
   o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -68,7 +68,8 @@ TEST_CASE("a mesh too large for the memory per rank is refused before it is gene
     CHECK_THAT(o.err, Contains("more than limits.max_memory_per_rank = 4 GB"));
   }
   SECTION("a wall of 2147483647 courses") {
-    const Outcome o = run_with(wall, "check scene.yaml --set bodies.0.mesh.wall.courses=2147483647");
+    const Outcome o =
+        run_with(wall, "check scene.yaml --set bodies.0.mesh.wall.courses=2147483647");
     INFO(o.err);
     CHECK(o.exit_code == 2);
     CHECK_THAT(o.err, Contains("limits.max_memory_per_rank"));
@@ -76,7 +77,8 @@ TEST_CASE("a mesh too large for the memory per rank is refused before it is gene
   SECTION("the ceiling is the scene's to raise") {
     const Outcome o = run_with(two_blocks, "check scene.yaml --set limits.max_memory_per_rank=1e6");
     CHECK(o.exit_code == 2);
-    const Outcome ok = run_with(two_blocks, "check scene.yaml --set limits.max_memory_per_rank=1e9");
+    const Outcome ok =
+        run_with(two_blocks, "check scene.yaml --set limits.max_memory_per_rank=1e9");
     INFO(ok.err);
     CHECK(ok.exit_code == 0);
     CHECK_THAT(ok.out, Contains("memory: about"));
@@ -87,7 +89,9 @@ TEST_CASE("a run needing more steps than limits.max_steps is refused with what s
           "[cli][limits]") {
   SECTION("time.end = 1e300 (the step count does not fit an integer)") {
     for (const char* command : {"check", "run"}) {
-      const Outcome o = run_with(two_blocks, std::string(command) + " scene.yaml --set time.end=1e300 --set output.every=0");
+      const Outcome o =
+          run_with(two_blocks,
+                   std::string(command) + " scene.yaml --set time.end=1e300 --set output.every=0");
       INFO(o.out << o.err);
       CHECK(o.exit_code == 2);
       CHECK_THAT(o.err, Contains("limits.max_steps"));
@@ -125,8 +129,8 @@ TEST_CASE("a run needing more steps than limits.max_steps is refused with what s
 TEST_CASE("output intervals that cannot advance time are refused; short ones do not loop",
           "[cli][limits]") {
   for (const char* key : {"every", "energy_every", "checkpoint_every"}) {
-    const Outcome o = run_with(two_blocks, std::string("check scene.yaml --set output.") + key +
-                                               "=1e-300");
+    const Outcome o =
+        run_with(two_blocks, std::string("check scene.yaml --set output.") + key + "=1e-300");
     INFO(key << ": " << o.err);
     CHECK(o.exit_code == 2);
     CHECK_THAT(o.err, Contains(std::string("output.") + key + ": 1e-300 s cannot advance time"));
@@ -140,9 +144,10 @@ TEST_CASE("output intervals that cannot advance time are refused; short ones do 
   CHECK(o.exit_code == 0);
 }
 
-TEST_CASE("a time step far above the mesh's stable step is stopped at once by the minimum-step "
-          "guard",
-          "[cli][limits]") {
+TEST_CASE(
+    "a time step far above the mesh's stable step is stopped at once by the minimum-step "
+    "guard",
+    "[cli][limits]") {
   TempDir dir;
   write_text(dir / "scene.yaml", wall);
   // One unit: no contact, so the critical step is the elastic one.

@@ -40,8 +40,7 @@ std::string first_checkpoint(const TempDir& dir) {
   REQUIRE(o.exit_code == 0);
   std::string first;
   for (const auto& entry : std::filesystem::directory_iterator(dir / "first"))
-    if (entry.path().extension() == ".h5" &&
-        (first.empty() || entry.path().string() < first))
+    if (entry.path().extension() == ".h5" && (first.empty() || entry.path().string() < first))
       first = entry.path().string();
   REQUIRE_FALSE(first.empty());
   return first;
@@ -64,8 +63,7 @@ TEST_CASE("a restart refuses changed densities and elastic constants, naming the
           "[cli][restart]") {
   TempDir dir;
   const std::string checkpoint = first_checkpoint(dir);
-  for (const char* change :
-       {"materials.stone.density=2400", "materials.stone.elastic.young=2e8"}) {
+  for (const char* change : {"materials.stone.density=2400", "materials.stone.elastic.young=2e8"}) {
     const Outcome o =
         run_fdem(dir, "run scene.yaml -o again -q --restart " + checkpoint + " --set " + change);
     INFO(change << ": " << o.err);
@@ -83,10 +81,10 @@ TEST_CASE("a restart lists other changes as warnings by key and continues", "[cl
   CHECK(same.exit_code == 0);
   CHECK_THAT(same.err, !Contains("warning"));
 
-  const Outcome changed =
-      run_fdem(dir, "run scene.yaml -o changed -q --restart " + checkpoint +
-                        " --set bodies.1.velocity=[9,0,0] --set materials.stone.contact.friction=0.3"
-                        " --set gravity=[0,0,-5]");
+  const Outcome changed = run_fdem(
+      dir, "run scene.yaml -o changed -q --restart " + checkpoint +
+               " --set bodies.1.velocity=[9,0,0] --set materials.stone.contact.friction=0.3"
+               " --set gravity=[0,0,-5]");
   INFO(changed.err);
   CHECK(changed.exit_code == 0);
   CHECK_THAT(changed.err,
