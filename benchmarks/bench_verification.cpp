@@ -1,6 +1,6 @@
-// Verification suite: every reference problem of the design notes (REFERENCES.md) that the engine
-// supports, run at several mesh sizes h, time-step fractions Δt/Δt_crit and penalty ratios p/E.
-// Each run records its wall time and the error of each measured quantity against its reference
+// Verification suite: every reference problem of the design notes (docs/references.md) that the
+// engine supports, run at several mesh sizes h, time-step fractions Δt/Δt_crit and penalty ratios
+// p/E. Each run records its wall time and the error of each measured quantity against its reference
 // value, with the pass/fail tolerance of that quantity: the "run time against error" curves of
 // docs/verification.md.
 //
@@ -65,7 +65,7 @@ Measure absolute(const std::string& q, double value, double reference, double to
 
 struct Problem {
   std::string name;       // short id, used in file names
-  std::string reference;  // REFERENCES.md item
+  std::string reference;  // docs/references.md item
   Setting base;
   std::vector<double> h, dt_fraction, penalty_ratio;  // the values swept (besides the base)
   std::function<std::vector<Measure>(const Setting&)> run;
@@ -707,7 +707,8 @@ int main(int argc, char** argv) {
   }
   const std::vector<Problem> all = problems();
   if (list) {
-    for (const Problem& p : all) std::cout << p.name << " (REFERENCES " << p.reference << ")\n";
+    for (const Problem& p : all)
+      std::cout << p.name << " (docs/references.md " << p.reference << ")\n";
     return 0;
   }
   std::ofstream csv(csv_path);

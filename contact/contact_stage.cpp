@@ -13,8 +13,8 @@
 namespace fdem {
 
 namespace {
-// Auto penalty: 10 E keeps the kinetic energy recovered in an impact above 99 % (REFERENCES 2) and
-// the penetration under 10 % of the element size at the material's strength scale.
+// Auto penalty: 10 E keeps the kinetic energy recovered in an impact above 99 % (docs/references.md
+// 2) and the penetration under 10 % of the element size at the material's strength scale.
 constexpr double auto_penalty_factor = 10.0;
 }  // namespace
 

@@ -1,6 +1,6 @@
-// Brazilian disc (splitting tensile test, REFERENCES 9) through the whole engine: a jointed disc
-// loaded along y between two rigid strips at its poles, elastic up to the first damage, then split
-// along the loaded diameter (x = 0).  Setup and measured figures: docs/verification.md.
+// Brazilian disc (splitting tensile test, docs/references.md 9) through the whole engine: a jointed
+// disc loaded along y between two rigid strips at its poles, elastic up to the first damage, then
+// split along the loaded diameter (x = 0).  Setup and measured figures: docs/verification.md.
 //
 // Disc: D = 50 mm, t = 25 mm, E = 30 GPa, ν = 0.2, ρ = 2400, f_t = 10 MPa, G_I = 20 J/m², axis z,
 // centred at the origin (tests/data/gmsh/brazilian_disc_coarse.msh).
@@ -23,11 +23,11 @@
 // and the slope averages out the small ringing of the load.  The reference is the Hertz solution
 // averaged over the same tets (r < 5 mm: 0.957 and −2.953 instead of 1 and −3).
 //
-// Tolerances: σ_y within 3 % (REFERENCES 9).  σ_x within 5 %, NOT the 3 % of REFERENCES 9: this
-// mesh gives −3.3 % (and −5.2 % in a slow elastic run without joints); the fine example mesh
-// (61 k tets, elastic, slow) still gives −2.7 % for σ_x and −2.5 % for σ_y, so part of the gap is
-// not mesh size (docs/verification.md).  Peak σ_BD/f_t within 0.9–1.15 and KE < 1 % of the
-// stored energy at the peak, as REFERENCES 9 asks.
+// Tolerances: σ_y within 3 % (docs/references.md 9).  σ_x within 5 %, NOT the 3 % of
+// docs/references.md 9: this mesh gives −3.3 % (and −5.2 % in a slow elastic run without joints);
+// the fine example mesh (61 k tets, elastic, slow) still gives −2.7 % for σ_x and −2.5 % for σ_y,
+// so part of the gap is not mesh size (docs/verification.md).  Peak σ_BD/f_t within 0.9–1.15 and KE
+// < 1 % of the stored energy at the peak, as docs/references.md 9 asks.
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
@@ -272,7 +272,7 @@ TEST_CASE("Brazilian disc: centre stresses, split along the loaded diameter, pea
   // Centre stresses before cracking (σ_x tension across the loaded diameter).
   CHECK(r.centre_tets > 50);
   CHECK(std::abs(r.sigma_y / r.hertz_y - 1) < 0.03);
-  CHECK(std::abs(r.sigma_x / r.hertz_x - 1) < 0.05);  // REFERENCES: 3 % (see the header)
+  CHECK(std::abs(r.sigma_x / r.hertz_x - 1) < 0.05);  // docs/references.md: 3 % (see the header)
   // Peak load: σ_BD = 2P_max/(πDt) against f_t.
   const double sigma_bd = 2 * r.peak_load / (pi * diameter * thickness);
   INFO("sigma_BD/f_t " << sigma_bd / tensile_strength << ", KE/U at peak "
@@ -290,8 +290,9 @@ TEST_CASE("Brazilian disc: centre stresses, split along the loaded diameter, pea
   CHECK(r.worst_balance < 0.1);
 }
 
-TEST_CASE("Brazilian disc, fine mesh before cracking: centre stresses within 3 % (REFERENCES 9)",
-          "[verification][fracture]") {
+TEST_CASE(
+    "Brazilian disc, fine mesh before cracking: centre stresses within 3 % (docs/references.md 9)",
+    "[verification][fracture]") {
   // The example's 61k-tet mesh (1.2 mm on the loaded diameter), elastic: the centre stresses the
   // coarse CI mesh above gets within 3.3 % (σ_x) and 2.2 % (σ_y).
   DiscSettings settings;

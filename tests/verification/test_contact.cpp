@@ -1,4 +1,4 @@
-// Contact verification problems of ../shared/REFERENCES.md (items 2, 3, 6) through the whole
+// Contact verification problems of docs/references.md (items 2, 3, 6) through the whole
 // engine.
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -32,7 +32,8 @@ std::unique_ptr<Simulation> simulation_from(const Scene& scene,
 }  // namespace
 
 TEST_CASE(
-    "tet-tet impact conserves energy and momentum for penalties over two decades (REFERENCES 3)",
+    "tet-tet impact conserves energy and momentum for penalties over two decades "
+    "(docs/references.md 3)",
     "[verification][contact]") {
   // Tets with three orthogonal 2 m edges, E = 100 GPa, ν = 0, ρ = 1500, v = 550 m/s along the
   // normal of the slanted faces, which face each other 11.5 mm apart.
@@ -78,7 +79,7 @@ TEST_CASE(
   }
 }
 
-TEST_CASE("two-bar impact: contact time, interface stress and restitution (REFERENCES 2)",
+TEST_CASE("two-bar impact: contact time, interface stress and restitution (docs/references.md 2)",
           "[verification][contact]") {
   // Two steel bars L = 0.5 m, E = 200 GPa, ρ = 7800, ν = 0, at ±1 m/s.  Contact time 2L/c0,
   // interface stress ρ c0 v, kinetic energy recovered > 99 % for p = 10 E.
@@ -211,7 +212,7 @@ double tilted_stick(double slope_deg, double friction_deg) {
 
 }  // namespace
 
-TEST_CASE("block on an incline slides with a = g(sinψ − cosψ·tanφ) (REFERENCES 6)",
+TEST_CASE("block on an incline slides with a = g(sinψ − cosψ·tanφ) (docs/references.md 6)",
           "[verification][contact]") {
   const double g = 10.0, psi = 40 * M_PI / 180, phi = 20 * M_PI / 180;
   const double expected = g * (std::sin(psi) - std::cos(psi) * std::tan(phi));  // 3.640 m/s²
@@ -241,12 +242,14 @@ TEST_CASE("block on an incline slides with a = g(sinψ − cosψ·tanφ) (REFERE
   CHECK(std::abs(firm) < 1e-6);
 }
 
-TEST_CASE("stacked blocks: shortening = σ(H/E + interface compliance), error ∝ E/p (REFERENCES 8)",
-          "[verification][contact]") {
+TEST_CASE(
+    "stacked blocks: shortening = σ(H/E + interface compliance), error ∝ E/p (docs/references.md "
+    "8)",
+    "[verification][contact]") {
   // Three 0.1 m cubes (ν = 0) stacked on a fixed base, the top face pushed down slowly.  For the
   // potential φ = 4 min λ a face pressed a depth d into a tet whose opposite node is H away stores
   // U = 2pA d²(1/H_c + 1/H_t), so an interface between cells of height a closes d = σa/(8p): this
-  // is the "n·h/p" term of REFERENCES 8 for this contact law (h = a/8).
+  // is the "n·h/p" term of docs/references.md 8 for this contact law (h = a/8).
   const double a = 0.1, E = 1e9, rho = 1000;
   for (double penalty_ratio : {10.0, 100.0}) {
     const double p = penalty_ratio * E;
@@ -284,8 +287,9 @@ TEST_CASE("stacked blocks: shortening = σ(H/E + interface compliance), error �
   }
 }
 
-TEST_CASE("oblique impact in gross slip: tangential restitution 1 − μ(1+e)/tanθ (REFERENCES 7)",
-          "[verification][contact]") {
+TEST_CASE(
+    "oblique impact in gross slip: tangential restitution 1 − μ(1+e)/tanθ (docs/references.md 7)",
+    "[verification][contact]") {
   // A block lands face-first on a fixed base at 45° (tanθ = 1 ≥ 3.5μ(1+e) for μ = 0.1).
   const double mu = 0.1;
   Scene scene = basic_scene(0.02);

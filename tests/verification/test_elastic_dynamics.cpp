@@ -1,4 +1,4 @@
-// Verification problems of ../shared/REFERENCES.md for elastic bodies (items 1, 4b, 5, energy).
+// Verification problems of docs/references.md for elastic bodies (items 1, 4b, 5, energy).
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
@@ -10,8 +10,9 @@
 using namespace fdem;
 using namespace fdem::testing;
 
-TEST_CASE("suddenly stopped bar: wave arrival, stress plateau, free-end reversal (REFERENCES 1)",
-          "[verification]") {
+TEST_CASE(
+    "suddenly stopped bar: wave arrival, stress plateau, free-end reversal (docs/references.md 1)",
+    "[verification]") {
   // 20x1x1 mm steel bar, ν = 0, moving at v0 = 0.1 m/s, end x = 0 stopped at t = 0.
   const double L = 0.02, E = 205e9, rho = 7850, v0 = 0.1;
   const double c0 = std::sqrt(E / rho);  // 5110 m/s
@@ -88,8 +89,9 @@ TEST_CASE("suddenly stopped bar: wave arrival, stress plateau, free-end reversal
   CHECK(sim->energy().balance_error() < 1e-3);
 }
 
-TEST_CASE("free spinning cube conserves angular momentum and kinetic energy (REFERENCES 4b)",
-          "[verification]") {
+TEST_CASE(
+    "free spinning cube conserves angular momentum and kinetic energy (docs/references.md 4b)",
+    "[verification]") {
   // 1 m cube, ρ = 2500, E = 30 GPa, ω = 10 rad/s about the body diagonal, one full turn.
   Scene scene = basic_scene(2 * M_PI / 10);
   scene.materials.push_back(elastic_material(2500, 30e9, 0.2));
@@ -126,7 +128,8 @@ TEST_CASE("free spinning cube conserves angular momentum and kinetic energy (REF
   CHECK(motion[0].centroid.norm() < 1e-9);
 }
 
-TEST_CASE("free-free axial frequency of a beam within 1 % (REFERENCES 5)", "[verification]") {
+TEST_CASE("free-free axial frequency of a beam within 1 % (docs/references.md 5)",
+          "[verification]") {
   // 2.0 x 0.1 x 0.1 m, E = 30 GPa, ρ = 2500, ν = 0: f1 = c/2L = 866.0 Hz.
   const double L = 2.0, E = 30e9, rho = 2500;
   const double f_exact = std::sqrt(E / rho) / (2 * L);

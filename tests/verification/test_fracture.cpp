@@ -1,4 +1,4 @@
-// Fracture through the whole engine (REFERENCES 9, 10, 12; docs/fracture-model.md): joint
+// Fracture through the whole engine (docs/references.md 9, 10, 12; docs/fracture-model.md): joint
 // placement, the joint stage in the step loop, energy, hand-over to contact.
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -105,7 +105,7 @@ TEST_CASE("joints: all splits nodes per tet and bonds every interior face",
   CHECK(sim->plan().contact);  // tets meet once joints break
 }
 
-TEST_CASE("two-block bar pulled apart: peak stress f_t, dissipation G_I (REFERENCES 10)",
+TEST_CASE("two-block bar pulled apart: peak stress f_t, dissipation G_I (docs/references.md 10)",
           "[verification][fracture]") {
   // Quasi-static pull of the interface through the elastic blocks, ν = 0.
   const double L = 0.1, w = 0.05, v = 0.01;
@@ -242,8 +242,10 @@ TEST_CASE("interface in shear: peak c, dissipation G_II; under compression c + �
   }
 }
 
-TEST_CASE("dry-joint shear of two 200x200x100 mm blocks: τ = 0.65σ_n, no softening (REFERENCES 12)",
-          "[verification][fracture]") {
+TEST_CASE(
+    "dry-joint shear of two 200x200x100 mm blocks: τ = 0.65σ_n, no softening (docs/references.md "
+    "12)",
+    "[verification][fracture]") {
   FractureSpec dry;
   dry.tensile_strength = 1e3;  // a dry joint: no cohesion, next to no tension
   dry.energy_I = 1.0;

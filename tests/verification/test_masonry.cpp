@@ -1,7 +1,8 @@
 // Masonry closed-form checks on generated scenes: a block on a tilting table slides at tanθ = μ or
-// topples at tanθ = b/h (REFERENCES 6 idea), a slender block on a moving base lifts off at
-// a = g·b/h (REFERENCES 13, Housner), the dry-joint shear of a generated wall course
-// (REFERENCES 12), and a dry running-bond wall with exactly touching units standing under gravity.
+// topples at tanθ = b/h (docs/references.md 6 idea), a slender block on a moving base lifts off at
+// a = g·b/h (docs/references.md 13, Housner), the dry-joint shear of a generated wall course
+// (docs/references.md 12), and a dry running-bond wall with exactly touching units standing under
+// gravity.
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
@@ -243,7 +244,8 @@ RockResult rock_at(double level) {
 }  // namespace
 
 TEST_CASE(
-    "rocking block on a moving base lifts off at a = g·b/h within 2 % (REFERENCES 13, Housner)",
+    "rocking block on a moving base lifts off at a = g·b/h within 2 % (docs/references.md 13, "
+    "Housner)",
     "[verification][masonry]") {
   // Lift-off is the loss of rotational equilibrium: the block turns away about its toe.  With a
   // penalty (compliant) contact the heel unloads long before that (at the kern limit, a_c/3 for a
@@ -290,8 +292,10 @@ Vec3 reaction_on_piece(const Model& model, std::int32_t piece) {
 
 }  // namespace
 
-TEST_CASE("dry-joint shear on a generated wall course: τ_peak = μσ_n, no softening (REFERENCES 12)",
-          "[verification][masonry]") {
+TEST_CASE(
+    "dry-joint shear on a generated wall course: τ_peak = μσ_n, no softening (docs/references.md "
+    "12)",
+    "[verification][masonry]") {
   // One course of two 100 × 200 × 200 mm units (stack bond): the head joint between them is the
   // 200 × 200 mm dry joint, contact with Coulomb friction μ = 0.65 and no cohesion.  The left unit
   // is held, the right one pressed onto it by σ_n and then slid along y by 0.5 mm at 0.5 m/s.

@@ -1,7 +1,7 @@
 // Stability stress tests: very stiff penalties, steps at and past the stability limit, a 500 m/s
 // impact, sliver elements, and thousands of contacts on one element.  Each run must either stay
-// stable with its energy balance within 1 % (REFERENCES "Stability and energy") or stop with a
-// NumericalFailure that names the step and gives advice — never leave NaN in the state.
+// stable with its energy balance within 1 % (docs/references.md "Stability and energy") or stop
+// with a NumericalFailure that names the step and gives advice — never leave NaN in the state.
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>

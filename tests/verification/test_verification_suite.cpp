@@ -1,7 +1,7 @@
 // The cheap end of the verification suite (benchmarks/bench_verification.cpp, docs/verification.md)
 // for the reference problems that the other verification tests do not cover: uniaxial compression
-// between frictionless platens (REFERENCES 14) and the free–free bending frequency of a beam of
-// linear tetrahedra against h (REFERENCES 5, shear locking).
+// between frictionless platens (docs/references.md 14) and the free–free bending frequency of a
+// beam of linear tetrahedra against h (docs/references.md 5, shear locking).
 #include <catch2/catch.hpp>
 #include <cmath>
 
@@ -142,7 +142,7 @@ double bending_frequency(int nx, int n, double periods, double exact) {
 
 TEST_CASE(
     "uniaxial compression between frictionless platens: apparent E and ν within 1 % "
-    "(REFERENCES 14)",
+    "(docs/references.md 14)",
     "[verification][contact]") {
   const Compression c = uniaxial_compression(1, 0.9);
   INFO("apparent E " << c.young << " Pa, ν " << c.poisson << ", worst balance " << c.balance);
@@ -153,7 +153,7 @@ TEST_CASE(
 
 TEST_CASE(
     "free-free bending frequency of a tetrahedral beam converges from above as h falls "
-    "(REFERENCES 5)",
+    "(docs/references.md 5)",
     "[verification]") {
   // Euler–Bernoulli: f = (β₁L)²/(2πL²)·√(EI/ρA) = 89.03 Hz with β₁L = 4.7300.
   const double exact =

@@ -140,7 +140,7 @@ TEST_CASE("nodal forces are minus the gradient of the strain energy", "[tet]") {
 
 TEST_CASE("objectivity: a pre-stretched tet turned through a full turn keeps S, rotates sigma",
           "[tet]") {
-  // REFERENCES 4(a): x = Q(t)·1.01·X about (1,1,1)/√3.
+  // docs/references.md 4(a): x = Q(t)·1.01·X about (1,1,1)/√3.
   const Mat3 U = 1.01 * Mat3::Identity();
   const Mat3 P0 = NeoHookean{lame}.first_piola(U);
   const Mat3 S0 = U.inverse() * P0;

@@ -24,7 +24,8 @@ TEST_CASE("softening curve z(D): end values, monotone, integral 0.3863", "[fract
     REQUIRE(value <= previous + 1e-15);
     previous = value;
   }
-  // REFERENCES item 10: ∫₀¹ z dD = 0.3863 (4 digits); cross-check with an independent Simpson rule.
+  // docs/references.md item 10: ∫₀¹ z dD = 0.3863 (4 digits); cross-check with an independent
+  // Simpson rule.
   CHECK(std::round(curve.integral() * 1e4) / 1e4 == Approx(0.3863).margin(1e-12));
   const double simpson =
       fdem::test::simpson([](double D) { return fdem::test::z_reference(D); }, 0.0, 1.0, 200000);
@@ -137,7 +138,7 @@ TEST_CASE("dry joint (c = 0, tanφ = 0.65): τ_peak = 0.65σn, no softening, no 
     std::printf("  dry joint σn = %.2f MPa: peak τ %.6f MPa (0.65σn = %.6f), after 1 mm %.6f MPa\n",
                 sigma_n / 1e6, t.max_shear / 1e6, 0.65 * sigma_n / 1e6, last / 1e6);
   }
-  // REFERENCES item 12: 200 × 200 mm face at 0.5 MPa → 13 kN.
+  // docs/references.md item 12: 200 × 200 mm face at 0.5 MPa → 13 kN.
   CHECK(0.65 * 0.5e6 * 0.2 * 0.2 == Approx(13.0e3).epsilon(1e-12));
 }
 
