@@ -118,16 +118,27 @@ void Simulation::write_checkpoint() {
 
 void Simulation::restore_checkpoint(const std::string& path) {
   if (!comm_) throw InputError(path + ": a restart needs the MPI environment of the fdem command");
-  const auto [header, rows] = read_checkpoint(path, *comm_);
-  if (header.n_nodes != whole_nodes_ || header.n_tets != whole_tets_ ||
-      header.n_joints != whole_joints_ || header.reference_hash != reference_hash_)
-    throw InputError("checkpoint '" + path + "' was written for a different scene (" +
-                     std::to_string(header.n_nodes) + " nodes, " + std::to_string(header.n_tets) +
-                     " tetrahedra, " + std::to_string(header.n_joints) +
-                     " joints; this scene has " + std::to_string(whole_nodes_) + ", " +
-                     std::to_string(whole_tets_) + ", " + std::to_string(whole_joints_) +
-                     (header.n_nodes == whole_nodes_ ? ", and other reference positions" : "") +
-                     ")");
+  // Only the rows of what this rank holds (parallel/checkpoint.hpp): its owned and ghost nodes,
+  // its joints, and the friction pairs of its tets.
+  CheckpointWanted wanted;
+  const NodeArrays& held = model_.nodes;
+  wanted.nodes = held.gid;
+  std::inplace_merge(wanted.nodes.begin(), wanted.nodes.begin() + held.n_owned,
+                     wanted.nodes.end());
+  wanted.joints = model_.joints.gid;
+  wanted.tets = model_.tets.gid;
+  const auto same_scene = [&](const CheckpointHeader& header) {
+    if (header.n_nodes != whole_nodes_ || header.n_tets != whole_tets_ ||
+        header.n_joints != whole_joints_ || header.reference_hash != reference_hash_)
+      throw InputError(
+          "checkpoint '" + path + "' was written for a different scene (" +
+          std::to_string(header.n_nodes) + " nodes, " + std::to_string(header.n_tets) +
+          " tetrahedra, " + std::to_string(header.n_joints) + " joints; this scene has " +
+          std::to_string(whole_nodes_) + ", " + std::to_string(whole_tets_) + ", " +
+          std::to_string(whole_joints_) +
+          (header.n_nodes == whole_nodes_ ? ", and other reference positions" : "") + ")");
+  };
+  const auto [header, rows] = read_checkpoint(path, *comm_, &wanted, same_scene);
   if (header.n_joints > 0 && rows.joint_history_bytes != sizeof(JointHistory))
     throw InputError("checkpoint '" + path + "' holds joint histories of " +
                      std::to_string(rows.joint_history_bytes) + " bytes; this fdem uses " +

@@ -17,33 +17,19 @@
 
 #include "core/error.hpp"
 #include "parallel/checkpoint_checksum.hpp"
+#include "parallel/checkpoint_format.hpp"
 #include "parallel/checkpoint_seal.hpp"
 #include "parallel/hdf5_support.hpp"
 
 namespace fdem {
 
 using namespace hdf5;  // Handle, Context, Writer, ... (shared with parallel/xdmf_output.cpp)
+using namespace checkpoint_format;  // format_name, serialized, header_checksum, GidBlocks
 
 namespace {
 
-constexpr const char* format_name = "fdem-checkpoint";
-
 // ---------------------------------------------------------------------------------------------
 // Checks of the caller's rows (a violation is a bug of the caller: internal error).
-
-std::string serialized(const CheckpointHeader& header) {
-  std::ostringstream out;
-  out << header.n_nodes << ' ' << header.n_tets << ' ' << header.n_joints << ' '
-      << header.reference_hash;
-  for (const auto& [name, value] : header.doubles) {
-    std::uint64_t bits = 0;
-    std::memcpy(&bits, &value, sizeof bits);
-    out << " d:" << name.size() << ':' << name << '=' << bits;
-  }
-  for (const auto& [name, value] : header.integers)
-    out << " i:" << name.size() << ':' << name << '=' << value;
-  return out.str();
-}
 
 void check_run_names(const CheckpointHeader& header) {
   std::set<std::string> names;
@@ -108,15 +94,10 @@ class BlockExchange {
                 const char* what)
       : comm_(comm) {
     const int ranks = comm.size();
-    const std::int64_t base = n / ranks, extra = n % ranks;  // the first `extra` blocks: base+1
-    auto block_begin = [&](std::int64_t r) { return r * base + std::min(r, extra); };
-    begin_ = block_begin(comm.rank());
-    rows_ = block_begin(comm.rank() + 1) - begin_;
-    const std::int64_t long_blocks_end = extra * (base + 1);
-    auto owner = [&](GlobalId g) {
-      return static_cast<int>(g < long_blocks_end ? g / (base + 1)
-                                                  : extra + (g - long_blocks_end) / base);
-    };
+    const GidBlocks blocks{n, ranks};
+    begin_ = blocks.begin(comm.rank());
+    rows_ = blocks.count(comm.rank());
+    auto owner = [&](GlobalId g) { return blocks.owner(g); };
 
     // Local rows grouped by destination rank (a counting sort keeps it linear).
     detail::checked_count(gids.size(), 1);
@@ -251,23 +232,8 @@ void compute_checksums(const Communicator& comm, FileBlock& block) {
   for (std::size_t i = 0; i < local.size(); ++i) block.checksums[local[i].first] = sums[i];
 }
 
-// The checksum of the header (root counts and /run values).
-std::uint64_t header_checksum(const std::string& serialized_header, std::int64_t history_bytes) {
-  return text_checksum(serialized_header + " h:" + std::to_string(history_bytes));
-}
-
 // ---------------------------------------------------------------------------------------------
 // Writing.
-
-template <class T>
-std::vector<T> permuted(const std::vector<T>& values, const std::vector<std::size_t>& order,
-                        std::size_t width) {
-  std::vector<T> out(values.size());
-  for (std::size_t i = 0; i < order.size(); ++i)
-    std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(order[i] * width), width,
-                out.begin() + static_cast<std::ptrdiff_t>(i * width));
-  return out;
-}
 
 // Where every dataset's raw data lies in the file (for the seal).  Collective (metadata reads).
 std::vector<FileRegion> data_regions(const Context& ctx, hid_t file) {
@@ -407,154 +373,6 @@ double estimated_file_bytes(const CheckpointHeader& header, std::size_t history_
          double(friction_pairs) * (8 + 8 + 24 + 8) + 1048576.0;
 }
 
-// ---------------------------------------------------------------------------------------------
-// Reading.
-
-class Reader {
- public:
-  Reader(const Context& ctx, hid_t file) : ctx_(ctx), file_(file) {
-    dxpl_ = make_collective_transfer(ctx);
-  }
-
-  Handle attribute(hid_t object, const std::string& object_name, const std::string& name) const {
-    const htri_t exists = H5Aexists(object, name.c_str());
-    if (exists < 0) ctx_.fail_hdf5("cannot look up attribute '" + name + "' of " + object_name);
-    if (exists == 0) ctx_.fail(object_name + " has no attribute '" + name + "'");
-    return ctx_.own(H5Aopen(object, name.c_str(), H5P_DEFAULT), H5Aclose,
-                    "cannot open attribute '" + name + "' of " + object_name);
-  }
-
-  H5T_class_t attribute_class(hid_t attr, const std::string& name) const {
-    Handle type = ctx_.own(H5Aget_type(attr), H5Tclose, "cannot get the type of " + name);
-    Handle space = ctx_.own(H5Aget_space(attr), H5Sclose, "cannot get the shape of " + name);
-    if (H5Sget_simple_extent_npoints(space.get()) != 1)
-      ctx_.fail("attribute '" + name + "' is not a single value");
-    return H5Tget_class(type.get());
-  }
-
-  std::string string_attribute(hid_t object, const std::string& object_name,
-                               const std::string& name) const {
-    Handle attr = attribute(object, object_name, name);
-    if (attribute_class(attr.get(), name) != H5T_STRING)
-      ctx_.fail("attribute '" + name + "' of " + object_name + " is not a string");
-    Handle type = ctx_.own(H5Aget_type(attr.get()), H5Tclose, "cannot get the type of " + name);
-    if (H5Tis_variable_str(type.get()) != 0)
-      ctx_.fail("attribute '" + name + "' of " + object_name + " is not a fixed-length string");
-    const std::size_t size = H5Tget_size(type.get());
-    std::vector<char> text(size + 1, '\0');
-    ctx_.check_status(H5Aread(attr.get(), type.get(), text.data()), "cannot read " + name);
-    return std::string(text.data(), strnlen(text.data(), size));
-  }
-
-  template <class T>
-  T number_attribute(hid_t object, const std::string& object_name, const std::string& name) const {
-    Handle attr = attribute(object, object_name, name);
-    const H5T_class_t cls = attribute_class(attr.get(), name);
-    const bool integral = std::is_integral_v<T>;
-    if (cls != (integral ? H5T_INTEGER : H5T_FLOAT))
-      ctx_.fail("attribute '" + name + "' of " + object_name + " is not " +
-                (integral ? "an integer" : "a floating-point number"));
-    T value{};
-    ctx_.check_status(H5Aread(attr.get(), native_type<T>(), &value),
-                      "cannot read attribute '" + name + "' of " + object_name);
-    return value;
-  }
-
-  Handle group(const char* name) const {
-    const htri_t exists = H5Lexists(file_, name, H5P_DEFAULT);
-    if (exists < 0) ctx_.fail_hdf5(std::string("cannot look up group ") + name);
-    if (exists == 0) ctx_.fail(std::string("has no group ") + name);
-    return ctx_.own(H5Gopen2(file_, name, H5P_DEFAULT), H5Gclose,
-                    std::string("cannot open group ") + name);
-  }
-
-  // Names of the attributes of `object`, in creation order.
-  std::vector<std::string> attribute_names(hid_t object, const std::string& object_name) const {
-    std::vector<std::string> names;
-    hsize_t index = 0;
-    auto collect = [](hid_t, const char* name, const H5A_info_t*, void* out) -> herr_t {
-      static_cast<std::vector<std::string>*>(out)->emplace_back(name);
-      return 0;
-    };
-    ctx_.check_status(H5Aiterate2(object, H5_INDEX_CRT_ORDER, H5_ITER_INC, &index, collect, &names),
-                      "cannot list the values of " + object_name);
-    return names;
-  }
-
-  // Dataset `group_name/name` whose shape must be `dims` (explained by `why` in the message) and
-  // whose type class matches T; returns its values in row-major order.  Collective.
-  template <class T>
-  std::vector<T> dataset(hid_t group, const std::string& group_name, const char* name,
-                         const std::vector<hsize_t>& dims, const std::string& why) const {
-    const std::string full = group_name + "/" + name;
-    const htri_t exists = H5Lexists(group, name, H5P_DEFAULT);
-    if (exists < 0) ctx_.fail_hdf5("cannot look up dataset " + full);
-    if (exists == 0) ctx_.fail("has no dataset " + full);
-    Handle dataset = ctx_.own(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose, "cannot open " + full);
-    Handle space =
-        ctx_.own(H5Dget_space(dataset.get()), H5Sclose, "cannot get the shape of " + full);
-    const int rank = H5Sget_simple_extent_ndims(space.get());
-    if (rank < 0) ctx_.fail_hdf5("cannot get the shape of " + full);
-    std::vector<hsize_t> found(static_cast<std::size_t>(rank));
-    if (rank > 0 && H5Sget_simple_extent_dims(space.get(), found.data(), nullptr) < 0)
-      ctx_.fail_hdf5("cannot get the shape of " + full);
-    if (found != dims)
-      ctx_.fail("dataset " + full + " has shape " + shape_text(found) + ", expected " +
-                shape_text(dims) + " (" + why + ")");
-    Handle type = ctx_.own(H5Dget_type(dataset.get()), H5Tclose, "cannot get the type of " + full);
-    const H5T_class_t cls = H5Tget_class(type.get());
-    const H5T_class_t wanted = std::is_floating_point_v<T> ? H5T_FLOAT : H5T_INTEGER;
-    if (cls != wanted)
-      ctx_.fail("dataset " + full + " is not of " +
-                (wanted == H5T_FLOAT ? "floating-point" : "integer") + " type");
-    hsize_t count = 1;
-    for (hsize_t d : dims) count *= d;
-    std::vector<T> values(static_cast<std::size_t>(count));
-    if (count > 0)
-      ctx_.check_status(
-          H5Dread(dataset.get(), native_type<T>(), H5S_ALL, H5S_ALL, dxpl_.get(), values.data()),
-          "cannot read " + full);
-    const auto stored = number_attribute<std::uint64_t>(dataset.get(), full, "checksum");
-    const std::size_t width = dims.size() > 1 ? static_cast<std::size_t>(dims[1]) : 1;
-    if (rows_checksum(full, values, width, 0) != stored) ctx_.corrupt("dataset " + full);
-    return values;
-  }
-
- private:
-  static std::string shape_text(const std::vector<hsize_t>& dims) {
-    if (dims.empty()) return "scalar";
-    std::string text;
-    for (std::size_t i = 0; i < dims.size(); ++i)
-      text += (i ? " x " : "") + std::to_string(dims[i]);
-    return text;
-  }
-
-  const Context& ctx_;
-  hid_t file_;
-  Handle dxpl_;
-};
-
-void check_dense_gids(const Context& ctx, const std::vector<GlobalId>& gids, const char* what) {
-  for (std::size_t i = 0; i < gids.size(); ++i)
-    if (gids[i] != static_cast<GlobalId>(i))
-      ctx.fail(std::string("dataset ") + what + " holds gid " + std::to_string(gids[i]) +
-               " in row " + std::to_string(i) + "; a checkpoint stores gid i in row i");
-}
-
-void sort_friction(CheckpointRows& rows) {
-  const std::size_t m = rows.friction_a.size();
-  std::vector<std::size_t> order(m);
-  std::iota(order.begin(), order.end(), std::size_t(0));
-  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
-    return std::make_pair(rows.friction_a[i], rows.friction_b[i]) <
-           std::make_pair(rows.friction_a[j], rows.friction_b[j]);
-  });
-  rows.friction_a = permuted(rows.friction_a, order, 1);
-  rows.friction_b = permuted(rows.friction_b, order, 1);
-  rows.friction_spring = permuted(rows.friction_spring, order, 3);
-  rows.friction_stiffness = permuted(rows.friction_stiffness, order, 1);
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -647,137 +465,6 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
     }
     sync_directory_of(path);
   });
-}
-
-std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& path,
-                                                            const Communicator& comm) {
-  const Context ctx(path, "checkpoint", Context::Mode::read);
-  const SilenceHdf5Errors silence;
-  CheckpointHeader header;
-  CheckpointRows rows;
-
-  SealState sealed = SealState::absent;
-  comm.run_collectively([&] {
-    std::error_code error;
-    if (!std::filesystem::exists(path, error)) ctx.fail("file does not exist");
-    if (!std::filesystem::is_regular_file(path, error)) ctx.fail("is not a regular file");
-    // The seal first (rank 0): damaged metadata must not reach HDF5's parser.
-    std::string problem;
-    if (comm.is_root()) sealed = check_checkpoint_seal(path, problem);
-    if (sealed == SealState::damaged) ctx.corrupt(problem);
-    const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
-    if (is_hdf5 < 0) ctx.fail_hdf5("cannot be opened");
-    if (is_hdf5 == 0) ctx.fail("is not an HDF5 file, so not an fdem checkpoint");
-  });
-
-  Handle file;
-  comm.run_collectively([&] {
-    Handle fapl = make_mpio_access(ctx, comm);
-    file = ctx.own(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()), H5Fclose,
-                   "cannot open the HDF5 file (damaged or truncated?)");
-  });
-
-  std::int64_t history_bytes = 0;
-  comm.run_collectively([&] {
-    const Reader read(ctx, file.get());
-    const hid_t root = file.get();
-    const htri_t has_format = H5Aexists(root, "format");
-    if (has_format < 0) ctx.fail_hdf5("cannot read the root attributes");
-    const std::string format = has_format ? read.string_attribute(root, "/", "format") : "";
-    if (format != format_name)
-      ctx.fail(std::string("is an HDF5 file but not an fdem checkpoint (root attribute format ") +
-               (has_format ? "is '" + format + "'" : "is missing") + ", expected '" + format_name +
-               "')");
-    const auto version = read.number_attribute<std::int32_t>(root, "/", "version");
-    if (version != checkpoint_format_version)
-      ctx.fail("has format version " + std::to_string(version) + "; this fdem reads version " +
-               std::to_string(checkpoint_format_version));
-    if (comm.is_root() && sealed != SealState::intact)
-      ctx.corrupt("its checksum block (the HDF5 userblock) is missing");
-    header.ranks = read.number_attribute<std::int32_t>(root, "/", "ranks");
-    header.n_nodes = read.number_attribute<std::int64_t>(root, "/", "n_nodes");
-    header.n_tets = read.number_attribute<std::int64_t>(root, "/", "n_tets");
-    header.n_joints = read.number_attribute<std::int64_t>(root, "/", "n_joints");
-    header.reference_hash = read.number_attribute<std::uint64_t>(root, "/", "reference_hash");
-    history_bytes = read.number_attribute<std::int64_t>(root, "/", "joint_history_bytes");
-    if (header.n_nodes < 0 || header.n_tets < 0 || header.n_joints < 0 || history_bytes < 0)
-      ctx.fail("has a negative count in its root attributes");
-
-    Handle run = read.group("/run");
-    for (const std::string& name : read.attribute_names(run.get(), "/run")) {
-      Handle attr = read.attribute(run.get(), "/run", name);
-      const H5T_class_t cls = read.attribute_class(attr.get(), "/run/" + name);
-      attr.reset();
-      if (cls == H5T_FLOAT)
-        header.doubles.emplace_back(name, read.number_attribute<double>(run.get(), "/run", name));
-      else if (cls == H5T_INTEGER)
-        header.integers.emplace_back(name,
-                                     read.number_attribute<std::int64_t>(run.get(), "/run", name));
-      else
-        ctx.fail("value /run/" + name + " is neither a floating-point number nor an integer");
-    }
-    const auto stored = read.number_attribute<std::uint64_t>(root, "/", "header_checksum");
-    if (header_checksum(serialized(header), history_bytes) != stored)
-      ctx.corrupt("header (the root attributes and /run values)");
-  });
-
-  comm.run_collectively([&] {
-    const Reader read(ctx, file.get());
-    const auto n = static_cast<hsize_t>(header.n_nodes);
-    const std::string why = "n_nodes = " + std::to_string(n);
-    Handle nodes = read.group("/nodes");
-    rows.node_gid = read.dataset<GlobalId>(nodes.get(), "/nodes", "gid", {n}, why);
-    check_dense_gids(ctx, rows.node_gid, "/nodes/gid");
-    rows.node_x = read.dataset<double>(nodes.get(), "/nodes", "x", {n, 3}, why);
-    rows.node_v = read.dataset<double>(nodes.get(), "/nodes", "v", {n, 3}, why);
-    rows.node_x_at_detection =
-        read.dataset<double>(nodes.get(), "/nodes", "x_at_detection", {n, 3}, why);
-    rows.node_prescribed_velocity =
-        read.dataset<double>(nodes.get(), "/nodes", "prescribed_velocity", {n, 3}, why);
-  });
-
-  comm.run_collectively([&] {
-    const Reader read(ctx, file.get());
-    const auto n = static_cast<hsize_t>(header.n_joints);
-    const auto bytes = static_cast<hsize_t>(history_bytes);
-    const std::string why = "n_joints = " + std::to_string(n);
-    Handle joints = read.group("/joints");
-    rows.joint_gid = read.dataset<GlobalId>(joints.get(), "/joints", "gid", {n}, why);
-    check_dense_gids(ctx, rows.joint_gid, "/joints/gid");
-    rows.joint_broken = read.dataset<std::uint8_t>(joints.get(), "/joints", "broken", {n}, why);
-    rows.joint_mode = read.dataset<std::uint8_t>(joints.get(), "/joints", "mode", {n}, why);
-    rows.joint_failure_time =
-        read.dataset<double>(joints.get(), "/joints", "failure_time", {n}, why);
-    rows.joint_damage = read.dataset<double>(joints.get(), "/joints", "damage", {n}, why);
-    rows.joint_history_bytes = static_cast<std::size_t>(bytes);
-    rows.joint_history =
-        read.dataset<std::uint8_t>(joints.get(), "/joints", "history", {n, bytes},
-                                   why + ", joint_history_bytes = " + std::to_string(bytes));
-  });
-
-  comm.run_collectively([&] {
-    const Reader read(ctx, file.get());
-    Handle friction = read.group("/friction");
-    // The pair count is what /friction/a holds; every other friction dataset must agree.
-    Handle a = ctx.own(H5Dopen2(friction.get(), "a", H5P_DEFAULT), H5Dclose,
-                       "has no readable dataset /friction/a");
-    Handle space = ctx.own(H5Dget_space(a.get()), H5Sclose, "cannot get the shape of /friction/a");
-    const hssize_t points = H5Sget_simple_extent_npoints(space.get());
-    if (points < 0) ctx.fail_hdf5("cannot get the shape of /friction/a");
-    space.reset();
-    a.reset();
-    const auto m = static_cast<hsize_t>(points);
-    const std::string why = "/friction/a has " + std::to_string(m) + " pairs";
-    rows.friction_a = read.dataset<GlobalId>(friction.get(), "/friction", "a", {m}, why);
-    rows.friction_b = read.dataset<GlobalId>(friction.get(), "/friction", "b", {m}, why);
-    rows.friction_spring = read.dataset<double>(friction.get(), "/friction", "spring", {m, 3}, why);
-    rows.friction_stiffness =
-        read.dataset<double>(friction.get(), "/friction", "stiffness", {m}, why);
-    sort_friction(rows);
-  });
-
-  comm.run_collectively([&] { ctx.check_status(file.close(), "cannot close the file"); });
-  return {std::move(header), std::move(rows)};
 }
 
 }  // namespace fdem

@@ -27,6 +27,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -78,11 +79,28 @@ struct CheckpointRows {
 void write_checkpoint(const std::string& path, const Communicator& comm,
                       const CheckpointHeader& header, const CheckpointRows& owned);
 
-// Collective.  Every rank reads the whole file: rows sorted by gid (the file stores them so),
-// friction pairs sorted by (a, b).  A missing file, a file that is not an fdem checkpoint, a
-// different format version, a dataset of the wrong size or type, or one that does not match its
-// checksum ("checkpoint corrupt: dataset X") throws CollectiveInputError
-// on every rank naming the file and what is wrong.
+// The rows a rank needs from a checkpoint, by gid (each list ascending, without repeats): the
+// nodes and joints it holds, and the tets whose friction pairs it keeps (a pair (a, b) goes to
+// every rank that lists its first tet a).
+struct CheckpointWanted {
+  std::vector<GlobalId> nodes, joints, tets;
+};
+
+// Collective.  Reads the header on every rank, then each rank reads one contiguous block of every
+// dataset by hyperslab (collective I/O), the ranks verify the datasets' checksums together, and
+// the rows travel from the block ranks to the ranks that want them: a rank reads and receives its
+// block and its wanted rows, never the whole file.  Rows come back in the order of `wanted`,
+// friction pairs sorted by (a, b).  `check_header` (optional) runs on every rank once the header
+// is read, before any row (a scene mismatch is reported there; what it throws becomes a
+// collective failure).  Without `wanted`, every rank gets every row (small files, tests).
+//
+// A missing file, a file that is not an fdem checkpoint, a different format version, a dataset
+// of the wrong size or type, one that does not match its checksum ("checkpoint corrupt: dataset
+// X"), or a wanted gid beyond the file's counts throws CollectiveInputError on every rank naming
+// the file and what is wrong.
+std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(
+    const std::string& path, const Communicator& comm, const CheckpointWanted* wanted,
+    const std::function<void(const CheckpointHeader&)>& check_header);
 std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& path,
                                                             const Communicator& comm);
 
