@@ -81,12 +81,16 @@ void build_internal_force_split(const Model& model, InternalForceSplit& split) {
     if (ghost)
       for (int c = 0; c < 4; ++c) split.boundary[tets.nodes[4 * t + c]] = 1;
   }
+  split.corner_slot.assign(static_cast<std::size_t>(tets.size()), -1);
   for (const LocalIndex t : model.tet_force_order) {
     bool touches = false;
     for (int c = 0; c < 4; ++c) touches = touches || split.boundary[tets.nodes[4 * t + c]];
-    if (touches) split.boundary_tets.push_back(t);
+    if (!touches) continue;
+    split.corner_slot[t] = static_cast<LocalIndex>(split.boundary_tets.size());
+    split.boundary_tets.push_back(t);
   }
-  split.corner_force.assign(12 * static_cast<std::size_t>(tets.size()), 0.0);
+  // Only tets touching a boundary node park their corner forces (12 doubles each).
+  split.corner_force.assign(12 * split.boundary_tets.size(), 0.0);
 }
 
 InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& split,
@@ -97,17 +101,19 @@ InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& s
   InternalForceSummary sum;
   double* f = nodes.f.data();
   double* corner = split.corner_force.data();
+  const LocalIndex* slot = split.corner_slot.data();
   const std::uint8_t* boundary = split.boundary.data();
   LocalIndex t = 0;  // the tet being computed, for the scatters below
+  const auto parked = [&](int c) {
+    return Eigen::Map<Vec3>(corner + 12 * static_cast<std::size_t>(slot[t]) + 3 * c);
+  };
   const auto early_scatter = [&](int c, LocalIndex n, const Vec3& force) {
     if (boundary[n])
-      Eigen::Map<Vec3>(corner + 12 * static_cast<std::size_t>(t) + 3 * c) = force;
+      parked(c) = force;
     else
       vec3_at(f, n) += force;
   };
-  const auto late_scatter = [&](int c, LocalIndex, const Vec3& force) {
-    Eigen::Map<Vec3>(corner + 12 * static_cast<std::size_t>(t) + 3 * c) = force;
-  };
+  const auto late_scatter = [&](int c, LocalIndex, const Vec3& force) { parked(c) = force; };
   // Interior work while the ghost positions travel.
   for (const LocalIndex e : split.early) {
     t = e;
@@ -123,12 +129,13 @@ InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& s
     });
   }
   // Boundary nodes: every contribution, in ascending tet gid.
-  for (const LocalIndex b : split.boundary_tets)
+  for (std::size_t k = 0; k < split.boundary_tets.size(); ++k) {
+    const LocalIndex b = split.boundary_tets[k];
     for (int c = 0; c < 4; ++c) {
       const LocalIndex n = tets.nodes[4 * b + c];
-      if (boundary[n])
-        vec3_at(f, n) += Eigen::Map<const Vec3>(corner + 12 * static_cast<std::size_t>(b) + 3 * c);
+      if (boundary[n]) vec3_at(f, n) += Eigen::Map<const Vec3>(corner + 12 * k + 3 * c);
     }
+  }
   return sum;
 }
 

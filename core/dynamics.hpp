@@ -31,7 +31,8 @@ struct InternalForceSplit {
   std::vector<LocalIndex> late;           // active tets with a ghost node, ascending gid
   std::vector<LocalIndex> boundary_tets;  // active tets touching a boundary node, ascending gid
   std::vector<std::uint8_t> boundary;     // per node: its sum waits for the late tets
-  std::vector<double> corner_force;       // 12 per tet (N), scratch
+  std::vector<LocalIndex> corner_slot;    // per tet: its row in corner_force, or -1
+  std::vector<double> corner_force;       // 12 per boundary tet (N), scratch
 };
 // Call after every change of the local model (distribution).
 void build_internal_force_split(const Model& model, InternalForceSplit& split);

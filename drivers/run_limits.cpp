@@ -178,7 +178,8 @@ double step_count(double start, double end, double dt) {
   return std::ceil((end - start) / dt - 1e-9);
 }
 
-void check_step_limit(const Scene& scene, double start, double dt, const std::string& step_origin) {
+void check_step_limit(const Scene& scene, double start, double dt,
+                      const std::function<std::string()>& step_origin) {
   const double steps = step_count(start, scene.time.end, dt);
   if (steps <= scene.limits.max_steps && fits_integer<long>(steps)) return;
   std::ostringstream msg;
@@ -188,7 +189,7 @@ void check_step_limit(const Scene& scene, double start, double dt, const std::st
   if (start > 0) msg << " from t = " << start << " s";
   msg << " with a step of " << dt
       << " s), more than limits.max_steps = " << format_count(scene.limits.max_steps) << ". "
-      << step_origin
+      << step_origin()
       << " Shorten time.end, fix the mesh or stiffness that sets the step, or raise "
          "limits.max_steps if this many steps are intended.";
   throw InputError(msg.str());

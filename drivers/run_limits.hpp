@@ -3,6 +3,7 @@
 // the scene's `limits:` block (docs/scene-format.md) with the numbers and the key to change.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "core/model.hpp"
@@ -40,8 +41,10 @@ void check_memory_limit(const Scene& scene, const ModelSize& size, int ranks, in
 double step_count(double start, double end, double dt);
 
 // Throws InputError when the steps from `start` to time.end exceed limits.max_steps (or do not
-// fit a long).  `step_origin` explains the time step (which element or stiffness sets it).
-void check_step_limit(const Scene& scene, double start, double dt, const std::string& step_origin);
+// fit a long).  `step_origin` explains the time step (which element or stiffness sets it); it is
+// only called for the message (it scans the model).
+void check_step_limit(const Scene& scene, double start, double dt,
+                      const std::function<std::string()>& step_origin);
 
 // The step count of a run already checked by check_step_limit.
 long checked_step_count(double start, double end, double dt);

@@ -223,7 +223,7 @@ void Simulation::check_run_limits() const {
         << "): there is nothing to continue. Set a later time.end (--set time.end=...).";
     throw InputError(msg.str());
   }
-  check_step_limit(scene_, time_, dt_, step_origin());
+  check_step_limit(scene_, time_, dt_, [this] { return step_origin(); });
 }
 
 // Where the time step comes from, for messages: the element that sets the elastic critical step

@@ -240,13 +240,14 @@ std::vector<FrictionRow> deliver_friction(const Communicator& comm, std::int64_t
   std::sort(held.begin(), held.end(), pair_less);
 
   std::vector<std::vector<GlobalId>> requests(static_cast<std::size_t>(comm.size()));
-  for (GlobalId g : wanted_tets) requests[static_cast<std::size_t>(tet_blocks.owner(g))].push_back(g);
+  for (GlobalId g : wanted_tets)
+    requests[static_cast<std::size_t>(tet_blocks.owner(g))].push_back(g);
   std::vector<int> askers;
   const std::vector<GlobalId> asked = comm.exchange(requests, &askers);
   std::vector<std::vector<FrictionRow>> replies(static_cast<std::size_t>(comm.size()));
   for (std::size_t k = 0; k < asked.size(); ++k) {
     const auto first = std::lower_bound(held.begin(), held.end(), asked[k],
-                                         [](const FrictionRow& r, GlobalId g) { return r.a < g; });
+                                        [](const FrictionRow& r, GlobalId g) { return r.a < g; });
     auto& reply = replies[static_cast<std::size_t>(askers[k])];
     for (auto it = first; it != held.end() && it->a == asked[k]; ++it) reply.push_back(*it);
   }
@@ -363,10 +364,9 @@ FileBlocks read_blocks(const Context& ctx, const Communicator& comm, hid_t file,
         read.block<double>(joints.get(), "/joints", "failure_time", {n}, why, b, tally);
     rows.joint_damage = read.block<double>(joints.get(), "/joints", "damage", {n}, why, b, tally);
     rows.joint_history_bytes = static_cast<std::size_t>(bytes);
-    rows.joint_history =
-        read.block<std::uint8_t>(joints.get(), "/joints", "history", {n, bytes},
-                                 why + ", joint_history_bytes = " + std::to_string(bytes), b,
-                                 tally);
+    rows.joint_history = read.block<std::uint8_t>(
+        joints.get(), "/joints", "history", {n, bytes},
+        why + ", joint_history_bytes = " + std::to_string(bytes), b, tally);
   });
   hsize_t pairs = 0;
   comm.run_collectively([&] {
@@ -386,8 +386,10 @@ FileBlocks read_blocks(const Context& ctx, const Communicator& comm, hid_t file,
     Handle friction = read.group("/friction");
     const std::string why = "/friction/a has " + std::to_string(pairs) + " pairs";
     const Run b = blocks.pairs;
-    rows.friction_a = read.block<GlobalId>(friction.get(), "/friction", "a", {pairs}, why, b, tally);
-    rows.friction_b = read.block<GlobalId>(friction.get(), "/friction", "b", {pairs}, why, b, tally);
+    rows.friction_a =
+        read.block<GlobalId>(friction.get(), "/friction", "a", {pairs}, why, b, tally);
+    rows.friction_b =
+        read.block<GlobalId>(friction.get(), "/friction", "b", {pairs}, why, b, tally);
     rows.friction_spring =
         read.block<double>(friction.get(), "/friction", "spring", {pairs, 3}, why, b, tally);
     rows.friction_stiffness =
@@ -395,9 +397,9 @@ FileBlocks read_blocks(const Context& ctx, const Communicator& comm, hid_t file,
     for (std::size_t k = 0; k < rows.friction_a.size(); ++k)
       if (rows.friction_a[k] < 0 || rows.friction_a[k] >= rows.friction_b[k] ||
           rows.friction_b[k] >= header.n_tets)
-        ctx.fail("dataset /friction/a, /friction/b row " + std::to_string(b.start + k) +
-                 " is not a pair of tet gids a < b below n_tets = " +
-                 std::to_string(header.n_tets));
+        ctx.fail(
+            "dataset /friction/a, /friction/b row " + std::to_string(b.start + k) +
+            " is not a pair of tet gids a < b below n_tets = " + std::to_string(header.n_tets));
   });
   // Every rank reached this point (the blocks above are collective failures), so the sum is safe.
   comm.sum_in_place(tally.local);  // unsigned: wraps mod 2^64, the same on any rank count

@@ -211,6 +211,12 @@ class Communicator {
   template <class T>
   std::vector<T> exchange(const std::vector<std::vector<T>>& outbox,
                           std::vector<int>* sources = nullptr) const;
+  // The same from one array already grouped by destination: the first counts[0] elements go to
+  // rank 0, the next counts[1] to rank 1, ... (no copy of the data is made to send it).
+  template <class T>
+  std::vector<T> exchange_grouped(const std::vector<T>& grouped,
+                                  const std::vector<std::size_t>& counts,
+                                  std::vector<int>* sources = nullptr) const;
   // Returns root's string on every rank.
   std::string broadcast(const std::string& text, int root = 0) const;
 
@@ -270,19 +276,31 @@ std::vector<T> Communicator::allgather(const T& value) const {
 template <class T>
 std::vector<T> Communicator::exchange(const std::vector<std::vector<T>>& outbox,
                                       std::vector<int>* sources) const {
-  static_assert(std::is_trivially_copyable_v<T>, "exchange moves plain values only");
   FDEM_VERIFY(static_cast<int>(outbox.size()) == size_, "one outbox per rank");
+  std::vector<std::size_t> counts(static_cast<std::size_t>(size_));
+  std::size_t total = 0;
+  for (int r = 0; r < size_; ++r) total += counts[r] = outbox[r].size();
+  std::vector<T> send;
+  send.reserve(total);
+  for (const auto& box : outbox) send.insert(send.end(), box.begin(), box.end());
+  return exchange_grouped(send, counts, sources);
+}
+
+template <class T>
+std::vector<T> Communicator::exchange_grouped(const std::vector<T>& grouped,
+                                              const std::vector<std::size_t>& counts,
+                                              std::vector<int>* sources) const {
+  static_assert(std::is_trivially_copyable_v<T>, "exchange moves plain values only");
+  FDEM_VERIFY(static_cast<int>(counts.size()) == size_, "one count per rank");
   std::vector<int> send_counts(size_), send_displs(size_), receive_counts(size_),
       receive_displs(size_);
   std::size_t total = 0;
   for (int r = 0; r < size_; ++r) {
     send_displs[r] = detail::checked_count(total, 1);
-    send_counts[r] = detail::checked_count(outbox[r].size(), 1);
-    total += outbox[r].size();
+    send_counts[r] = detail::checked_count(counts[r], 1);
+    total += counts[r];
   }
-  std::vector<T> send;
-  send.reserve(total);
-  for (const auto& box : outbox) send.insert(send.end(), box.begin(), box.end());
+  FDEM_VERIFY(total == grouped.size(), "the counts cover the grouped array");
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_);
   total = 0;
   for (int r = 0; r < size_; ++r) {
@@ -294,7 +312,7 @@ std::vector<T> Communicator::exchange(const std::vector<std::vector<T>>& outbox,
   MPI_Datatype type;
   MPI_Type_contiguous(static_cast<int>(sizeof(T)), MPI_BYTE, &type);
   MPI_Type_commit(&type);
-  MPI_Alltoallv(send.data(), send_counts.data(), send_displs.data(), type, received.data(),
+  MPI_Alltoallv(grouped.data(), send_counts.data(), send_displs.data(), type, received.data(),
                 receive_counts.data(), receive_displs.data(), type, comm_);
   MPI_Type_free(&type);
   if (sources) {

@@ -62,27 +62,22 @@ std::vector<TetRecord> sort_into_blocks(std::vector<TetRecord> local,
   std::vector<SortKey> splitters;
   for (int r = 1; r < ranks && !all.empty(); ++r)
     splitters.push_back(all[static_cast<std::size_t>(r) * all.size() / ranks]);
-  std::vector<std::vector<TetRecord>> outbox(static_cast<std::size_t>(ranks));
-  for (const TetRecord& r : local) {
-    const auto bucket =
-        std::upper_bound(splitters.begin(), splitters.end(), sort_key(r)) - splitters.begin();
-    outbox[static_cast<std::size_t>(bucket)].push_back(r);
-  }
-  local.clear();
-  local.shrink_to_fit();
-  std::vector<TetRecord> bucket = comm.exchange(outbox);
-  outbox.assign(static_cast<std::size_t>(ranks), {});
+  // Sorted, so each bucket is a contiguous range: sent straight from `local` (no copy).
+  std::vector<std::size_t> counts(static_cast<std::size_t>(ranks), 0);
+  for (const TetRecord& r : local)
+    ++counts[static_cast<std::size_t>(
+        std::upper_bound(splitters.begin(), splitters.end(), sort_key(r)) - splitters.begin())];
+  std::vector<TetRecord> bucket = comm.exchange_grouped(local, counts);
+  local = std::vector<TetRecord>{};
   std::sort(bucket.begin(), bucket.end(), less);
   // Buckets are in global order by rank: each record's position, and so its block, follows.
-  const std::vector<std::int64_t> counts = comm.allgather(static_cast<std::int64_t>(bucket.size()));
+  const std::vector<std::int64_t> sizes = comm.allgather(static_cast<std::int64_t>(bucket.size()));
   const GlobalId first =
-      std::accumulate(counts.begin(), counts.begin() + comm.rank(), std::int64_t{0});
+      std::accumulate(sizes.begin(), sizes.begin() + comm.rank(), std::int64_t{0});
+  counts.assign(static_cast<std::size_t>(ranks), 0);
   for (std::size_t i = 0; i < bucket.size(); ++i)
-    outbox[static_cast<std::size_t>(block_owner(block, first + static_cast<GlobalId>(i)))]
-        .push_back(bucket[i]);
-  bucket.clear();
-  bucket.shrink_to_fit();
-  return comm.exchange(outbox);  // from lower ranks first, each sorted: in order
+    ++counts[static_cast<std::size_t>(block_owner(block, first + static_cast<GlobalId>(i)))];
+  return comm.exchange_grouped(bucket, counts);  // from lower ranks first, each sorted: in order
 }
 
 // A use of a mesh node by a tet corner: use = 4 × tet gid + corner (first use = smallest).
@@ -363,13 +358,16 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     const double* x;
     std::int32_t piece;
   };
-  std::vector<LocalNode> local_nodes;
-  local_nodes.reserve(numbers.size());
+  // One entry per node used here (`numbers` holds each once, by mesh node): its position and
+  // piece from the first corner that uses it.
+  std::vector<LocalNode> local_nodes(numbers.size(), LocalNode{0, 0, nullptr, 0});
   for (const TetRecord& r : records)
     for (int c = 0; c < 4; ++c) {
       const NodeNumber& n = number_of(r.node[c]);
-      local_nodes.push_back({n.gid, n.first_tet, &r.x[3 * c], r.piece});
+      LocalNode& l = local_nodes[static_cast<std::size_t>(&n - numbers.data())];
+      if (!l.x) l = {n.gid, n.first_tet, &r.x[3 * c], r.piece};
     }
+  for (const LocalNode& l : local_nodes) FDEM_VERIFY(l.x, "every numbered node is used here");
   const auto owned_here = [&](const LocalNode& n) {
     return n.first_tet >= first_tet && n.first_tet < out.tet_block[me + 1];
   };
@@ -377,10 +375,6 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     const bool oa = owned_here(a), ob = owned_here(b);
     return oa != ob ? oa : a.gid < b.gid;
   });
-  local_nodes.erase(
-      std::unique(local_nodes.begin(), local_nodes.end(),
-                  [](const LocalNode& a, const LocalNode& b) { return a.gid == b.gid; }),
-      local_nodes.end());
   NodeArrays& nodes = model.nodes;
   const LocalIndex n_local = static_cast<LocalIndex>(local_nodes.size());
   nodes.resize(n_local);
@@ -418,6 +412,10 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   tets.contact_group.resize(n_tets);
   tets.owned.assign(n_tets, 1);
   tets.active.assign(n_tets, 1);
+  // A node owned here is first used here, so no tet of a lower rank uses it: its mass is the sum
+  // of this block's quarters in gid order (added right away), then those of higher ranks' tets
+  // (sent here, added after in gid order) — the serial builder's order.  Only the quarters for
+  // nodes owned elsewhere travel.
   std::vector<std::vector<MassPart>> parts(static_cast<std::size_t>(ranks));
   for (LocalIndex t = 0; t < n_tets; ++t) {
     const TetRecord& r = records[t];
@@ -437,8 +435,11 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     tets.viscosity[t] = setup.viscosity;
     for (int c = 0; c < 4; ++c) {
       const LocalIndex n = tets.nodes[4 * t + c];
-      parts[static_cast<std::size_t>(out.node_owner[n])].push_back(
-          {nodes.gid[n], tets.gid[t], 0.25 * setup.mass});
+      if (n < nodes.n_owned)
+        nodes.mass[n] += 0.25 * setup.mass;
+      else
+        parts[static_cast<std::size_t>(out.node_owner[n])].push_back(
+            {nodes.gid[n], tets.gid[t], 0.25 * setup.mass});
     }
   }
   records.clear();
@@ -448,7 +449,10 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   std::sort(arrived.begin(), arrived.end(), [](const MassPart& a, const MassPart& b) {
     return a.node != b.node ? a.node < b.node : a.tet < b.tet;
   });
-  for (const MassPart& p : arrived) nodes.mass[local_node(p.node)] += p.mass;
+  for (const MassPart& p : arrived) {
+    FDEM_VERIFY(p.tet >= out.tet_block[me + 1], "mass quarters arrive from higher blocks");
+    nodes.mass[local_node(p.node)] += p.mass;
+  }
   // The other local nodes ask their owners for the mass.
   std::vector<std::vector<GlobalId>> asks(static_cast<std::size_t>(ranks));
   for (LocalIndex n = nodes.n_owned; n < n_local; ++n)

@@ -14,69 +14,15 @@
 #include "core/checked_cast.hpp"
 #include "core/error.hpp"
 #include "core/state_hash.hpp"
+#include "parallel/distribution_rows.hpp"
 #include "parallel/partition.hpp"
 #include "parallel/zoltan_partition.hpp"
 
 namespace fdem {
 
+using namespace distribution_rows;
+
 namespace {
-
-// Rows as they travel: plain values, node and tet references as global ids.
-struct TetRow {
-  GlobalId gid;
-  std::int32_t owner;  // rank that owns it after this redistribution
-  GlobalId nodes[4];
-  double dm_inv[9];
-  double volume0, viscosity;
-  std::int32_t material, piece, contact_group;
-  std::uint8_t joint_state;
-};
-struct NodeRow {
-  GlobalId gid;
-  GlobalId first_tet;  // smallest tet gid that uses it (fixed)
-  std::int32_t owner;  // the owner of first_tet after this redistribution
-  double x[3], x0[3], v[3], prescribed_velocity[3], x_at_detection[3];
-  double mass;
-  std::int32_t piece;
-  std::uint8_t constrained;
-};
-struct JointRow {
-  GlobalId gid;
-  GlobalId nodes[6];
-  GlobalId tets[2];
-  double area0, failure_time, damage;
-  std::int32_t law;
-  std::uint8_t broken, mode;
-  JointHistory history;
-};
-struct FrictionRow {
-  GlobalId a, b;
-  double spring[3];
-  double stiffness;
-};
-struct BlockHeader {
-  std::int64_t tets = 0, nodes = 0, joints = 0, friction = 0;
-};
-static_assert(std::is_trivially_copyable_v<JointHistory>, "joint history travels as bytes");
-static_assert(sizeof(TetRow) % 8 == 0 && sizeof(NodeRow) % 8 == 0 && sizeof(JointRow) % 8 == 0 &&
-                  sizeof(FrictionRow) % 8 == 0 && sizeof(BlockHeader) % 8 == 0,
-              "rows travel as 8-byte words");
-
-template <class T>
-void append(std::vector<char>& out, const T& value) {
-  static_assert(std::is_trivially_copyable_v<T>);
-  const std::size_t at = out.size();
-  out.resize(at + sizeof(T));
-  std::memcpy(out.data() + at, &value, sizeof(T));
-}
-
-template <class T>
-T take(const char*& p) {
-  T value;
-  std::memcpy(&value, p, sizeof(T));
-  p += sizeof(T);
-  return value;
-}
 
 // Axis-aligned box of a tet at the current positions: lo xyz, hi xyz.
 void tet_box(const Model& model, LocalIndex t, double box[6]) {
@@ -136,129 +82,6 @@ double largest_joint_gap(const Model& model) {
   }
   return gap;
 }
-
-// Packs the rows that travel with a set of tets: the tets, their nodes (once per block), the
-// joints whose first tet they are, and their friction pairs (pairs keyed by their first tet).
-class RowPacker {
- public:
-  // `tet_owner`, `node_owner`, `node_first_tet`: per local tet and node, their owners after the
-  // redistribution and the nodes' first tets.
-  RowPacker(const Model& model, const TravellingState& state,
-            const std::vector<std::int32_t>& tet_owner, const std::vector<std::int32_t>& node_owner,
-            const std::vector<GlobalId>& node_first_tet)
-      : model_(model),
-        state_(state),
-        tet_owner_(tet_owner),
-        node_owner_(node_owner),
-        node_first_tet_(node_first_tet),
-        stamp_(model.nodes.size(), -1) {
-    const JointArrays& joints = model.joints;
-    joint_offsets_.assign(static_cast<std::size_t>(model.tets.size()) + 1, 0);
-    for (LocalIndex j = 0; j < joints.size(); ++j) ++joint_offsets_[joints.tets[2 * j] + 1];
-    std::partial_sum(joint_offsets_.begin(), joint_offsets_.end(), joint_offsets_.begin());
-    joint_list_.resize(static_cast<std::size_t>(joints.size()));
-    std::vector<std::int64_t> fill(joint_offsets_.begin(), joint_offsets_.end() - 1);
-    for (LocalIndex j = 0; j < joints.size(); ++j) joint_list_[fill[joints.tets[2 * j]]++] = j;
-  }
-
-  void pack(const std::vector<LocalIndex>& tet_list, std::vector<char>& out) {
-    ++mark_;
-    const NodeArrays& nodes = model_.nodes;
-    const TetArrays& tets = model_.tets;
-    const JointArrays& joints = model_.joints;
-    std::vector<LocalIndex> node_list, joint_list;
-    std::vector<const FrictionEntry*> friction_list;
-    for (LocalIndex t : tet_list) {
-      for (int c = 0; c < 4; ++c) {
-        const LocalIndex n = tets.nodes[4 * static_cast<std::size_t>(t) + c];
-        if (stamp_[n] != mark_) {
-          stamp_[n] = mark_;
-          node_list.push_back(n);
-        }
-      }
-      for (std::int64_t k = joint_offsets_[t]; k < joint_offsets_[t + 1]; ++k)
-        joint_list.push_back(joint_list_[k]);
-      const GlobalId g = tets.gid[t];
-      auto it =
-          std::lower_bound(state_.friction.begin(), state_.friction.end(), g,
-                           [](const FrictionEntry& e, GlobalId value) { return e.a < value; });
-      for (; it != state_.friction.end() && it->a == g; ++it) friction_list.push_back(&*it);
-    }
-    BlockHeader header;
-    header.tets = static_cast<std::int64_t>(tet_list.size());
-    header.nodes = static_cast<std::int64_t>(node_list.size());
-    header.joints = static_cast<std::int64_t>(joint_list.size());
-    header.friction = static_cast<std::int64_t>(friction_list.size());
-    out.reserve(out.size() + sizeof(header) + tet_list.size() * sizeof(TetRow) +
-                node_list.size() * sizeof(NodeRow) + joint_list.size() * sizeof(JointRow) +
-                friction_list.size() * sizeof(FrictionRow));
-    append(out, header);
-    for (LocalIndex t : tet_list) {
-      TetRow row{};
-      row.gid = tets.gid[t];
-      row.owner = tet_owner_[t];
-      for (int c = 0; c < 4; ++c) row.nodes[c] = nodes.gid[tets.nodes[4 * t + c]];
-      std::copy_n(&tets.dm_inv[9 * static_cast<std::size_t>(t)], 9, row.dm_inv);
-      row.volume0 = tets.volume0[t];
-      row.viscosity = tets.viscosity[t];
-      row.material = tets.material[t];
-      row.piece = tets.piece[t];
-      row.contact_group = tets.group_of(t);
-      row.joint_state = state_.tet_joint_state.empty() ? 0 : state_.tet_joint_state[t];
-      append(out, row);
-    }
-    for (LocalIndex n : node_list) {
-      NodeRow row{};
-      row.gid = nodes.gid[n];
-      row.first_tet = node_first_tet_[n];
-      row.owner = node_owner_[n];
-      for (int k = 0; k < 3; ++k) {
-        row.x[k] = nodes.x[3 * n + k];
-        row.x0[k] = nodes.x0[3 * n + k];
-        row.v[k] = nodes.v[3 * n + k];
-        row.prescribed_velocity[k] = nodes.prescribed_velocity[3 * n + k];
-        row.x_at_detection[k] = state_.x_at_detection[3 * n + k];
-      }
-      row.mass = nodes.mass[n];
-      row.piece = nodes.piece[n];
-      row.constrained = nodes.constrained[n];
-      append(out, row);
-    }
-    for (LocalIndex j : joint_list) {
-      JointRow row{};
-      row.gid = joints.gid[j];
-      for (int i = 0; i < 6; ++i) row.nodes[i] = nodes.gid[joints.nodes[6 * j + i]];
-      for (int i = 0; i < 2; ++i) row.tets[i] = tets.gid[joints.tets[2 * j + i]];
-      row.area0 = joints.area0[j];
-      row.failure_time = joints.failure_time[j];
-      row.damage = joints.damage[j];
-      row.law = joints.law[j];
-      row.broken = joints.broken[j];
-      row.mode = joints.mode[j];
-      row.history = state_.joint_history[j];
-      append(out, row);
-    }
-    for (const FrictionEntry* e : friction_list) {
-      FrictionRow row{};
-      row.a = e->a;
-      row.b = e->b;
-      for (int k = 0; k < 3; ++k) row.spring[k] = e->spring[k];
-      row.stiffness = e->stiffness;
-      append(out, row);
-    }
-  }
-
- private:
-  const Model& model_;
-  const TravellingState& state_;
-  const std::vector<std::int32_t>& tet_owner_;
-  const std::vector<std::int32_t>& node_owner_;
-  const std::vector<GlobalId>& node_first_tet_;
-  std::vector<int> stamp_;
-  int mark_ = 0;
-  std::vector<std::int64_t> joint_offsets_;
-  std::vector<LocalIndex> joint_list_;
-};
 
 // Which ranks own tets near a point: a grid of cubes (side 2 × the mean tet extent + the growth
 // below), each listing the ranks whose owned tets' boxes grown by their reach touch it.  A tet goes
@@ -403,62 +226,36 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   update_report(local);
 }
 
-Distribution::Distribution(const Communicator& comm, DistributionSettings settings,
-                           DistributedModel start, double buffer, Model& local,
-                           TravellingState& local_state)
-    : comm_(comm), settings_(settings), buffer_(buffer) {
-  n_tets_ = start.n_tets;
-  // The blocks are the initial partition: every local tet is owned here.
-  tet_owner_.assign(static_cast<std::size_t>(start.model.tets.size()), comm_.rank());
-  node_owner_ = std::move(start.node_owner);
-  node_first_tet_ = std::move(start.node_first_tet);
-  TravellingState state;
-  state.x_at_detection = start.model.nodes.x;
-  local = Model{};
-  local.materials = start.model.materials;
-  local.pieces = start.model.pieces;
-  local.body_names = start.model.body_names;
-  local.body_fixed = start.model.body_fixed;
-  local.gravity = start.model.gravity;
-  local.joint_laws = start.model.joint_laws;
-  migrate(start.model, state, local, local_state);
-  report_.cycles = 1;
-  update_report(local);
+// Packs lists[p] for every other rank p into `send` (grouped by rank; counts in 8-byte words),
+// and lists[me] into `own` when given.
+void Distribution::pack_rows(const Model& model, const TravellingState& state,
+                             const std::vector<std::vector<LocalIndex>>& lists,
+                             std::vector<char>& send, std::vector<int>& send_counts,
+                             std::vector<char>* own) const {
+  const int ranks = comm_.size(), me = comm_.rank();
+  send_counts.assign(static_cast<std::size_t>(ranks), 0);
+  RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_);
+  for (int p = 0; p < ranks; ++p) {
+    if (lists[p].empty()) continue;
+    if (p == me) {
+      if (own) packer.pack(lists[p], *own);
+      continue;
+    }
+    const std::size_t before = send.size();
+    packer.pack(lists[p], send);
+    // Counts in 8-byte words (every row is a multiple of 8 bytes): up to 16 GiB per rank.
+    FDEM_VERIFY(send.size() / 8 < static_cast<std::size_t>(std::numeric_limits<int>::max()),
+                "migration data under 16 GiB per rank");
+    send_counts[p] = static_cast<int>((send.size() - before) / 8);
+  }
 }
 
-// Sends every owned tet (with its rows) to its owner and to the ranks near it, and assembles what
-// arrives into `out` (which may be `model` itself).
-void Distribution::migrate(Model& model, TravellingState& state, Model& out,
-                           TravellingState& out_state) {
-  const int ranks = comm_.size(), me = comm_.rank();
-  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
-  // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
-  std::vector<char> send, own;
-  std::vector<int> send_counts(ranks, 0), send_offsets(ranks, 0);
-  {
-    RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_);
-    for (int p = 0; p < ranks; ++p) {
-      send_offsets[p] = static_cast<int>(send.size() / 8);
-      if (lists[p].empty()) continue;
-      if (p == me) {
-        packer.pack(lists[p], own);
-        continue;
-      }
-      packer.pack(lists[p], send);
-      // Counts in 8-byte words (every row is a multiple of 8 bytes): up to 16 GiB per rank.
-      const std::size_t words = (send.size() - static_cast<std::size_t>(send_offsets[p]) * 8) / 8;
-      FDEM_VERIFY(send.size() / 8 < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-                  "migration data under 16 GiB per rank");
-      send_counts[p] = static_cast<int>(words);
-    }
-  }
-  // The rows hold everything that travels: the source arrays can go before the new ones come.
-  model.nodes = NodeArrays{};
-  model.tets = TetArrays{};
-  model.joints = JointArrays{};
-  model.tet_force_order = {};
-  state = TravellingState{};
-  std::vector<int> receive_counts(ranks, 0), receive_offsets(ranks, 0);
+// Sends the packed rows (freeing `send`) and returns what the other ranks sent here.
+std::vector<char> Distribution::exchange_rows(std::vector<char>& send,
+                                              const std::vector<int>& send_counts) const {
+  const int ranks = comm_.size();
+  std::vector<int> send_offsets(ranks, 0), receive_counts(ranks, 0), receive_offsets(ranks, 0);
+  for (int p = 1; p < ranks; ++p) send_offsets[p] = send_offsets[p - 1] + send_counts[p - 1];
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
   std::size_t received = 0;  // words
   for (int p = 0; p < ranks; ++p) {
@@ -474,8 +271,26 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), word, receive.data(),
                 receive_counts.data(), receive_offsets.data(), word, comm_.handle());
   MPI_Type_free(&word);
-  send.clear();
-  send.shrink_to_fit();
+  send = std::vector<char>{};
+  return receive;
+}
+
+// Sends every owned tet (with its rows) to its owner and to the ranks near it, and assembles what
+// arrives into `out` (which may be `model` itself).
+void Distribution::migrate(Model& model, TravellingState& state, Model& out,
+                           TravellingState& out_state) {
+  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
+  // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
+  std::vector<char> send, own;
+  std::vector<int> send_counts;
+  pack_rows(model, state, lists, send, send_counts, &own);
+  // The rows hold everything that travels: the source arrays can go before the new ones come.
+  model.nodes = NodeArrays{};
+  model.tets = TetArrays{};
+  model.joints = JointArrays{};
+  model.tet_force_order = {};
+  state = TravellingState{};
+  std::vector<char> receive = exchange_rows(send, send_counts);
   assemble({&receive, &own}, out, out_state);
   build_exchange(out);
 }
@@ -483,21 +298,11 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
 void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
                             TravellingState& state) {
   const int me = comm_.rank();
-  std::vector<TetRow> tet_rows;
-  std::vector<NodeRow> node_rows;
-  std::vector<JointRow> joint_rows;
-  std::vector<FrictionRow> friction_rows;
-  for (std::vector<char>* rows : buffers) {
-    for (const char* p = rows->data(); p < rows->data() + rows->size();) {
-      const BlockHeader header = take<BlockHeader>(p);
-      for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
-      for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
-      for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
-      for (std::int64_t i = 0; i < header.friction; ++i)
-        friction_rows.push_back(take<FrictionRow>(p));
-    }
-    *rows = std::vector<char>{};  // parsed: its memory goes back before the arrays are built
-  }
+  ParsedRows parsed = parse_rows(buffers);
+  std::vector<TetRow>& tet_rows = parsed.tets;
+  std::vector<NodeRow>& node_rows = parsed.nodes;
+  std::vector<JointRow>& joint_rows = parsed.joints;
+  std::vector<FrictionRow>& friction_rows = parsed.friction;
   const auto by_gid = [](const auto& a, const auto& b) { return a.gid < b.gid; };
   const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
   std::sort(tet_rows.begin(), tet_rows.end(), by_gid);
@@ -516,8 +321,6 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   node_owner_.resize(static_cast<std::size_t>(n_nodes));
   node_first_tet_.resize(static_cast<std::size_t>(n_nodes));
   state.x_at_detection.assign(3 * static_cast<std::size_t>(n_nodes), 0.0);
-  std::unordered_map<GlobalId, LocalIndex> node_index;
-  node_index.reserve(node_rows.size());
   for (LocalIndex n = 0; n < n_nodes; ++n) {
     const NodeRow& r = node_rows[n];
     if (r.owner == me) nodes.n_owned = n + 1;
@@ -535,9 +338,9 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
     nodes.mass[n] = r.mass;
     nodes.piece[n] = r.piece;
     nodes.constrained[n] = r.constrained;
-    node_index.emplace(r.gid, n);
   }
 
+  node_rows = std::vector<NodeRow>{};
   TetArrays& tets = model.tets;
   const LocalIndex n_tets = static_cast<LocalIndex>(tet_rows.size());
   tets.resize(n_tets);
@@ -547,18 +350,29 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   tets.active.assign(n_tets, 0);
   tet_owner_.resize(static_cast<std::size_t>(n_tets));
   state.tet_joint_state.assign(has_joint_state_ ? n_tets : 0, 0);
-  std::unordered_map<GlobalId, LocalIndex> tet_index;
-  tet_index.reserve(tet_rows.size());
+  // Lookups by gid in the sorted ranges (no hash tables: they cost more than the arrays).
+  const auto node_index = [&](GlobalId gid) {
+    const auto owned_end = nodes.gid.begin() + nodes.n_owned;
+    auto it = std::lower_bound(nodes.gid.begin(), owned_end, gid);
+    if (it == owned_end || *it != gid) it = std::lower_bound(owned_end, nodes.gid.end(), gid);
+    return it != nodes.gid.end() && *it == gid ? static_cast<LocalIndex>(it - nodes.gid.begin())
+                                               : LocalIndex{-1};
+  };
+  const auto tet_index = [&](GlobalId gid) {
+    const auto it = std::lower_bound(tets.gid.begin(), tets.gid.end(), gid);
+    return it != tets.gid.end() && *it == gid ? static_cast<LocalIndex>(it - tets.gid.begin())
+                                              : LocalIndex{-1};
+  };
   for (LocalIndex t = 0; t < n_tets; ++t) {
     const TetRow& r = tet_rows[t];
     tets.gid[t] = r.gid;
     tet_owner_[t] = r.owner;
     bool touches_owned = false;
     for (int c = 0; c < 4; ++c) {
-      const auto it = node_index.find(r.nodes[c]);
-      FDEM_VERIFY(it != node_index.end(), "a tet arrives with its nodes");
-      tets.nodes[4 * t + c] = it->second;
-      touches_owned = touches_owned || it->second < nodes.n_owned;
+      const LocalIndex n = node_index(r.nodes[c]);
+      FDEM_VERIFY(n >= 0, "a tet arrives with its nodes");
+      tets.nodes[4 * t + c] = n;
+      touches_owned = touches_owned || n < nodes.n_owned;
     }
     std::copy_n(r.dm_inv, 9, &tets.dm_inv[9 * static_cast<std::size_t>(t)]);
     tets.volume0[t] = r.volume0;
@@ -570,8 +384,8 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
     tets.active[t] = tets.owned[t] || touches_owned;
     tets.n_owned += tets.owned[t];
     if (has_joint_state_) state.tet_joint_state[t] = r.joint_state;
-    tet_index.emplace(r.gid, t);
   }
+  tet_rows = std::vector<TetRow>{};
   build_tet_force_order(tets, model.tet_force_order);
 
   // Joints whose two tets are both here (a joint with one tet missing is never computed here).
@@ -579,8 +393,7 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   joint_rows.erase(std::unique(joint_rows.begin(), joint_rows.end(), same_gid), joint_rows.end());
   joint_rows.erase(std::remove_if(joint_rows.begin(), joint_rows.end(),
                                   [&](const JointRow& r) {
-                                    return !tet_index.count(r.tets[0]) ||
-                                           !tet_index.count(r.tets[1]);
+                                    return tet_index(r.tets[0]) < 0 || tet_index(r.tets[1]) < 0;
                                   }),
                    joint_rows.end());
   JointArrays& joints = model.joints;
@@ -592,11 +405,11 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
     const JointRow& r = joint_rows[j];
     joints.gid[j] = r.gid;
     for (int i = 0; i < 6; ++i) {
-      const auto it = node_index.find(r.nodes[i]);
-      FDEM_VERIFY(it != node_index.end(), "a joint's nodes are those of its tets");
-      joints.nodes[6 * j + i] = it->second;
+      const LocalIndex n = node_index(r.nodes[i]);
+      FDEM_VERIFY(n >= 0, "a joint's nodes are those of its tets");
+      joints.nodes[6 * j + i] = n;
     }
-    for (int i = 0; i < 2; ++i) joints.tets[2 * j + i] = tet_index.at(r.tets[i]);
+    for (int i = 0; i < 2; ++i) joints.tets[2 * j + i] = tet_index(r.tets[i]);
     joints.area0[j] = r.area0;
     joints.failure_time[j] = r.failure_time;
     joints.damage[j] = r.damage;

@@ -103,6 +103,17 @@ class Distribution {
   // Sends the owned tets where destinations() says, frees `model`'s mesh arrays and `state` once
   // packed, and assembles what arrives into `out` (which may be `model`).
   void migrate(Model& model, TravellingState& state, Model& out, TravellingState& out_state);
+  // The start (parallel/distribution_start.cpp): every local tet is owned here, so only halo
+  // copies travel, and they are appended to `model` in place (gid order kept): no second copy of
+  // the model is ever made.  For models without joints (else migrate).
+  void append_halo(Model& model, TravellingState& state);
+  // Packs lists[p] for the other ranks into `send` (counts in 8-byte words) and lists[me] into
+  // `own` when given; exchange_rows sends them (freeing `send`) and returns what arrived.
+  void pack_rows(const Model& model, const TravellingState& state,
+                 const std::vector<std::vector<LocalIndex>>& lists, std::vector<char>& send,
+                 std::vector<int>& send_counts, std::vector<char>* own) const;
+  std::vector<char> exchange_rows(std::vector<char>& send,
+                                  const std::vector<int>& send_counts) const;
   // Builds `model` from packed rows; empties each buffer once parsed.
   void assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
                 TravellingState& state);

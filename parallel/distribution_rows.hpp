@@ -1,0 +1,242 @@
+// The rows that carry tets, nodes, joints and friction pairs between ranks when the model is
+// (re)distributed, and the packer that writes them (parallel/distribution*.cpp).  Internal to
+// parallel/.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <initializer_list>
+#include <numeric>
+#include <type_traits>
+#include <vector>
+
+#include "core/model.hpp"
+#include "parallel/distribution.hpp"
+
+namespace fdem::distribution_rows {
+
+// Rows as they travel: plain values, node and tet references as global ids.
+struct TetRow {
+  GlobalId gid;
+  std::int32_t owner;  // rank that owns it after this redistribution
+  GlobalId nodes[4];
+  double dm_inv[9];
+  double volume0, viscosity;
+  std::int32_t material, piece, contact_group;
+  std::uint8_t joint_state;
+};
+struct NodeRow {
+  GlobalId gid;
+  GlobalId first_tet;  // smallest tet gid that uses it (fixed)
+  std::int32_t owner;  // the owner of first_tet after this redistribution
+  double x[3], x0[3], v[3], prescribed_velocity[3], x_at_detection[3];
+  double mass;
+  std::int32_t piece;
+  std::uint8_t constrained;
+};
+struct JointRow {
+  GlobalId gid;
+  GlobalId nodes[6];
+  GlobalId tets[2];
+  double area0, failure_time, damage;
+  std::int32_t law;
+  std::uint8_t broken, mode;
+  JointHistory history;
+};
+struct FrictionRow {
+  GlobalId a, b;
+  double spring[3];
+  double stiffness;
+};
+struct BlockHeader {
+  std::int64_t tets = 0, nodes = 0, joints = 0, friction = 0;
+};
+static_assert(std::is_trivially_copyable_v<JointHistory>, "joint history travels as bytes");
+static_assert(sizeof(TetRow) % 8 == 0 && sizeof(NodeRow) % 8 == 0 && sizeof(JointRow) % 8 == 0 &&
+                  sizeof(FrictionRow) % 8 == 0 && sizeof(BlockHeader) % 8 == 0,
+              "rows travel as 8-byte words");
+
+template <class T>
+inline void append(std::vector<char>& out, const T& value) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const std::size_t at = out.size();
+  out.resize(at + sizeof(T));
+  std::memcpy(out.data() + at, &value, sizeof(T));
+}
+
+template <class T>
+inline T take(const char*& p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  p += sizeof(T);
+  return value;
+}
+
+// Packs the rows that travel with a set of tets: the tets, their nodes (once per block), the
+// joints whose first tet they are, and their friction pairs (pairs keyed by their first tet).
+class RowPacker {
+ public:
+  // `tet_owner`, `node_owner`, `node_first_tet`: per local tet and node, their owners after the
+  // redistribution and the nodes' first tets.
+  RowPacker(const Model& model, const TravellingState& state,
+            const std::vector<std::int32_t>& tet_owner, const std::vector<std::int32_t>& node_owner,
+            const std::vector<GlobalId>& node_first_tet)
+      : model_(model),
+        state_(state),
+        tet_owner_(tet_owner),
+        node_owner_(node_owner),
+        node_first_tet_(node_first_tet),
+        stamp_(model.nodes.size(), -1) {
+    const JointArrays& joints = model.joints;
+    joint_offsets_.assign(static_cast<std::size_t>(model.tets.size()) + 1, 0);
+    for (LocalIndex j = 0; j < joints.size(); ++j) ++joint_offsets_[joints.tets[2 * j] + 1];
+    std::partial_sum(joint_offsets_.begin(), joint_offsets_.end(), joint_offsets_.begin());
+    joint_list_.resize(static_cast<std::size_t>(joints.size()));
+    std::vector<std::int64_t> fill(joint_offsets_.begin(), joint_offsets_.end() - 1);
+    for (LocalIndex j = 0; j < joints.size(); ++j) joint_list_[fill[joints.tets[2 * j]]++] = j;
+  }
+
+  void pack(const std::vector<LocalIndex>& tet_list, std::vector<char>& out) {
+    ++mark_;
+    const NodeArrays& nodes = model_.nodes;
+    const TetArrays& tets = model_.tets;
+    const JointArrays& joints = model_.joints;
+    std::vector<LocalIndex> node_list, joint_list;
+    std::vector<const FrictionEntry*> friction_list;
+    for (LocalIndex t : tet_list) {
+      for (int c = 0; c < 4; ++c) {
+        const LocalIndex n = tets.nodes[4 * static_cast<std::size_t>(t) + c];
+        if (stamp_[n] != mark_) {
+          stamp_[n] = mark_;
+          node_list.push_back(n);
+        }
+      }
+      for (std::int64_t k = joint_offsets_[t]; k < joint_offsets_[t + 1]; ++k)
+        joint_list.push_back(joint_list_[k]);
+      const GlobalId g = tets.gid[t];
+      auto it =
+          std::lower_bound(state_.friction.begin(), state_.friction.end(), g,
+                           [](const FrictionEntry& e, GlobalId value) { return e.a < value; });
+      for (; it != state_.friction.end() && it->a == g; ++it) friction_list.push_back(&*it);
+    }
+    BlockHeader header;
+    header.tets = static_cast<std::int64_t>(tet_list.size());
+    header.nodes = static_cast<std::int64_t>(node_list.size());
+    header.joints = static_cast<std::int64_t>(joint_list.size());
+    header.friction = static_cast<std::int64_t>(friction_list.size());
+    out.reserve(out.size() + sizeof(header) + tet_list.size() * sizeof(TetRow) +
+                node_list.size() * sizeof(NodeRow) + joint_list.size() * sizeof(JointRow) +
+                friction_list.size() * sizeof(FrictionRow));
+    append(out, header);
+    for (LocalIndex t : tet_list) {
+      TetRow row{};
+      row.gid = tets.gid[t];
+      row.owner = tet_owner_[t];
+      for (int c = 0; c < 4; ++c) row.nodes[c] = nodes.gid[tets.nodes[4 * t + c]];
+      std::copy_n(&tets.dm_inv[9 * static_cast<std::size_t>(t)], 9, row.dm_inv);
+      row.volume0 = tets.volume0[t];
+      row.viscosity = tets.viscosity[t];
+      row.material = tets.material[t];
+      row.piece = tets.piece[t];
+      row.contact_group = tets.group_of(t);
+      row.joint_state = state_.tet_joint_state.empty() ? 0 : state_.tet_joint_state[t];
+      append(out, row);
+    }
+    for (LocalIndex n : node_list) {
+      NodeRow row{};
+      row.gid = nodes.gid[n];
+      row.first_tet = node_first_tet_[n];
+      row.owner = node_owner_[n];
+      for (int k = 0; k < 3; ++k) {
+        row.x[k] = nodes.x[3 * n + k];
+        row.x0[k] = nodes.x0[3 * n + k];
+        row.v[k] = nodes.v[3 * n + k];
+        row.prescribed_velocity[k] = nodes.prescribed_velocity[3 * n + k];
+        row.x_at_detection[k] = state_.x_at_detection[3 * n + k];
+      }
+      row.mass = nodes.mass[n];
+      row.piece = nodes.piece[n];
+      row.constrained = nodes.constrained[n];
+      append(out, row);
+    }
+    for (LocalIndex j : joint_list) {
+      JointRow row{};
+      row.gid = joints.gid[j];
+      for (int i = 0; i < 6; ++i) row.nodes[i] = nodes.gid[joints.nodes[6 * j + i]];
+      for (int i = 0; i < 2; ++i) row.tets[i] = tets.gid[joints.tets[2 * j + i]];
+      row.area0 = joints.area0[j];
+      row.failure_time = joints.failure_time[j];
+      row.damage = joints.damage[j];
+      row.law = joints.law[j];
+      row.broken = joints.broken[j];
+      row.mode = joints.mode[j];
+      row.history = state_.joint_history[j];
+      append(out, row);
+    }
+    for (const FrictionEntry* e : friction_list) {
+      FrictionRow row{};
+      row.a = e->a;
+      row.b = e->b;
+      for (int k = 0; k < 3; ++k) row.spring[k] = e->spring[k];
+      row.stiffness = e->stiffness;
+      append(out, row);
+    }
+  }
+
+ private:
+  const Model& model_;
+  const TravellingState& state_;
+  const std::vector<std::int32_t>& tet_owner_;
+  const std::vector<std::int32_t>& node_owner_;
+  const std::vector<GlobalId>& node_first_tet_;
+  std::vector<int> stamp_;
+  int mark_ = 0;
+  std::vector<std::int64_t> joint_offsets_;
+  std::vector<LocalIndex> joint_list_;
+};
+
+// The rows of packed buffers (each emptied once parsed), in the order they come.
+struct ParsedRows {
+  std::vector<TetRow> tets;
+  std::vector<NodeRow> nodes;
+  std::vector<JointRow> joints;
+  std::vector<FrictionRow> friction;
+};
+inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) {
+  ParsedRows parsed;
+  std::vector<TetRow>& tet_rows = parsed.tets;
+  std::vector<NodeRow>& node_rows = parsed.nodes;
+  std::vector<JointRow>& joint_rows = parsed.joints;
+  std::vector<FrictionRow>& friction_rows = parsed.friction;
+  {  // exact sizes first: growing the row arrays would hold up to three copies at once
+    std::int64_t counts[4] = {0, 0, 0, 0};
+    for (std::vector<char>* rows : buffers)
+      for (const char* p = rows->data(); p < rows->data() + rows->size();) {
+        const BlockHeader header = take<BlockHeader>(p);
+        counts[0] += header.tets;
+        counts[1] += header.nodes;
+        counts[2] += header.joints;
+        counts[3] += header.friction;
+        p += header.tets * sizeof(TetRow) + header.nodes * sizeof(NodeRow) +
+             header.joints * sizeof(JointRow) + header.friction * sizeof(FrictionRow);
+      }
+    tet_rows.reserve(static_cast<std::size_t>(counts[0]));
+    node_rows.reserve(static_cast<std::size_t>(counts[1]));
+    joint_rows.reserve(static_cast<std::size_t>(counts[2]));
+    friction_rows.reserve(static_cast<std::size_t>(counts[3]));
+  }
+  for (std::vector<char>* rows : buffers) {
+    for (const char* p = rows->data(); p < rows->data() + rows->size();) {
+      const BlockHeader header = take<BlockHeader>(p);
+      for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
+      for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
+      for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
+      for (std::int64_t i = 0; i < header.friction; ++i)
+        friction_rows.push_back(take<FrictionRow>(p));
+    }
+    *rows = std::vector<char>{};  // parsed: its memory goes back before the arrays are built
+  }
+  return parsed;
+}
+
+}  // namespace fdem::distribution_rows

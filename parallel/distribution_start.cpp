@@ -1,0 +1,196 @@
+// The distributed start of a Distribution: each rank holds its block of the model
+// (parallel/distributed_build), every tet of it owned here; what is missing is the halo.
+#include <algorithm>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "parallel/distribution.hpp"
+#include "parallel/distribution_rows.hpp"
+
+namespace fdem {
+
+using namespace distribution_rows;
+
+namespace {
+
+// Reorders rows [first, first + order.size()) of `values` (`width` values per row): new row
+// first + i is old row order[i].
+template <class T>
+void permute_tail(std::vector<T>& values, std::size_t width, std::size_t first,
+                  const std::vector<std::size_t>& order) {
+  std::vector<T> tail(order.size() * width);
+  for (std::size_t i = 0; i < order.size(); ++i)
+    std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(order[i] * width), width,
+                tail.begin() + static_cast<std::ptrdiff_t>(i * width));
+  std::copy(tail.begin(), tail.end(), values.begin() + static_cast<std::ptrdiff_t>(first * width));
+}
+
+// Grows `values` from `old_rows` to `rows` rows, moving the old rows down by `shift` rows.
+template <class T>
+void open_rows(std::vector<T>& values, std::size_t width, std::size_t old_rows, std::size_t rows,
+               std::size_t shift) {
+  values.resize(rows * width);
+  std::move_backward(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(old_rows * width),
+                     values.begin() + static_cast<std::ptrdiff_t>((old_rows + shift) * width));
+}
+
+}  // namespace
+
+Distribution::Distribution(const Communicator& comm, DistributionSettings settings,
+                           DistributedModel start, double buffer, Model& local,
+                           TravellingState& local_state)
+    : comm_(comm), settings_(settings), buffer_(buffer) {
+  n_tets_ = start.n_tets;
+  // The blocks are the initial partition: every local tet is owned here.
+  tet_owner_.assign(static_cast<std::size_t>(start.model.tets.size()), comm_.rank());
+  node_owner_ = std::move(start.node_owner);
+  node_first_tet_ = std::move(start.node_first_tet);
+  TravellingState state;
+  state.x_at_detection = start.model.nodes.x;
+  if (start.model.joints.size() == 0) {
+    local = std::move(start.model);
+    append_halo(local, state);
+    local_state = std::move(state);
+  } else {
+    local = Model{};
+    local.materials = start.model.materials;
+    local.pieces = start.model.pieces;
+    local.body_names = start.model.body_names;
+    local.body_fixed = start.model.body_fixed;
+    local.gravity = start.model.gravity;
+    local.joint_laws = start.model.joint_laws;
+    migrate(start.model, state, local, local_state);
+  }
+  report_.cycles = 1;
+  update_report(local);
+}
+
+void Distribution::append_halo(Model& model, TravellingState& state) {
+  FDEM_VERIFY(model.joints.size() == 0 && state.friction.empty() && !has_joint_state_,
+              "append_halo: a model without joints or friction history");
+  std::vector<char> send;
+  std::vector<int> send_counts;
+  pack_rows(model, state, destinations(model, false), send, send_counts, nullptr);
+  std::vector<char> receive = exchange_rows(send, send_counts);
+  ParsedRows rows = parse_rows({&receive});
+  FDEM_VERIFY(rows.joints.empty() && rows.friction.empty(), "halo rows without joints");
+  const auto by_gid = [](const auto& a, const auto& b) { return a.gid < b.gid; };
+  const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
+  NodeArrays& nodes = model.nodes;
+  TetArrays& tets = model.tets;
+  const auto find_node = [&](GlobalId gid) {
+    const auto owned_end = nodes.gid.begin() + nodes.n_owned;
+    auto it = std::lower_bound(nodes.gid.begin(), owned_end, gid);
+    if (it == owned_end || *it != gid) it = std::lower_bound(owned_end, nodes.gid.end(), gid);
+    return it != nodes.gid.end() && *it == gid ? static_cast<LocalIndex>(it - nodes.gid.begin())
+                                               : LocalIndex{-1};
+  };
+
+  // Nodes: the ones not held yet are ghosts, appended, then the ghost range sorted by gid.
+  std::sort(rows.nodes.begin(), rows.nodes.end(), by_gid);
+  rows.nodes.erase(std::unique(rows.nodes.begin(), rows.nodes.end(), same_gid), rows.nodes.end());
+  rows.nodes.erase(std::remove_if(rows.nodes.begin(), rows.nodes.end(),
+                                  [&](const NodeRow& r) { return find_node(r.gid) >= 0; }),
+                   rows.nodes.end());
+  const auto n_old = static_cast<std::size_t>(nodes.size());
+  const std::size_t n_all = n_old + rows.nodes.size();
+  const auto n_owned = static_cast<std::size_t>(nodes.n_owned);
+  nodes.resize(static_cast<LocalIndex>(n_all));
+  node_owner_.resize(n_all);
+  node_first_tet_.resize(n_all);
+  state.x_at_detection.resize(3 * n_all);
+  for (std::size_t k = 0; k < rows.nodes.size(); ++k) {
+    const NodeRow& r = rows.nodes[k];
+    const std::size_t n = n_old + k;
+    FDEM_VERIFY(r.owner != comm_.rank(), "a node owned here is held already");
+    nodes.gid[n] = r.gid;
+    node_owner_[n] = r.owner;
+    node_first_tet_[n] = r.first_tet;
+    for (int i = 0; i < 3; ++i) {
+      nodes.x[3 * n + i] = r.x[i];
+      nodes.x0[3 * n + i] = r.x0[i];
+      nodes.v[3 * n + i] = r.v[i];
+      nodes.f[3 * n + i] = 0.0;
+      nodes.prescribed_velocity[3 * n + i] = r.prescribed_velocity[i];
+      state.x_at_detection[3 * n + i] = r.x_at_detection[i];
+    }
+    nodes.mass[n] = r.mass;
+    nodes.piece[n] = r.piece;
+    nodes.constrained[n] = r.constrained;
+  }
+  rows.nodes = std::vector<NodeRow>{};
+  std::vector<std::size_t> order(n_all - n_owned);
+  std::iota(order.begin(), order.end(), n_owned);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return nodes.gid[a] < nodes.gid[b]; });
+  std::vector<LocalIndex> moved_to(n_all - n_owned);  // old ghost index − n_owned → new index
+  for (std::size_t i = 0; i < order.size(); ++i)
+    moved_to[order[i] - n_owned] = static_cast<LocalIndex>(n_owned + i);
+  permute_tail(nodes.gid, 1, n_owned, order);
+  permute_tail(nodes.x, 3, n_owned, order);
+  permute_tail(nodes.x0, 3, n_owned, order);
+  permute_tail(nodes.v, 3, n_owned, order);
+  permute_tail(nodes.f, 3, n_owned, order);
+  permute_tail(nodes.mass, 1, n_owned, order);
+  permute_tail(nodes.piece, 1, n_owned, order);
+  permute_tail(nodes.constrained, 1, n_owned, order);
+  permute_tail(nodes.prescribed_velocity, 3, n_owned, order);
+  permute_tail(node_owner_, 1, n_owned, order);
+  permute_tail(node_first_tet_, 1, n_owned, order);
+  permute_tail(state.x_at_detection, 3, n_owned, order);
+  for (LocalIndex& n : tets.nodes)
+    if (static_cast<std::size_t>(n) >= n_owned) n = moved_to[static_cast<std::size_t>(n) - n_owned];
+
+  // Tets: the block's tets are contiguous in gid; halo tets of lower blocks go before them.
+  std::sort(rows.tets.begin(), rows.tets.end(), by_gid);
+  const auto t_old = static_cast<std::size_t>(tets.size());
+  const std::size_t t_all = t_old + rows.tets.size();
+  const GlobalId block_first = t_old ? tets.gid[0] : 0;
+  const auto lower = static_cast<std::size_t>(
+      std::lower_bound(rows.tets.begin(), rows.tets.end(), block_first,
+                       [](const TetRow& r, GlobalId g) { return r.gid < g; }) -
+      rows.tets.begin());
+  FDEM_VERIFY(tets.contact_group.size() == t_old && tets.owned.size() == t_old &&
+                  tets.active.size() == t_old,
+              "the block's tets carry their groups and roles");
+  open_rows(tets.gid, 1, t_old, t_all, lower);
+  open_rows(tets.nodes, 4, t_old, t_all, lower);
+  open_rows(tets.dm_inv, 9, t_old, t_all, lower);
+  open_rows(tets.volume0, 1, t_old, t_all, lower);
+  open_rows(tets.material, 1, t_old, t_all, lower);
+  open_rows(tets.piece, 1, t_old, t_all, lower);
+  open_rows(tets.viscosity, 1, t_old, t_all, lower);
+  open_rows(tets.contact_group, 1, t_old, t_all, lower);
+  open_rows(tets.owned, 1, t_old, t_all, lower);
+  open_rows(tets.active, 1, t_old, t_all, lower);
+  open_rows(tet_owner_, 1, t_old, t_all, lower);
+  for (std::size_t k = 0; k < rows.tets.size(); ++k) {
+    const TetRow& r = rows.tets[k];
+    const std::size_t t = k < lower ? k : t_old + k;
+    FDEM_VERIFY(
+        r.owner != comm_.rank() && (k < lower || t_old == 0 || r.gid > tets.gid[lower + t_old - 1]),
+        "halo tets lie outside the block");
+    tets.gid[t] = r.gid;
+    tet_owner_[t] = r.owner;
+    bool touches_owned = false;
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = find_node(r.nodes[c]);
+      FDEM_VERIFY(n >= 0, "a tet arrives with its nodes");
+      tets.nodes[4 * t + c] = n;
+      touches_owned = touches_owned || n < nodes.n_owned;
+    }
+    std::copy_n(r.dm_inv, 9, &tets.dm_inv[9 * t]);
+    tets.volume0[t] = r.volume0;
+    tets.viscosity[t] = r.viscosity;
+    tets.material[t] = r.material;
+    tets.piece[t] = r.piece;
+    tets.contact_group[t] = r.contact_group;
+    tets.owned[t] = 0;
+    tets.active[t] = touches_owned;
+  }
+  rows.tets = std::vector<TetRow>{};
+  build_tet_force_order(tets, model.tet_force_order);
+  build_exchange(model);
+}
+
+}  // namespace fdem
