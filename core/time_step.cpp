@@ -11,17 +11,17 @@ CriticalStep critical_time_step(const Model& model) {
   const NodeArrays& nodes = model.nodes;
   const LocalIndex n_tets = tets.size();
 
-  // Pass 1: each tet's stiffness weight (its largest K eigenvalue, N/m) and the weight per node.
-  std::vector<double> weight(n_tets, 0.0), node_weight(nodes.size(), 0.0);
-  std::vector<Mat3> dm_inv(n_tets);
-  std::vector<double> volume(n_tets, 0.0);
-  for (LocalIndex t = 0; t < n_tets; ++t) {
+  // The current shape of tet t (recomputed in pass 2 rather than stored: 80 B per tet).
+  const auto current_shape = [&](LocalIndex t) {
     Vec3 x[4];
     for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * t + c]);
-    const TetReference current = tet_reference(x);
+    return tet_reference(x);
+  };
+  // Pass 1: each tet's stiffness weight (its largest K eigenvalue, N/m) and the weight per node.
+  std::vector<double> weight(n_tets, 0.0), node_weight(nodes.size(), 0.0);
+  for (LocalIndex t = 0; t < n_tets; ++t) {
+    const TetReference current = current_shape(t);
     if (!(current.volume > 0.0)) continue;  // inverted: the force stage reports it
-    dm_inv[t] = current.dm_inv;
-    volume[t] = current.volume;
     weight[t] = tet_max_stiffness_eigenvalue(current.dm_inv, current.volume,
                                              model.materials[tets.material[t]].lame);
     for (int c = 0; c < 4; ++c) node_weight[tets.nodes[4 * t + c]] += weight[t];
@@ -39,7 +39,9 @@ CriticalStep critical_time_step(const Model& model) {
       corner_mass[c] = nodes.mass[n] * weight[t] / node_weight[n];
     }
     const MaterialProperties& mat = model.materials[tets.material[t]];
-    const double omega = std::sqrt(tet_max_eigenvalue(dm_inv[t], volume[t], mat.lame, corner_mass));
+    const TetReference current = current_shape(t);
+    const double omega =
+        std::sqrt(tet_max_eigenvalue(current.dm_inv, current.volume, mat.lame, corner_mass));
     const double dt = critical_step_for_frequency(omega, mat.damping_ratio);
     if (dt < out.dt) {
       out.dt = dt;
