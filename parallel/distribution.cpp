@@ -143,14 +143,18 @@ class RowPacker {
  public:
   // `tet_owner`, `node_owner`, `node_first_tet`: per local tet and node, their owners after the
   // redistribution and the nodes' first tets.
+  // `start_joints` (distributed start, model.joints empty): the joints whose tet A is local, by
+  // gid, with global references.
   RowPacker(const Model& model, const TravellingState& state,
             const std::vector<std::int32_t>& tet_owner, const std::vector<std::int32_t>& node_owner,
-            const std::vector<GlobalId>& node_first_tet)
+            const std::vector<GlobalId>& node_first_tet,
+            const std::vector<StartJoint>* start_joints = nullptr)
       : model_(model),
         state_(state),
         tet_owner_(tet_owner),
         node_owner_(node_owner),
         node_first_tet_(node_first_tet),
+        start_joints_(start_joints),
         stamp_(model.nodes.size(), -1) {
     const JointArrays& joints = model.joints;
     joint_offsets_.assign(static_cast<std::size_t>(model.tets.size()) + 1, 0);
@@ -167,8 +171,16 @@ class RowPacker {
     const TetArrays& tets = model_.tets;
     const JointArrays& joints = model_.joints;
     std::vector<LocalIndex> node_list, joint_list;
+    std::vector<const StartJoint*> start_list;
     std::vector<const FrictionEntry*> friction_list;
     for (LocalIndex t : tet_list) {
+      if (start_joints_) {
+        auto it =
+            std::lower_bound(start_joints_->begin(), start_joints_->end(), tets.gid[t],
+                             [](const StartJoint& j, GlobalId value) { return j.tets[0] < value; });
+        for (; it != start_joints_->end() && it->tets[0] == tets.gid[t]; ++it)
+          start_list.push_back(&*it);
+      }
       for (int c = 0; c < 4; ++c) {
         const LocalIndex n = tets.nodes[4 * static_cast<std::size_t>(t) + c];
         if (stamp_[n] != mark_) {
@@ -187,10 +199,11 @@ class RowPacker {
     BlockHeader header;
     header.tets = static_cast<std::int64_t>(tet_list.size());
     header.nodes = static_cast<std::int64_t>(node_list.size());
-    header.joints = static_cast<std::int64_t>(joint_list.size());
+    header.joints = static_cast<std::int64_t>(joint_list.size() + start_list.size());
     header.friction = static_cast<std::int64_t>(friction_list.size());
     out.reserve(out.size() + sizeof(header) + tet_list.size() * sizeof(TetRow) +
-                node_list.size() * sizeof(NodeRow) + joint_list.size() * sizeof(JointRow) +
+                node_list.size() * sizeof(NodeRow) +
+                (joint_list.size() + start_list.size()) * sizeof(JointRow) +
                 friction_list.size() * sizeof(FrictionRow));
     append(out, header);
     for (LocalIndex t : tet_list) {
@@ -238,6 +251,20 @@ class RowPacker {
       row.history = state_.joint_history[j];
       append(out, row);
     }
+    for (const StartJoint* j : start_list) {  // intact, as JointArrays::resize leaves a joint
+      JointRow row{};
+      row.gid = j->gid;
+      std::copy_n(j->nodes, 6, row.nodes);
+      std::copy_n(j->tets, 2, row.tets);
+      row.area0 = j->area0;
+      row.failure_time = -1.0;
+      row.damage = 0.0;
+      row.law = j->law;
+      row.broken = 0;
+      row.mode = 0;
+      row.history = JointHistory{};
+      append(out, row);
+    }
     for (const FrictionEntry* e : friction_list) {
       FrictionRow row{};
       row.a = e->a;
@@ -254,6 +281,7 @@ class RowPacker {
   const std::vector<std::int32_t>& tet_owner_;
   const std::vector<std::int32_t>& node_owner_;
   const std::vector<GlobalId>& node_first_tet_;
+  const std::vector<StartJoint>* start_joints_;
   std::vector<int> stamp_;
   int mark_ = 0;
   std::vector<std::int64_t> joint_offsets_;
@@ -414,6 +442,10 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   node_first_tet_ = std::move(start.node_first_tet);
   TravellingState state;
   state.x_at_detection = start.model.nodes.x;
+  // With joints, tets carry their joint state (bonded anywhere, not only by the joints that end
+  // up held with them).
+  has_joint_state_ = !start.tet_joint_state.empty();
+  state.tet_joint_state = std::move(start.tet_joint_state);
   local = Model{};
   local.materials = start.model.materials;
   local.pieces = start.model.pieces;
@@ -421,7 +453,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   local.body_fixed = start.model.body_fixed;
   local.gravity = start.model.gravity;
   local.joint_laws = start.model.joint_laws;
-  migrate(start.model, state, local, local_state);
+  migrate(start.model, state, local, local_state, &start.joints, &start.tet_reach);
   report_.cycles = 1;
   update_report(local);
 }
@@ -429,14 +461,15 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
 // Sends every owned tet (with its rows) to its owner and to the ranks near it, and assembles what
 // arrives into `out` (which may be `model` itself).
 void Distribution::migrate(Model& model, TravellingState& state, Model& out,
-                           TravellingState& out_state) {
+                           TravellingState& out_state, const std::vector<StartJoint>* start_joints,
+                           const std::vector<double>* start_reach) {
   const int ranks = comm_.size(), me = comm_.rank();
-  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
+  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false, start_reach);
   // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
   std::vector<char> send, own;
   std::vector<int> send_counts(ranks, 0), send_offsets(ranks, 0);
   {
-    RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_);
+    RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_, start_joints);
     for (int p = 0; p < ranks; ++p) {
       send_offsets[p] = static_cast<int>(send.size() / 8);
       if (lists[p].empty()) continue;
@@ -622,8 +655,8 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
             });
 }
 
-std::vector<std::vector<LocalIndex>> Distribution::destinations(const Model& model,
-                                                                bool whole) const {
+std::vector<std::vector<LocalIndex>> Distribution::destinations(
+    const Model& model, bool whole, const std::vector<double>* start_reach) const {
   // Senders: the tets this rank owns, or (at the start, every rank holding the whole model) all.
   const TetArrays& tets = model.tets;
   const int ranks = comm_.size();
@@ -645,7 +678,9 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(const Model& mod
     comm_.sum_in_place(sums);
     joint_gap = comm_.max(joint_gap);
   }
-  const std::vector<double> reach = tet_reach(model, tet_boxes);
+  std::vector<double> reach = tet_reach(model, tet_boxes);
+  if (start_reach)  // the distributed start: neighbours in other blocks count too
+    for (std::size_t t = 0; t < reach.size(); ++t) reach[t] = std::max(reach[t], (*start_reach)[t]);
   const double grow = 2.5 * buffer_ + joint_gap;
   OwnerGrid grid(origin.data(), 2.0 * sums[0] / std::max(sums[1], 1.0) + grow);
   // Every sending tet must fit the grid; a tet that does not has flown off (or blown up) — every
