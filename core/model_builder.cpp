@@ -97,23 +97,11 @@ struct TouchingFaces {
   LocalIndex a[3], b[3];
 };
 
-// The cell of a hash grid of spacing `tol` (m) that holds x.  A coordinate so far from the origin
-// that x / tol leaves the 64-bit range cannot be matched to a neighbour's: an input error.
-std::array<std::int64_t, 3> tolerance_cell(const Vec3& x, double tol) {
-  std::array<std::int64_t, 3> cell{};
-  for (int k = 0; k < 3; ++k) {
-    const auto c = floor_to_integer<std::int64_t>(x[k] / tol);
-    if (!c)
-      throw InputError("a mesh node at (" + std::to_string(x[0]) + ", " + std::to_string(x[1]) +
-                       ", " + std::to_string(x[2]) + ") m is too far from the origin to match " +
-                       "touching faces within " + std::to_string(tol) + " m");
-    cell[k] = *c;
-  }
-  return cell;
-}
-
 // Boundary triangles of a body mesh that coincide (node positions within tol) with a boundary
 // triangle of another piece of the same mesh, each touching pair once (`joints: interfaces`).
+// A boundary face of piece P is matched with each piece Q > P that has a boundary node at the
+// position of its first node: its i-th node's partner is the lowest-numbered boundary node of Q
+// within tol of it (in a conforming mesh the only one).
 std::vector<TouchingFaces> touching_piece_faces(const BodyMesh& mesh,
                                                 const std::vector<MeshFace>& faces, double tol) {
   const LocalIndex n_nodes = static_cast<LocalIndex>(mesh.coords.size() / 3);
@@ -135,8 +123,10 @@ std::vector<TouchingFaces> touching_piece_faces(const BodyMesh& mesh,
         grid[cell_of(vec3_at(mesh.coords.data(), m))].push_back(m);
       }
   }
-  // Boundary nodes of piece `piece` at the position of mesh node m.
-  const auto coincident = [&](LocalIndex m, std::vector<LocalIndex>& out) {
+  // (piece, node) of the boundary nodes of other pieces at the position of mesh node m: for each
+  // piece its lowest-numbered node there, pieces ascending.
+  using Partner = std::pair<std::int32_t, LocalIndex>;
+  const auto coincident = [&](LocalIndex m, std::vector<Partner>& out) {
     out.clear();
     const Vec3 x = vec3_at(mesh.coords.data(), m);
     const auto c = cell_of(x);
@@ -148,24 +138,30 @@ std::vector<TouchingFaces> touching_piece_faces(const BodyMesh& mesh,
           for (LocalIndex n : g->second)
             if (node_piece[n] != node_piece[m] &&
                 (vec3_at(mesh.coords.data(), n) - x).norm() <= tol)
-              out.push_back(n);
+              out.emplace_back(node_piece[n], n);
         }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end(),
+                          [](const Partner& p, const Partner& q) { return p.first == q.first; }),
+              out.end());
+  };
+  const auto in_piece = [](const std::vector<Partner>& list, std::int32_t piece) {
+    const auto it = std::lower_bound(list.begin(), list.end(), Partner{piece, 0});
+    return it != list.end() && it->first == piece ? it->second : LocalIndex{-1};
   };
   std::vector<TouchingFaces> out;
-  std::vector<LocalIndex> first, second, third;
+  std::vector<Partner> first, second, third;
   for (const MeshFace* f : boundary) {
     const std::int32_t piece = tet_piece[f->tet];
     coincident(f->key[0], first);
-    for (LocalIndex c0 : first) {
-      const std::int32_t other = node_piece[c0];
+    if (first.empty()) continue;
+    coincident(f->key[1], second);
+    coincident(f->key[2], third);
+    for (const auto& [other, c0] : first) {
       if (other < piece) continue;  // the pair is found from the lower piece
       TouchingFaces t{f->tet, -1, {f->key[0], f->key[1], f->key[2]}, {c0, -1, -1}};
-      coincident(f->key[1], second);
-      coincident(f->key[2], third);
-      for (LocalIndex c : second)
-        if (node_piece[c] == other) t.b[1] = c;
-      for (LocalIndex c : third)
-        if (node_piece[c] == other) t.b[2] = c;
+      t.b[1] = in_piece(second, other);
+      t.b[2] = in_piece(third, other);
       if (t.b[1] < 0 || t.b[2] < 0) continue;
       std::array<LocalIndex, 3> key = {t.b[0], t.b[1], t.b[2]};
       std::sort(key.begin(), key.end());
@@ -224,22 +220,21 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
       std::swap(d.tet_a, d.tet_b);
       for (int i = 0; i < 3; ++i) std::swap(d.a[i], d.b[i]);
     }
-    // Orientation: (a1 − a0) × (a2 − a0) points out of A, away from A's fourth corner.
     LocalIndex opposite = -1;
     for (int c = 0; c < 4; ++c) {
       const LocalIndex n = tets.nodes[4 * d.tet_a + c];
       if (n != d.a[0] && n != d.a[1] && n != d.a[2]) opposite = n;
     }
-    const Vec3 x0 = vec3_at(nodes.x0.data(), d.a[0]);
-    const Vec3 normal =
-        (vec3_at(nodes.x0.data(), d.a[1]) - x0).cross(vec3_at(nodes.x0.data(), d.a[2]) - x0);
-    if (normal.dot(vec3_at(nodes.x0.data(), opposite) - x0) > 0.0) {
+    const double* x0 = nodes.x0.data();
+    if (joint_face_turned(vec3_at(x0, d.a[0]), vec3_at(x0, d.a[1]), vec3_at(x0, d.a[2]),
+                          vec3_at(x0, opposite))) {
       std::swap(d.a[1], d.a[2]);
       std::swap(d.b[1], d.b[2]);
     }
     drafts.push_back(d);
   };
 
+  const double tol = matching_tolerance(extent);
   std::vector<std::vector<MeshFace>> faces(meshes.size());
   for (std::size_t b = 0; b < meshes.size(); ++b) {
     const bool jointed = scene.bodies[b].joints == JointPlacement::all;
@@ -252,25 +247,15 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     faces[b] = sorted_faces(meshes[b]);
     const auto& f = faces[b];
     for (std::size_t i = 0; i + 2 < f.size(); ++i)
-      if (f[i].key == f[i + 2].key) {
-        std::ostringstream msg;
-        msg << "body '" << scene.bodies[b].name << "' (" << meshes[b].source
-            << "): a triangle is shared by more than two tetrahedra (mesh nodes " << f[i].key[0] + 1
-            << ", " << f[i].key[1] + 1 << ", " << f[i].key[2] + 1
-            << "); joints need a conforming, manifold tetrahedral mesh";
-        throw InputError(msg.str());
-      }
+      if (f[i].key == f[i + 2].key)
+        throw InputError(non_manifold_message(scene.bodies[b].name, meshes[b].source,
+                                              {f[i].key[0], f[i].key[1], f[i].key[2]}));
     if (bonded_pieces) {  // mortar: joints where the body's pieces touch at t = 0
       const std::size_t before = drafts.size();
-      for (const TouchingFaces& t :
-           touching_piece_faces(meshes[b], f, 1e-9 * std::max(extent.norm(), 1e-300)))
+      for (const TouchingFaces& t : touching_piece_faces(meshes[b], f, tol))
         add(b, t.tet_a, t.a, b, t.tet_b, t.b, scene.bodies[b].material);
       if (drafts.size() == before)
-        throw InputError(scene.source_path + ": body '" + scene.bodies[b].name + "' (" +
-                         meshes[b].source +
-                         ") has joints: interfaces, but no two of its pieces share a triangle at "
-                         "t = 0. Touching pieces need identical triangles (a generated wall with "
-                         "mortar_gap 0, conforming cells) to be bonded.");
+        throw InputError(no_touching_pieces_message(scene, b, meshes[b].source));
     }
     if (!jointed) continue;
     for (std::size_t i = 0; i + 1 < f.size(); ++i)
@@ -281,8 +266,7 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
       }
   }
 
-  // Interfaces: match boundary nodes by position (tolerance 1e-9 of the model size), then faces.
-  const double tol = 1e-9 * std::max(extent.norm(), 1e-300);
+  // Interfaces: match boundary nodes by position (within tol), then faces.
   for (std::size_t k = 0; k < scene.interfaces.size(); ++k) {
     const InterfaceSpec& spec = scene.interfaces[k];
     const std::size_t ba = spec.body_a, bb = spec.body_b;
@@ -307,20 +291,21 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
         auto& cell = grid[cell_of(vec3_at(xb, m))];
         if (std::find(cell.begin(), cell.end(), m) == cell.end()) cell.push_back(m);
       }
-    std::map<LocalIndex, LocalIndex> match;  // A's mesh node → B's coincident mesh node (or −1)
+    // A's mesh node → the lowest-numbered boundary node of B within tol of it (or −1).
+    std::map<LocalIndex, LocalIndex> match;
     const auto partner = [&](LocalIndex m) {
       const auto it = match.find(m);
       if (it != match.end()) return it->second;
       const Vec3 x = vec3_at(xa, m);
       const auto c = cell_of(x);
       LocalIndex found = -1;
-      for (int dx = -1; dx <= 1 && found < 0; ++dx)
-        for (int dy = -1; dy <= 1 && found < 0; ++dy)
-          for (int dz = -1; dz <= 1 && found < 0; ++dz) {
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
             const auto g = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
             if (g == grid.end()) continue;
             for (LocalIndex n : g->second)
-              if ((vec3_at(xb, n) - x).norm() <= tol) found = n;
+              if ((vec3_at(xb, n) - x).norm() <= tol && (found < 0 || n < found)) found = n;
           }
       return match[m] = found;
     };
@@ -339,61 +324,24 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
       const LocalIndex ma[3] = {fa.key[0], fa.key[1], fa.key[2]};
       add(ba, fa.tet, ma, bb, it->second->tet, mb, n_materials + static_cast<std::int32_t>(k));
     }
-    if (drafts.size() == before) {
-      std::ostringstream msg;
-      msg << scene.source_path << ": interfaces[" << k << "] between '" << scene.bodies[ba].name
-          << "' and '" << scene.bodies[bb].name
-          << "': no boundary triangle of one body coincides with a boundary triangle of the other "
-             "at t = 0 (node tolerance "
-          << tol
-          << " m). Interface joints need conforming meshes: the two bodies must touch with "
-             "identical triangles (same three node positions), as box meshes sharing a face or "
-             "a Gmsh mesh with shared surfaces give.";
-      throw InputError(msg.str());
-    }
+    if (drafts.size() == before) throw InputError(no_interface_match_message(scene, k, tol));
   }
 
-  // Laws: one per (group, element-size bin).  h = mean of the two tets' altitudes onto the joint
-  // face, the thickness of the elements the joint layer sits between.
-  const auto material_of = [&](std::size_t b) { return scene.bodies[b].material; };
-  std::map<std::pair<std::int32_t, long>, std::int32_t> law_index;
-  std::vector<std::int32_t> joint_law(drafts.size());
+  // Laws: one per (group, element-size bin), numbered in ascending (group, bin).
+  std::vector<std::pair<std::int32_t, long>> law_key(drafts.size());
   std::vector<double> joint_area(drafts.size());
+  std::map<std::pair<std::int32_t, long>, std::int32_t> law_index;
   for (std::size_t j = 0; j < drafts.size(); ++j) {
     const JointDraft& d = drafts[j];
-    const Vec3 a0 = vec3_at(nodes.x0.data(), d.a[0]);
-    const double area =
-        0.5 *
-        (vec3_at(nodes.x0.data(), d.a[1]) - a0).cross(vec3_at(nodes.x0.data(), d.a[2]) - a0).norm();
-    joint_area[j] = area;
-    const double h =
-        0.5 * (3.0 * tets.volume0[d.tet_a] / area + 3.0 * tets.volume0[d.tet_b] / area);
-    const long bin = std::lround(std::log(h) / std::log(element_size_bin_ratio));
-    const auto key = std::make_pair(d.group, bin);
-    auto it = law_index.find(key);
-    if (it == law_index.end()) {
-      JointLawSpec law;
-      double young;
-      if (d.group < n_materials) {
-        const MaterialSpec& m = scene.materials[d.group];
-        FDEM_VERIFY(m.fracture.has_value(), "joints: all needs a fracture block (reader checks)");
-        law.fracture = *m.fracture;
-        law.origin = "material '" + m.name + "'";
-        young = m.elastic.young;
-      } else {
-        const InterfaceSpec& spec = scene.interfaces[d.group - n_materials];
-        law.fracture = spec.fracture;
-        law.origin = "interface '" + scene.bodies[spec.body_a].name + "'-'" +
-                     scene.bodies[spec.body_b].name + "'";
-        young = std::min(scene.materials[material_of(spec.body_a)].elastic.young,
-                         scene.materials[material_of(spec.body_b)].elastic.young);
-      }
-      law.normal_penalty = law.tangential_penalty = joint_penalty_factor * young;
-      law.element_size = std::pow(element_size_bin_ratio, static_cast<double>(bin));
-      it = law_index.emplace(key, static_cast<std::int32_t>(model.joint_laws.size())).first;
-      model.joint_laws.push_back(law);
-    }
-    joint_law[j] = it->second;
+    const double* x0 = nodes.x0.data();
+    joint_area[j] = joint_face_area(vec3_at(x0, d.a[0]), vec3_at(x0, d.a[1]), vec3_at(x0, d.a[2]));
+    law_key[j] = {d.group,
+                  joint_size_bin(tets.volume0[d.tet_a], tets.volume0[d.tet_b], joint_area[j])};
+    law_index.emplace(law_key[j], 0);
+  }
+  for (auto& [key, index] : law_index) {
+    index = static_cast<std::int32_t>(model.joint_laws.size());
+    model.joint_laws.push_back(joint_law(scene, key.first, key.second));
   }
 
   // Canonical order: ascending (gid A, gid B).
@@ -415,11 +363,97 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     joints.tets[2 * j] = d.tet_a;
     joints.tets[2 * j + 1] = d.tet_b;
     joints.area0[j] = joint_area[order[j]];
-    joints.law[j] = joint_law[order[j]];
+    joints.law[j] = law_index.at(law_key[order[j]]);
   }
 }
 
 }  // namespace
+
+double matching_tolerance(const Vec3& extent) {
+  return 1e-9 * std::max(extent.norm(), 1e-300);
+}
+
+std::array<std::int64_t, 3> tolerance_cell(const Vec3& x, double tol) {
+  std::array<std::int64_t, 3> cell{};
+  for (int k = 0; k < 3; ++k) {
+    const auto c = floor_to_integer<std::int64_t>(x[k] / tol);
+    if (!c)
+      throw InputError("a mesh node at (" + std::to_string(x[0]) + ", " + std::to_string(x[1]) +
+                       ", " + std::to_string(x[2]) + ") m is too far from the origin to match " +
+                       "touching faces within " + std::to_string(tol) + " m");
+    cell[k] = *c;
+  }
+  return cell;
+}
+
+bool joint_face_turned(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& opposite) {
+  const Vec3 normal = (a1 - a0).cross(a2 - a0);
+  return normal.dot(opposite - a0) > 0.0;
+}
+
+double joint_face_area(const Vec3& a0, const Vec3& a1, const Vec3& a2) {
+  return 0.5 * (a1 - a0).cross(a2 - a0).norm();
+}
+
+long joint_size_bin(double volume_a, double volume_b, double area) {
+  const double h = 0.5 * (3.0 * volume_a / area + 3.0 * volume_b / area);
+  return std::lround(std::log(h) / std::log(element_size_bin_ratio));
+}
+
+JointLawSpec joint_law(const Scene& scene, std::int32_t group, long bin) {
+  const std::int32_t n_materials = static_cast<std::int32_t>(scene.materials.size());
+  JointLawSpec law;
+  double young;
+  if (group < n_materials) {
+    const MaterialSpec& m = scene.materials[group];
+    FDEM_VERIFY(m.fracture.has_value(), "joints: all needs a fracture block (reader checks)");
+    law.fracture = *m.fracture;
+    law.origin = "material '" + m.name + "'";
+    young = m.elastic.young;
+  } else {
+    const InterfaceSpec& spec = scene.interfaces[group - n_materials];
+    law.fracture = spec.fracture;
+    law.origin = "interface '" + scene.bodies[spec.body_a].name + "'-'" +
+                 scene.bodies[spec.body_b].name + "'";
+    young = std::min(scene.materials[scene.bodies[spec.body_a].material].elastic.young,
+                     scene.materials[scene.bodies[spec.body_b].material].elastic.young);
+  }
+  law.normal_penalty = law.tangential_penalty = joint_penalty_factor * young;
+  law.element_size = std::pow(element_size_bin_ratio, static_cast<double>(bin));
+  return law;
+}
+
+std::string non_manifold_message(const std::string& body, const std::string& source,
+                                 const std::array<std::int64_t, 3>& mesh_nodes) {
+  std::ostringstream msg;
+  msg << "body '" << body << "' (" << source
+      << "): a triangle is shared by more than two tetrahedra (mesh nodes " << mesh_nodes[0] + 1
+      << ", " << mesh_nodes[1] + 1 << ", " << mesh_nodes[2] + 1
+      << "); joints need a conforming, manifold tetrahedral mesh";
+  return msg.str();
+}
+
+std::string no_touching_pieces_message(const Scene& scene, std::size_t body,
+                                       const std::string& source) {
+  return scene.source_path + ": body '" + scene.bodies[body].name + "' (" + source +
+         ") has joints: interfaces, but no two of its pieces share a triangle at t = 0. Touching "
+         "pieces need identical triangles (a generated wall with mortar_gap 0, conforming cells) "
+         "to be bonded.";
+}
+
+std::string no_interface_match_message(const Scene& scene, std::size_t k, double tol) {
+  const InterfaceSpec& spec = scene.interfaces[k];
+  std::ostringstream msg;
+  msg << scene.source_path << ": interfaces[" << k << "] between '"
+      << scene.bodies[spec.body_a].name << "' and '" << scene.bodies[spec.body_b].name
+      << "': no boundary triangle of one body coincides with a boundary triangle of the other "
+         "at t = 0 (node tolerance "
+      << tol
+      << " m). Interface joints need conforming meshes: the two bodies must touch with "
+         "identical triangles (same three node positions), as box meshes sharing a face or "
+         "a Gmsh mesh with shared surfaces give.";
+  return msg.str();
+}
 
 std::vector<std::int32_t> connected_pieces(const std::vector<LocalIndex>& tets, LocalIndex n_nodes,
                                            std::int32_t* n_pieces) {

@@ -223,9 +223,15 @@ BodyMesh join_units(const std::vector<MeshUnit>& units, std::string source) {
   return mesh;
 }
 
+std::string wall_source(const WallMeshSpec& wall) {
+  const bool running = wall.bond == WallMeshSpec::Bond::running;
+  return std::string(running ? "running" : "stack") + " bond wall generator";
+}
+
 // Units as chunks: unit u is piece u, its nodes and tets follow those of the units before it.
-BodyChunks unit_chunks(std::vector<MeshUnit> units) {
+BodyChunks unit_chunks(std::vector<MeshUnit> units, std::string source) {
   BodyChunks chunks;
+  chunks.source = std::move(source);
   auto node_offset = std::make_shared<std::vector<std::int64_t>>();
   auto tet_offset = std::make_shared<std::vector<std::int64_t>>();
   std::int64_t tets = 0;
@@ -309,9 +315,7 @@ MeshChunk box_block(const BoxMeshSpec& box, int block_cells, std::int64_t block)
 }  // namespace
 
 BodyMesh wall_mesh(const WallMeshSpec& wall) {
-  const bool running = wall.bond == WallMeshSpec::Bond::running;
-  return join_units(wall_units(wall),
-                    std::string(running ? "running" : "stack") + " bond wall generator");
+  return join_units(wall_units(wall), wall_source(wall));
 }
 
 BodyMesh tower_mesh(const TowerMeshSpec& tower) {
@@ -331,6 +335,7 @@ BodyChunks body_chunks(const MeshSpec& mesh, int ranks) {
       const double cells_per_chunk = double(nx) * ny * nz / (64.0 * std::max(ranks, 1));
       const int block_cells = std::clamp(static_cast<int>(std::cbrt(cells_per_chunk)), 2, 8);
       BodyChunks chunks;
+      chunks.source = "box generator";
       chunks.lo = box.min;
       chunks.hi = box.max;
       chunks.n_nodes = std::int64_t{nx + 1} * (ny + 1) * (nz + 1);
@@ -351,11 +356,11 @@ BodyChunks body_chunks(const MeshSpec& mesh, int ranks) {
       return chunks;
     }
     case MeshSpec::Kind::wall:
-      return unit_chunks(wall_units(mesh.wall));
+      return unit_chunks(wall_units(mesh.wall), wall_source(mesh.wall));
     case MeshSpec::Kind::tower:
-      return unit_chunks(tower_units(mesh.tower));
+      return unit_chunks(tower_units(mesh.tower), "tower generator");
     case MeshSpec::Kind::arch:
-      return unit_chunks(arch_units(mesh.arch));
+      return unit_chunks(arch_units(mesh.arch), "arch generator");
     case MeshSpec::Kind::file:
       break;
   }

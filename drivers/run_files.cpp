@@ -216,7 +216,8 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
     << ", \"shear\": " << r.broken_by_mode[1] << ", \"mixed\": " << r.broken_by_mode[2] << "},\n";
   if (r.fragments >= 0) j << "  \"fragments\": " << r.fragments << ",\n";
   if (r.parallel)
-    j << "  \"decomposition\": {\"imbalance\": " << JsonNumber{r.imbalance}
+    j << "  \"decomposition\": {\"start\": \"" << r.start
+      << "\", \"imbalance\": " << JsonNumber{r.imbalance}
       << ", \"max_imbalance\": " << JsonNumber{r.max_imbalance}
       << ", \"redistributions\": " << r.redistributions << ", \"rebalances\": " << r.rebalances
       << ", \"migrated_elements\": " << r.migrated_elements

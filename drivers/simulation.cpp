@@ -104,10 +104,11 @@ std::vector<std::string> StagePlan::describe() const {
 }
 
 Simulation::Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm)
-    : Simulation(std::move(scene), std::move(model), std::move(options), comm, nullptr, -1.0) {}
+    : Simulation(std::move(scene), std::move(model), std::move(options), comm, nullptr, -1.0, {}) {}
 
 Simulation::Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm,
-                       std::unique_ptr<Distribution> distribution, double contact_buffer)
+                       std::unique_ptr<Distribution> distribution, double contact_buffer,
+                       std::vector<std::uint8_t> tet_joint_state)
     : scene_(std::move(scene)),
       model_(std::move(model)),
       options_(std::move(options)),
@@ -143,11 +144,14 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
     dt_critical_ =
         1.0 / std::sqrt(1.0 / (dt_critical_ * dt_critical_) + 1.0 / (dt_contact * dt_contact));
   }
-  plan_.joints = JointStage::needed(model_);
-  FDEM_VERIFY(!(distributed && plan_.joints), "the distributed start takes scenes without joints");
+  // On N ranks from the distributed start a rank may hold no joint while others do: every rank
+  // runs the joint stages when the model has joints.
+  plan_.joints =
+      distributed ? comm_->max(std::int64_t{model_.joints.size()}) > 0 : JointStage::needed(model_);
   if (plan_.joints) {
     joints_ = std::make_unique<JointStage>(model_);
-    const double dt_joint = joints_->critical_time_step(model_);  // joint springs add ω² too
+    // Joint springs add ω² too.  Each owned node's joints are all held with it, in gid order.
+    const double dt_joint = global_min(joints_->critical_time_step(model_));
     dt_critical_ =
         1.0 / std::sqrt(1.0 / (dt_critical_ * dt_critical_) + 1.0 / (dt_joint * dt_joint));
     if (contact_) {  // tets bonded by an intact joint never pair in contact
@@ -166,13 +170,24 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   for (LocalIndex t = 0; t < model_.tets.size(); ++t) owned_tets += model_.tets.is_owned(t);
   whole_nodes_ = global_sum(std::int64_t{model_.nodes.n_owned});
   whole_tets_ = global_sum(owned_tets);
-  whole_joints_ = model_.joints.size();
+  std::int64_t owned_joints = 0;  // by their tet A
+  for (LocalIndex j = 0; j < model_.joints.size(); ++j)
+    owned_joints += model_.tets.is_owned(model_.joints.tets[2 * j]);
+  whole_joints_ = global_sum(owned_joints);
   reference_hash_ =
       distributed ? global_reference_hash(model_.nodes, *comm_) : reference_hash(model_.nodes);
   next_checkpoint_time_ = scene_.output.checkpoint_every;
   if (distributed) {  // the stages were made on the local model: bind them to its halo
+    distributed_start_ = true;
     distribution_ = std::move(distribution);
     TravellingState state = travelling_state();
+    // A tet bonded by a joint that is not held here (its partner lies outside the halo) is
+    // still bonded: its joint state came from the owners.
+    if (contact_ && joints_) {
+      FDEM_VERIFY(tet_joint_state.size() == static_cast<std::size_t>(model_.tets.size()),
+                  "a joint state per local tet");
+      state.tet_joint_state = std::move(tet_joint_state);
+    }
     rebind_stages(state, false);
   }
   // A restart overwrites the state of the model (and of the stages) with the checkpoint's.
@@ -669,6 +684,7 @@ RunReport Simulation::report() const {
     r.fragments = global_fragment_count(model_, *comm_);
     const DistributionReport& d = distribution_->report();
     r.parallel = true;
+    r.start = distributed_start_ ? "distributed" : "whole_model";
     r.imbalance = d.imbalance;
     r.max_imbalance = d.max_imbalance;
     r.redistributions = d.cycles;
@@ -883,20 +899,20 @@ RunReport Simulation::run() {
         result.balance_error);
     if (result.parallel)
       std::fprintf(stderr,
-                   "%d ranks: imbalance %.3f (max %.3f), %ld redistributions, %ld re-partitions, "
-                   "%ld elements migrated, halo up to %ld elements / %ld ghost nodes, "
-                   "communication %.3f s\n",
-                   result.ranks, result.imbalance, result.max_imbalance, result.redistributions,
-                   result.rebalances, result.migrated_elements, result.halo_elements_max,
-                   result.ghost_nodes_max, result.communication_seconds);
+                   "%d ranks (%s start): imbalance %.3f (max %.3f), %ld redistributions, %ld "
+                   "re-partitions, %ld elements migrated, halo up to %ld elements / %ld ghost "
+                   "nodes, communication %.3f s\n",
+                   result.ranks, result.start.c_str(), result.imbalance, result.max_imbalance,
+                   result.redistributions, result.rebalances, result.migrated_elements,
+                   result.halo_elements_max, result.ghost_nodes_max, result.communication_seconds);
   }
   return result;
 }
 
 bool distributed_start_possible(const Scene& scene) {
-  if (!scene.parallel.distributed_start || !scene.interfaces.empty()) return false;
+  if (!scene.parallel.distributed_start) return false;
   for (const BodySpec& body : scene.bodies)
-    if (body.mesh.kind == MeshSpec::Kind::file || body.joints != JointPlacement::none) return false;
+    if (body.mesh.kind == MeshSpec::Kind::file) return false;
   return true;
 }
 
@@ -944,7 +960,8 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
     auto distribution = std::make_unique<Distribution>(*comm, settings, std::move(start), buffer,
                                                        local, local_state);
     return std::make_unique<Simulation>(scene, std::move(local), std::move(options), comm,
-                                        std::move(distribution), buffer);
+                                        std::move(distribution), buffer,
+                                        std::move(local_state.tet_joint_state));
   }
   // Every rank builds the same whole model; a bad scene or mesh stops every rank with the message.
   // What the constructor checks before distributing is decided from that same model, so every

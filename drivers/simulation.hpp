@@ -67,6 +67,7 @@ struct RunReport {
   long fragments = -1;                 // discrete elements now (−1: not counted)
   // Decomposition (N ranks): imbalance = max/mean owned cost, halo and migration sizes.
   bool parallel = false;
+  std::string start;  // "distributed" (no rank held the whole model) or "whole_model"
   double imbalance = 1.0, max_imbalance = 1.0;
   long redistributions = 0, rebalances = 0, migrated_elements = 0;
   long halo_elements_max = 0, ghost_nodes_max = 0, ghost_nodes_mean = 0, neighbours_max = 0;
@@ -84,9 +85,11 @@ class Simulation {
   // passes the same whole model; each keeps its part and halo (parallel/distribution.hpp).
   Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm = nullptr);
   // Distributed start (make_simulation): `model` is this rank's part with its halo, made by
-  // `distribution` for the contact buffer `contact_buffer` (m).
+  // `distribution` for the contact buffer `contact_buffer` (m); `tet_joint_state`: per local tet
+  // its joint state as the distribution delivered it (empty without joints).
   Simulation(Scene scene, Model model, RunOptions options, const Communicator* comm,
-             std::unique_ptr<Distribution> distribution, double contact_buffer);
+             std::unique_ptr<Distribution> distribution, double contact_buffer,
+             std::vector<std::uint8_t> tet_joint_state);
   ~Simulation();
 
   // Runs to scene.time.end (writing outputs); never throws NumericalFailure or IoError: a
@@ -177,12 +180,13 @@ class Simulation {
   long next_stability_check_ = 0;         // step of the next minimum-step guard check
   int interrupt_ = 0;  // signal that ends the run after this step (-1: received by another rank)
   long whole_nodes_ = 0, whole_tets_ = 0, whole_joints_ = 0;  // counts of the whole model
-  std::uint64_t reference_hash_ = 0;                          // of the whole model's x0
-  long startup_peak_rss_kib_ = 0;                             // this rank, end of start-up
+  bool distributed_start_ = false;    // started from build_distributed_model
+  std::uint64_t reference_hash_ = 0;  // of the whole model's x0
+  long startup_peak_rss_kib_ = 0;     // this rank, end of start-up
 };
 
 // Whether N ranks can start the scene without any rank holding the whole model: every mesh is
-// generated (box, wall, arch, tower) and no body has joints (docs/parallel.md).
+// generated (box, wall, arch, tower), and parallel.distributed_start is on (docs/parallel.md).
 bool distributed_start_possible(const Scene& scene);
 
 // Builds a Simulation from a scene file (meshes loaded or generated).

@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/tet_kernels.hpp"
+#include "parallel/distributed_joints.hpp"
 
 namespace fdem {
 
@@ -35,6 +36,20 @@ bool operator<(const SortKey& a, const SortKey& b) {
 SortKey sort_key(const TetRecord& r) {
   return {r.key, r.body, r.mesh_tet};
 }
+
+// Keys of the model's nodes before they are numbered: the node of a mesh node (node base of the
+// body + mesh node number: every corner at that mesh node shares it), except in a `joints: all`
+// body, where every tet corner is a node of its own (split base of the body + 4 × mesh tet +
+// corner), as build_model splits them.  Split keys follow all mesh node keys.
+struct NodeKeys {
+  std::vector<std::int64_t> split_base;  // per body; −1: the body's nodes are not split
+  std::int64_t split_start = 0;          // the first split key
+  std::int64_t key(const TetRecord& r, int c) const {
+    const std::int64_t base = split_base[static_cast<std::size_t>(r.body)];
+    return base < 0 ? r.node[c] : base + 4 * r.mesh_tet + c;
+  }
+  bool split(const TetRecord& r) const { return split_base[static_cast<std::size_t>(r.body)] >= 0; }
+};
 
 // Rank holding global position g when [block[r], block[r+1]) is rank r's.
 int block_owner(const std::vector<GlobalId>& block, GlobalId g) {
@@ -80,23 +95,26 @@ std::vector<TetRecord> sort_into_blocks(std::vector<TetRecord> local,
   return comm.exchange_grouped(bucket, counts);  // from lower ranks first, each sorted: in order
 }
 
-// A use of a mesh node by a tet corner: use = 4 × tet gid + corner (first use = smallest).
+// A use of a node (by its key, NodeKeys) by a tet corner: use = 4 × tet gid + corner (first
+// use = smallest).
 struct NodeUse {
   std::int64_t mesh_node, use;
   double x[3];
 };
-// A mesh node's model gid and its first tet.
+// A node's (key's) model gid and its first tet.
 struct NodeNumber {
   std::int64_t mesh_node;
   GlobalId gid, first_tet;
 };
 struct MassPart {
   GlobalId node, tet;
-  double mass;  // kg
+  double mass;    // kg
+  double extent;  // m: the tet's largest box side
 };
 struct NodeMass {
   GlobalId node;
-  double mass;
+  double mass;    // kg
+  double extent;  // m: the largest extent among the node's tets
 };
 
 // Directory rank of a node: the rank whose stretch of the Morton curve (its block of tets, sorted
@@ -186,7 +204,7 @@ std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<Bo
           X[k] = vec3_at(coords.data(), n);
           for (int d = 0; d < 3; ++d) r.x[3 * k + d] = X[k][d];
         }
-        check_tet_shape(X, scene.bodies[b].name, chunk.mesh.source, r.mesh_tet + 1);
+        check_tet_shape(X, scene.bodies[b].name, chunks[b].source, r.mesh_tet + 1);
         records.push_back(r);
       }
     }
@@ -206,18 +224,28 @@ std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<Bo
   return records;
 }
 
-// Step 4: node gids by first use.  Returns, per corner of the local tets, its node's number.
+// Step 4: node gids by first use.  Returns the numbers of the nodes of the local tets, by key.
+// Split nodes (one tet's own) are numbered here without a directory.
 std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalId first_tet,
-                                     const std::vector<GlobalId>& block,
+                                     const std::vector<GlobalId>& block, const NodeKeys& keys,
                                      const NodeDirectory& directory, const Communicator& comm,
                                      GlobalId* n_nodes) {
   const int ranks = comm.size();
   // This rank's first use of each node it uses (one message per node, not per corner).
-  std::vector<std::pair<std::int64_t, std::int64_t>> corner;  // (mesh node, use)
+  std::vector<std::pair<std::int64_t, std::int64_t>> corner;  // (node key, use)
+  std::vector<NodeUse> split;  // uses of split nodes: their first and only
   corner.reserve(4 * tets.size());
   for (std::size_t t = 0; t < tets.size(); ++t)
-    for (int c = 0; c < 4; ++c)
-      corner.emplace_back(tets[t].node[c], 4 * (first_tet + static_cast<GlobalId>(t)) + c);
+    for (int c = 0; c < 4; ++c) {
+      const std::int64_t use = 4 * (first_tet + static_cast<GlobalId>(t)) + c;
+      if (!keys.split(tets[t])) {
+        corner.emplace_back(tets[t].node[c], use);
+        continue;
+      }
+      NodeUse u{keys.key(tets[t], c), use, {}};
+      std::copy_n(&tets[t].x[3 * c], 3, u.x);
+      split.push_back(u);
+    }
   std::sort(corner.begin(), corner.end());
   std::vector<std::vector<NodeUse>> uses(static_cast<std::size_t>(ranks));
   for (std::size_t i = 0; i < corner.size(); ++i) {
@@ -247,6 +275,9 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
   // First users' ranks number the nodes they own, in order of first use.
   std::vector<NodeUse> owned = comm.exchange(firsts);
   firsts.clear();
+  owned.insert(owned.end(), split.begin(), split.end());
+  split.clear();
+  split.shrink_to_fit();
   std::sort(owned.begin(), owned.end(),
             [](const NodeUse& a, const NodeUse& b) { return a.use < b.use; });
   const std::vector<std::int64_t> counts = comm.allgather(static_cast<std::int64_t>(owned.size()));
@@ -254,9 +285,14 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
       std::accumulate(counts.begin(), counts.begin() + comm.rank(), std::int64_t{0});
   *n_nodes = std::accumulate(counts.begin(), counts.end(), std::int64_t{0});
   std::vector<std::vector<NodeNumber>> numbers(static_cast<std::size_t>(ranks));
-  for (std::size_t i = 0; i < owned.size(); ++i)
-    numbers[static_cast<std::size_t>(directory.rank_of(owned[i].x))].push_back(
-        {owned[i].mesh_node, base + static_cast<GlobalId>(i), owned[i].use / 4});
+  std::vector<NodeNumber> split_numbers;
+  for (std::size_t i = 0; i < owned.size(); ++i) {
+    const NodeNumber number{owned[i].mesh_node, base + static_cast<GlobalId>(i), owned[i].use / 4};
+    if (number.mesh_node >= keys.split_start)
+      split_numbers.push_back(number);
+    else
+      numbers[static_cast<std::size_t>(directory.rank_of(owned[i].x))].push_back(number);
+  }
   // Back to the directory, which answers every rank that used the node.
   std::vector<NodeNumber> known = comm.exchange(numbers);
   numbers.assign(static_cast<std::size_t>(ranks), {});
@@ -272,6 +308,7 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
     numbers[static_cast<std::size_t>(to)].push_back(*it);
   }
   std::vector<NodeNumber> mine = comm.exchange(numbers);
+  mine.insert(mine.end(), split_numbers.begin(), split_numbers.end());
   std::sort(mine.begin(), mine.end(),
             [](const NodeNumber& a, const NodeNumber& b) { return a.mesh_node < b.mesh_node; });
   return mine;
@@ -324,12 +361,22 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   model = model_frame(scene);
   std::vector<std::int64_t> node_base(chunks.size() + 1, 0);
   std::vector<std::int32_t> piece_base(chunks.size() + 1, 0);
+  std::vector<std::int64_t> body_tets(chunks.size(), 0);
   for (std::size_t b = 0; b < chunks.size(); ++b) {
     node_base[b + 1] = node_base[b] + chunks[b].n_nodes;
     piece_base[b + 1] = piece_base[b] + chunks[b].n_pieces;
     for (std::int32_t p = 0; p < chunks[b].n_pieces; ++p)
       model.pieces.push_back({static_cast<std::int32_t>(b), p});
-    for (std::int64_t n : chunks[b].chunk_tets) out.n_tets += n;
+    for (std::int64_t n : chunks[b].chunk_tets) body_tets[b] += n;
+    out.n_tets += body_tets[b];
+  }
+  NodeKeys keys;
+  keys.split_start = node_base.back();
+  std::int64_t next_split = keys.split_start;
+  for (std::size_t b = 0; b < chunks.size(); ++b) {
+    const bool split = scene.bodies[b].joints == JointPlacement::all;
+    keys.split_base.push_back(split ? next_split : -1);
+    if (split) next_split += 4 * body_tets[b];
   }
 
   // Steps 1–3: records generated here, sorted into equal blocks of gids.
@@ -344,8 +391,9 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
               "a rank receives its block of tets");
 
   // Step 4: node numbers; local nodes = owned (first used here) then the others, each by gid.
-  const std::vector<NodeNumber> numbers = number_nodes(
-      records, first_tet, out.tet_block, NodeDirectory(records, lo, hi, comm), comm, &out.n_nodes);
+  const std::vector<NodeNumber> numbers =
+      number_nodes(records, first_tet, out.tet_block, keys, NodeDirectory(records, lo, hi, comm),
+                   comm, &out.n_nodes);
   const auto number_of = [&](std::int64_t mesh_node) -> const NodeNumber& {
     const auto it =
         std::lower_bound(numbers.begin(), numbers.end(), mesh_node,
@@ -363,7 +411,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   std::vector<LocalNode> local_nodes(numbers.size(), LocalNode{0, 0, nullptr, 0});
   for (const TetRecord& r : records)
     for (int c = 0; c < 4; ++c) {
-      const NodeNumber& n = number_of(r.node[c]);
+      const NodeNumber& n = number_of(keys.key(r, c));
       LocalNode& l = local_nodes[static_cast<std::size_t>(&n - numbers.data())];
       if (!l.x) l = {n.gid, n.first_tet, &r.x[3 * c], r.piece};
     }
@@ -404,7 +452,8 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     return static_cast<LocalIndex>(it - nodes.gid.begin());
   };
 
-  // Tets: reference shapes, viscosities; node masses summed at the owners in tet-gid order.
+  // Tets: reference shapes, viscosities; node masses summed at the owners in tet-gid order, with
+  // the largest extent among each node's tets (the reach of the first halo).
   TetArrays& tets = model.tets;
   const LocalIndex n_tets = static_cast<LocalIndex>(records.size());
   tets.resize(n_tets);
@@ -416,6 +465,11 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   // of this block's quarters in gid order (added right away), then those of higher ranks' tets
   // (sent here, added after in gid order) — the serial builder's order.  Only the quarters for
   // nodes owned elsewhere travel.
+  std::vector<double> tet_extent(static_cast<std::size_t>(n_tets));
+  std::vector<FaceTet> face_tets;  // tets of bodies that joints concern
+  std::vector<char> has_faces(chunks.size());
+  for (std::size_t b = 0; b < chunks.size(); ++b) has_faces[b] = body_has_faces(scene, b);
+  std::vector<double> node_extent(static_cast<std::size_t>(n_local), 0.0);
   std::vector<std::vector<MassPart>> parts(static_cast<std::size_t>(ranks));
   for (LocalIndex t = 0; t < n_tets; ++t) {
     const TetRecord& r = records[t];
@@ -425,7 +479,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     tets.piece[t] = tets.contact_group[t] = r.piece;
     Vec3 X[4];
     for (int c = 0; c < 4; ++c) {
-      const LocalIndex n = local_node(number_of(r.node[c]).gid);
+      const LocalIndex n = local_node(number_of(keys.key(r, c)).gid);
       tets.nodes[4 * t + c] = n;
       X[c] = vec3_at(nodes.x0.data(), n);
     }
@@ -433,14 +487,44 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     Eigen::Map<Mat3>(tets.dm_inv.data() + 9 * static_cast<std::size_t>(t)) = setup.dm_inv;
     tets.volume0[t] = setup.volume;
     tets.viscosity[t] = setup.viscosity;
+    Vec3 box_lo = X[0], box_hi = X[0];
+    for (int c = 1; c < 4; ++c) {
+      box_lo = box_lo.cwiseMin(X[c]);
+      box_hi = box_hi.cwiseMax(X[c]);
+    }
+    tet_extent[static_cast<std::size_t>(t)] = (box_hi - box_lo).maxCoeff();
     for (int c = 0; c < 4; ++c) {
       const LocalIndex n = tets.nodes[4 * t + c];
-      if (n < nodes.n_owned)
+      if (n < nodes.n_owned) {
         nodes.mass[n] += 0.25 * setup.mass;
-      else
+        node_extent[static_cast<std::size_t>(n)] = std::max(
+            node_extent[static_cast<std::size_t>(n)], tet_extent[static_cast<std::size_t>(t)]);
+      } else {
         parts[static_cast<std::size_t>(out.node_owner[n])].push_back(
-            {nodes.gid[n], tets.gid[t], 0.25 * setup.mass});
+            {nodes.gid[n], tets.gid[t], 0.25 * setup.mass,
+             tet_extent[static_cast<std::size_t>(t)]});
+      }
     }
+    if (has_faces[static_cast<std::size_t>(r.body)]) {
+      FaceTet f{t, r.body, {}};
+      for (int c = 0; c < 4; ++c) f.mesh_node[c] = r.node[c] - node_base[r.body];
+      face_tets.push_back(f);
+    }
+  }
+  // Contact groups: a piece, or in a `joints: all` body each tet its own, numbered after the
+  // pieces in gid order (as build_model numbers them).
+  {
+    std::int64_t split = 0;
+    for (const TetRecord& r : records) split += keys.split(r);
+    const std::vector<std::int64_t> counts = comm.allgather(split);
+    std::int64_t next = static_cast<std::int64_t>(model.pieces.size()) +
+                        std::accumulate(counts.begin(), counts.begin() + me, std::int64_t{0});
+    FDEM_VERIFY(static_cast<std::int64_t>(model.pieces.size()) +
+                        std::accumulate(counts.begin(), counts.end(), std::int64_t{0}) <=
+                    std::numeric_limits<std::int32_t>::max(),
+                "contact groups fit 32 bits");
+    for (LocalIndex t = 0; t < n_tets; ++t)
+      if (keys.split(records[t])) tets.contact_group[t] = static_cast<std::int32_t>(next++);
   }
   records.clear();
   records.shrink_to_fit();
@@ -451,19 +535,48 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   });
   for (const MassPart& p : arrived) {
     FDEM_VERIFY(p.tet >= out.tet_block[me + 1], "mass quarters arrive from higher blocks");
-    nodes.mass[local_node(p.node)] += p.mass;
+    const LocalIndex n = local_node(p.node);
+    nodes.mass[n] += p.mass;
+    node_extent[static_cast<std::size_t>(n)] =
+        std::max(node_extent[static_cast<std::size_t>(n)], p.extent);
   }
-  // The other local nodes ask their owners for the mass.
+  arrived = {};
+  // The other local nodes ask their owners for the mass and extent.
   std::vector<std::vector<GlobalId>> asks(static_cast<std::size_t>(ranks));
   for (LocalIndex n = nodes.n_owned; n < n_local; ++n)
     asks[static_cast<std::size_t>(out.node_owner[n])].push_back(nodes.gid[n]);
   std::vector<int> asker;
   const std::vector<GlobalId> asked = comm.exchange(asks, &asker);
   std::vector<std::vector<NodeMass>> answers(static_cast<std::size_t>(ranks));
-  for (std::size_t i = 0; i < asked.size(); ++i)
+  for (std::size_t i = 0; i < asked.size(); ++i) {
+    const LocalIndex n = local_node(asked[i]);
     answers[static_cast<std::size_t>(asker[i])].push_back(
-        {asked[i], nodes.mass[local_node(asked[i])]});
-  for (const NodeMass& m : comm.exchange(answers)) nodes.mass[local_node(m.node)] = m.mass;
+        {asked[i], nodes.mass[n], node_extent[static_cast<std::size_t>(n)]});
+  }
+  for (const NodeMass& m : comm.exchange(answers)) {
+    const LocalIndex n = local_node(m.node);
+    nodes.mass[n] = m.mass;
+    node_extent[static_cast<std::size_t>(n)] = m.extent;
+  }
+
+  // Joints (parallel/distributed_joints), and the reach of each tet over the whole model.
+  std::vector<std::string> sources;
+  for (const BodyChunks& body : chunks) sources.push_back(body.source);
+  BlockJoints joints = place_block_joints(scene, sources, model, tet_extent, face_tets,
+                                          out.tet_block, matching_tolerance(hi - lo), comm);
+  face_tets = {};
+  out.joints = std::move(joints.joints);
+  out.n_joints = joints.n_joints;
+  model.joint_laws = std::move(joints.laws);
+  if (out.n_joints > 0) out.tet_joint_state = std::move(joints.bonded);
+  out.tet_reach.resize(static_cast<std::size_t>(n_tets));
+  for (LocalIndex t = 0; t < n_tets; ++t) {
+    double reach = std::max(tet_extent[static_cast<std::size_t>(t)],
+                            joints.partner_extent[static_cast<std::size_t>(t)]);
+    for (int c = 0; c < 4; ++c)
+      reach = std::max(reach, node_extent[static_cast<std::size_t>(tets.nodes[4 * t + c])]);
+    out.tet_reach[static_cast<std::size_t>(t)] = reach;
+  }
 
   // Pieces, velocities, constraints, force order.
   sum_pieces(model.pieces, model, comm);

@@ -28,22 +28,45 @@
 
 namespace fdem {
 
+// A cohesive joint as the distributed start-up leaves it, at the owner of its tet A: what
+// JointArrays holds for it, with tets and nodes as global ids (tet B and its nodes may be on
+// another rank).  Intact: not broken, damage 0, failure time −1.
+struct StartJoint {
+  GlobalId gid;
+  GlobalId tets[2];   // A (the smaller gid), B
+  GlobalId nodes[6];  // a0 a1 a2 b0 b1 b2, b_i coincident with a_i
+  double area0;       // m²
+  std::int32_t law;   // index into model.joint_laws
+};
+
 // One rank's block of the model and what the distribution needs to know about its nodes.
 struct DistributedModel {
   // Owned tets (tets.owned and tets.active all 1) and every node they use: the nodes this rank
   // owns (their first user is here) first, then the others, each range in ascending gid.  Every
-  // node has its mass, velocity and constraints.
+  // node has its mass, velocity and constraints.  model.joint_laws is the whole model's; the
+  // joints are in `joints` (model.joints stays empty).
   Model model;
   std::vector<GlobalId> node_first_tet;  // per local node: gid of the first tet that uses it
   std::vector<std::int32_t> node_owner;  // per local node: the rank that owns it
   std::vector<GlobalId> tet_block;       // size()+1 entries: rank r owns tet gids [r, r+1)
   GlobalId n_nodes = 0, n_tets = 0;      // of the whole model
+  // Joints whose tet A is in this block, in ascending gid (= ascending (gid A, gid B)).
+  std::vector<StartJoint> joints;
+  GlobalId n_joints = 0;  // of the whole model
+  // Per local tet: 1 when a joint bonds it (the contact stage's "intact" joint state), 0 when not;
+  // empty when the model has no joints.
+  std::vector<std::uint8_t> tet_joint_state;
+  // Per local tet: the largest box extent (m, at x0) among the tets that share a node with it or
+  // are bonded to it by a joint, itself included, over the whole model — the reach the
+  // distribution's first halo needs (tets of other blocks included).
+  std::vector<double> tet_reach;
 };
 
 // Collective.  `chunks`: one per body of `scene` (drivers/mesh_generators body_chunks).  Every
 // rank passes the same scene and chunk plans.  Throws (collectively) InputError for a bad mesh,
-// with the body and tet as the serial builder names them.  Bodies with joints are not supported
-// here (the caller keeps the whole-model start for them).
+// with the body and tet as the serial builder names them, and for joints that cannot be placed
+// (a triangle of more than two tets, touching pieces or an interface without a shared triangle)
+// with the serial builder's message.
 DistributedModel build_distributed_model(const Scene& scene, const std::vector<BodyChunks>& chunks,
                                          const Communicator& comm);
 

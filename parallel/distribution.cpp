@@ -231,10 +231,11 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
 void Distribution::pack_rows(const Model& model, const TravellingState& state,
                              const std::vector<std::vector<LocalIndex>>& lists,
                              std::vector<char>& send, std::vector<int>& send_counts,
-                             std::vector<char>* own) const {
+                             std::vector<char>* own,
+                             const std::vector<StartJoint>* start_joints) const {
   const int ranks = comm_.size(), me = comm_.rank();
   send_counts.assign(static_cast<std::size_t>(ranks), 0);
-  RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_);
+  RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_, start_joints);
   for (int p = 0; p < ranks; ++p) {
     if (lists[p].empty()) continue;
     if (p == me) {
@@ -278,12 +279,13 @@ std::vector<char> Distribution::exchange_rows(std::vector<char>& send,
 // Sends every owned tet (with its rows) to its owner and to the ranks near it, and assembles what
 // arrives into `out` (which may be `model` itself).
 void Distribution::migrate(Model& model, TravellingState& state, Model& out,
-                           TravellingState& out_state) {
-  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false);
+                           TravellingState& out_state, const std::vector<StartJoint>* start_joints,
+                           const std::vector<double>* start_reach) {
+  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false, start_reach);
   // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
   std::vector<char> send, own;
   std::vector<int> send_counts;
-  pack_rows(model, state, lists, send, send_counts, &own);
+  pack_rows(model, state, lists, send, send_counts, &own, start_joints);
   // The rows hold everything that travels: the source arrays can go before the new ones come.
   model.nodes = NodeArrays{};
   model.tets = TetArrays{};
@@ -435,8 +437,8 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
             });
 }
 
-std::vector<std::vector<LocalIndex>> Distribution::destinations(const Model& model,
-                                                                bool whole) const {
+std::vector<std::vector<LocalIndex>> Distribution::destinations(
+    const Model& model, bool whole, const std::vector<double>* start_reach) const {
   // Senders: the tets this rank owns, or (at the start, every rank holding the whole model) all.
   const TetArrays& tets = model.tets;
   const int ranks = comm_.size();
@@ -458,7 +460,9 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(const Model& mod
     comm_.sum_in_place(sums);
     joint_gap = comm_.max(joint_gap);
   }
-  const std::vector<double> reach = tet_reach(model, tet_boxes);
+  std::vector<double> reach = tet_reach(model, tet_boxes);
+  if (start_reach)  // the distributed start: neighbours in other blocks count too
+    for (std::size_t t = 0; t < reach.size(); ++t) reach[t] = std::max(reach[t], (*start_reach)[t]);
   const double grow = 2.5 * buffer_ + joint_gap;
   OwnerGrid grid(origin.data(), 2.0 * sums[0] / std::max(sums[1], 1.0) + grow);
   // Every sending tet must fit the grid; a tet that does not has flown off (or blown up) — every

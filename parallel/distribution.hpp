@@ -76,6 +76,8 @@ class Distribution {
   // (build_distributed_model) and the contact buffer.  The blocks — a Morton space-filling curve
   // over the tet centroids cut into equal parts — are the initial partition; each rank receives
   // the halo its tets need from the ranks that own it, and no rank ever holds the whole model.
+  // Joints travel with their tet A; `local_state.tet_joint_state` gets each tet's joint state
+  // (bonded anywhere: pass it to the contact stage, whose bonds see only the joints held here).
   Distribution(const Communicator& comm, DistributionSettings settings, DistributedModel start,
                double buffer, Model& local, TravellingState& local_state);
 
@@ -102,16 +104,21 @@ class Distribution {
   };
   // Sends the owned tets where destinations() says, frees `model`'s mesh arrays and `state` once
   // packed, and assembles what arrives into `out` (which may be `model`).
-  void migrate(Model& model, TravellingState& state, Model& out, TravellingState& out_state);
-  // The start (parallel/distribution_start.cpp): every local tet is owned here, so only halo
-  // copies travel, and they are appended to `model` in place (gid order kept): no second copy of
-  // the model is ever made.  For models without joints (else migrate).
-  void append_halo(Model& model, TravellingState& state);
+  // `start_joints`, `start_reach` (distributed start): the block's joints by gid and each tet's
+  // reach over the whole model (DistributedModel).
+  void migrate(Model& model, TravellingState& state, Model& out, TravellingState& out_state,
+               const std::vector<StartJoint>* start_joints = nullptr,
+               const std::vector<double>* start_reach = nullptr);
+  // The start (parallel/distribution_start.cpp) of a scene without joints: every local tet is
+  // owned here, so only halo copies travel, and they are appended to `model` in place (gid order
+  // kept): no second copy of the model is ever made.
+  void append_halo(Model& model, TravellingState& state, const std::vector<double>* start_reach);
   // Packs lists[p] for the other ranks into `send` (counts in 8-byte words) and lists[me] into
   // `own` when given; exchange_rows sends them (freeing `send`) and returns what arrived.
   void pack_rows(const Model& model, const TravellingState& state,
                  const std::vector<std::vector<LocalIndex>>& lists, std::vector<char>& send,
-                 std::vector<int>& send_counts, std::vector<char>* own) const;
+                 std::vector<int>& send_counts, std::vector<char>* own,
+                 const std::vector<StartJoint>* start_joints = nullptr) const;
   std::vector<char> exchange_rows(std::vector<char>& send,
                                   const std::vector<int>& send_counts) const;
   // Builds `model` from packed rows; empties each buffer once parsed.
@@ -125,7 +132,10 @@ class Distribution {
   // claimed a cell its box grown by 2.5 buffers (+ the widest joint gap) touches; a rank claims
   // the cells within reach of each tet it will own.  `whole`: every rank holds the whole model
   // (the start) and all tets send, without exchanging claims; else the owned tets send.
-  std::vector<std::vector<LocalIndex>> destinations(const Model& model, bool whole) const;
+  // `start_reach`: a lower bound of each local tet's reach (the distributed start's blocks do not
+  // hold their neighbours in other blocks).
+  std::vector<std::vector<LocalIndex>> destinations(
+      const Model& model, bool whole, const std::vector<double>* start_reach = nullptr) const;
   void update_report(const Model& model);
 
   Communicator comm_;

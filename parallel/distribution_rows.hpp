@@ -78,14 +78,18 @@ class RowPacker {
  public:
   // `tet_owner`, `node_owner`, `node_first_tet`: per local tet and node, their owners after the
   // redistribution and the nodes' first tets.
+  // `start_joints` (distributed start, model.joints empty): the joints whose tet A is local, by
+  // gid, with global references.
   RowPacker(const Model& model, const TravellingState& state,
             const std::vector<std::int32_t>& tet_owner, const std::vector<std::int32_t>& node_owner,
-            const std::vector<GlobalId>& node_first_tet)
+            const std::vector<GlobalId>& node_first_tet,
+            const std::vector<StartJoint>* start_joints = nullptr)
       : model_(model),
         state_(state),
         tet_owner_(tet_owner),
         node_owner_(node_owner),
         node_first_tet_(node_first_tet),
+        start_joints_(start_joints),
         stamp_(model.nodes.size(), -1) {
     const JointArrays& joints = model.joints;
     joint_offsets_.assign(static_cast<std::size_t>(model.tets.size()) + 1, 0);
@@ -102,8 +106,16 @@ class RowPacker {
     const TetArrays& tets = model_.tets;
     const JointArrays& joints = model_.joints;
     std::vector<LocalIndex> node_list, joint_list;
+    std::vector<const StartJoint*> start_list;
     std::vector<const FrictionEntry*> friction_list;
     for (LocalIndex t : tet_list) {
+      if (start_joints_) {
+        auto it =
+            std::lower_bound(start_joints_->begin(), start_joints_->end(), tets.gid[t],
+                             [](const StartJoint& j, GlobalId value) { return j.tets[0] < value; });
+        for (; it != start_joints_->end() && it->tets[0] == tets.gid[t]; ++it)
+          start_list.push_back(&*it);
+      }
       for (int c = 0; c < 4; ++c) {
         const LocalIndex n = tets.nodes[4 * static_cast<std::size_t>(t) + c];
         if (stamp_[n] != mark_) {
@@ -122,10 +134,11 @@ class RowPacker {
     BlockHeader header;
     header.tets = static_cast<std::int64_t>(tet_list.size());
     header.nodes = static_cast<std::int64_t>(node_list.size());
-    header.joints = static_cast<std::int64_t>(joint_list.size());
+    header.joints = static_cast<std::int64_t>(joint_list.size() + start_list.size());
     header.friction = static_cast<std::int64_t>(friction_list.size());
     out.reserve(out.size() + sizeof(header) + tet_list.size() * sizeof(TetRow) +
-                node_list.size() * sizeof(NodeRow) + joint_list.size() * sizeof(JointRow) +
+                node_list.size() * sizeof(NodeRow) +
+                (joint_list.size() + start_list.size()) * sizeof(JointRow) +
                 friction_list.size() * sizeof(FrictionRow));
     append(out, header);
     for (LocalIndex t : tet_list) {
@@ -173,6 +186,20 @@ class RowPacker {
       row.history = state_.joint_history[j];
       append(out, row);
     }
+    for (const StartJoint* j : start_list) {  // intact, as JointArrays::resize leaves a joint
+      JointRow row{};
+      row.gid = j->gid;
+      std::copy_n(j->nodes, 6, row.nodes);
+      std::copy_n(j->tets, 2, row.tets);
+      row.area0 = j->area0;
+      row.failure_time = -1.0;
+      row.damage = 0.0;
+      row.law = j->law;
+      row.broken = 0;
+      row.mode = 0;
+      row.history = JointHistory{};
+      append(out, row);
+    }
     for (const FrictionEntry* e : friction_list) {
       FrictionRow row{};
       row.a = e->a;
@@ -189,6 +216,7 @@ class RowPacker {
   const std::vector<std::int32_t>& tet_owner_;
   const std::vector<std::int32_t>& node_owner_;
   const std::vector<GlobalId>& node_first_tet_;
+  const std::vector<StartJoint>* start_joints_;
   std::vector<int> stamp_;
   int mark_ = 0;
   std::vector<std::int64_t> joint_offsets_;

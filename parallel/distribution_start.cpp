@@ -47,9 +47,13 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   node_first_tet_ = std::move(start.node_first_tet);
   TravellingState state;
   state.x_at_detection = start.model.nodes.x;
-  if (start.model.joints.size() == 0) {
+  // With joints, tets carry their joint state (bonded anywhere, not only by the joints that end
+  // up held with them).
+  has_joint_state_ = !start.tet_joint_state.empty();
+  state.tet_joint_state = std::move(start.tet_joint_state);
+  if (start.joints.empty() && !has_joint_state_) {
     local = std::move(start.model);
-    append_halo(local, state);
+    append_halo(local, state, &start.tet_reach);
     local_state = std::move(state);
   } else {
     local = Model{};
@@ -59,18 +63,19 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     local.body_fixed = start.model.body_fixed;
     local.gravity = start.model.gravity;
     local.joint_laws = start.model.joint_laws;
-    migrate(start.model, state, local, local_state);
+    migrate(start.model, state, local, local_state, &start.joints, &start.tet_reach);
   }
   report_.cycles = 1;
   update_report(local);
 }
 
-void Distribution::append_halo(Model& model, TravellingState& state) {
+void Distribution::append_halo(Model& model, TravellingState& state,
+                               const std::vector<double>* start_reach) {
   FDEM_VERIFY(model.joints.size() == 0 && state.friction.empty() && !has_joint_state_,
               "append_halo: a model without joints or friction history");
   std::vector<char> send;
   std::vector<int> send_counts;
-  pack_rows(model, state, destinations(model, false), send, send_counts, nullptr);
+  pack_rows(model, state, destinations(model, false, start_reach), send, send_counts, nullptr);
   std::vector<char> receive = exchange_rows(send, send_counts);
   ParsedRows rows = parse_rows({&receive});
   FDEM_VERIFY(rows.joints.empty() && rows.friction.empty(), "halo rows without joints");

@@ -1,8 +1,11 @@
 # Runs the fdem command on a scene with each rank count of RANKS and passes when every run
 # completes and summary.json's state_hash is the same in all of them.  With RESTART_RANKS, also
 # continues the first run's earliest checkpoint on each of those rank counts and requires the
-# same hash again (checkpoint-and-restart vs. uninterrupted).
-# -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list), RESTART_RANKS (list, optional)
+# same hash again (checkpoint-and-restart vs. uninterrupted).  With START, every run on more than
+# one rank must report that start-up in summary.json (decomposition.start: "distributed" when no
+# rank held the whole model, "whole_model").
+# -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list), RESTART_RANKS (list, optional),
+#    START (optional)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
@@ -16,7 +19,7 @@ function(run_fdem ranks out)
 endfunction()
 
 # The state hash, with the counts that must agree too (broken joints, fragments, elements).
-function(read_hash out variable)
+function(read_hash out variable ranks)
   file(READ ${out}/summary.json summary)
   string(REGEX MATCH "\"state_hash\": \"([0-9a-f]+)\"" _ "${summary}")
   set(hash ${CMAKE_MATCH_1})
@@ -29,14 +32,20 @@ function(read_hash out variable)
     string(APPEND hash "/${count}=${value}")
   endforeach()
   string(REGEX MATCH "\"migrated_elements\": ([0-9]+)" _ "${summary}")
-  message("${out}: state_hash ${hash}, migrated elements ${CMAKE_MATCH_1}")
+  set(migrated "${CMAKE_MATCH_1}")
+  string(REGEX MATCH "\"start\": \"([a-z_]+)\"" _ "${summary}")
+  set(start "${CMAKE_MATCH_1}")
+  if(START AND ranks GREATER 1 AND NOT start STREQUAL START)
+    message(FATAL_ERROR "${out}: start-up '${start}', expected '${START}'")
+  endif()
+  message("${out}: state_hash ${hash}, migrated elements ${migrated}, start ${start}")
   set(${variable} ${hash} PARENT_SCOPE)
 endfunction()
 
 set(reference "")
 foreach(ranks ${RANKS})
   run_fdem(${ranks} ${WORK}/ranks${ranks})
-  read_hash(${WORK}/ranks${ranks} hash)
+  read_hash(${WORK}/ranks${ranks} hash ${ranks})
   if(reference STREQUAL "")
     set(reference ${hash})
     set(first_run ${WORK}/ranks${ranks})
@@ -55,7 +64,7 @@ if(RESTART_RANKS)
   list(GET checkpoints 0 earliest)
   foreach(ranks ${RESTART_RANKS})
     run_fdem(${ranks} ${WORK}/restart${ranks} --restart ${earliest})
-    read_hash(${WORK}/restart${ranks} hash)
+    read_hash(${WORK}/restart${ranks} hash ${ranks})
     if(NOT hash STREQUAL reference)
       message(FATAL_ERROR "restart from ${earliest} on ${ranks} ranks: state_hash ${hash}, "
                           "uninterrupted ${reference}")

@@ -1,0 +1,733 @@
+#include "parallel/distributed_joints.hpp"
+
+#include <algorithm>
+#include <array>
+#include <functional>
+#include <initializer_list>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "core/model_builder.hpp"
+
+namespace fdem {
+
+namespace {
+
+using Key = std::array<std::int64_t, 3>;
+
+std::uint64_t mix(std::uint64_t h) {  // splitmix64's finaliser
+  h ^= h >> 30;
+  h *= 0xbf58476d1ce4e5b9ULL;
+  h ^= h >> 27;
+  h *= 0x94d049bb133111ebULL;
+  return h ^ (h >> 31);
+}
+
+std::uint64_t hash_of(std::initializer_list<std::int64_t> values) {
+  std::uint64_t h = 0x9E3779B97F4A7C15ULL;
+  for (std::int64_t v : values) h = mix(h ^ static_cast<std::uint64_t>(v));
+  return h;
+}
+
+int hashed_rank(std::initializer_list<std::int64_t> values, int ranks) {
+  return static_cast<int>(hash_of(values) % static_cast<std::uint64_t>(ranks));
+}
+
+int face_rank(std::int32_t body, const std::int64_t* key, int ranks) {
+  return hashed_rank({body, key[0], key[1], key[2]}, ranks);
+}
+
+int block_owner(const std::vector<GlobalId>& block, GlobalId g) {
+  return static_cast<int>(std::upper_bound(block.begin(), block.end(), g) - block.begin()) - 1;
+}
+
+// ⌊c / k⌋ for k > 0.
+std::int64_t floor_div(std::int64_t c, std::int64_t k) {
+  std::int64_t q = c / k;
+  if (c % k != 0 && c < 0) --q;
+  return q;
+}
+
+// Tolerance cells per position-directory block and axis.
+constexpr std::int64_t block_cells = 1024;
+
+// A face of a local tet: sorted mesh node numbers, body, tet, the corner left out.
+struct LocalFace {
+  Key key;
+  std::int32_t body;
+  LocalIndex tet;
+  std::int32_t skip;
+};
+
+// A face travelling to its face directory.
+struct FaceRecord {
+  std::int64_t key[3];  // sorted mesh node numbers
+  GlobalId tet;
+  GlobalId node[3];       // the tet's model node at key[i]
+  double volume, extent;  // the tet's volume (m³) and largest box side (m)
+  std::int32_t body, piece;
+};
+// Two faces of one block that paired where they are: only their count travels (a third face
+// elsewhere makes the mesh non-manifold).
+struct FacePresence {
+  std::int64_t key[3];
+  std::int32_t body, count;
+};
+// A boundary face, back to its tet's owner.
+struct BoundaryNotice {
+  GlobalId tet;
+  std::int64_t key[3];
+};
+// A boundary node on its way to a position directory.
+struct PosNode {
+  std::int64_t cell[3];  // tolerance cell
+  std::int64_t mesh_node;
+  double x[3];  // m
+  std::int32_t body, piece, home, unused;
+};
+// The partner of a boundary node: in piece `target` (>= 0) of its body, or in the other body of
+// interface −1 − target.
+struct NodeMatch {
+  std::int64_t mesh_node, partner;
+  std::int32_t body, target;
+};
+// Is `key` (sorted partner nodes) a boundary face of `body`?  Asked by the owner of the tet of
+// a boundary face whose node i has partner[i].
+struct FaceQuery {
+  std::int64_t key[3];
+  std::int64_t partner[3];
+  GlobalId tet;
+  GlobalId node[3];
+  double volume, extent;
+  std::int32_t body, group, counter, unused;
+};
+// A joint found (role 0, to the owner of tet A) or the bond of tet B (role 1, to its owner).
+struct DraftRecord {
+  GlobalId tet[2];      // A (smaller gid), B
+  GlobalId a[3], b[3];  // model nodes, b[i] coincident with a[i]
+  double volume[2], extent[2];
+  std::int32_t group, role;
+};
+
+DraftRecord make_draft(GlobalId tet_a, const GlobalId (&a)[3], double volume_a, double extent_a,
+                       GlobalId tet_b, const GlobalId (&b)[3], double volume_b, double extent_b,
+                       std::int32_t group) {
+  DraftRecord d{{tet_a, tet_b},
+                {a[0], a[1], a[2]},
+                {b[0], b[1], b[2]},
+                {volume_a, volume_b},
+                {extent_a, extent_b},
+                group,
+                0};
+  if (d.tet[0] > d.tet[1]) {  // canonical: A has the smaller gid
+    std::swap(d.tet[0], d.tet[1]);
+    for (int i = 0; i < 3; ++i) std::swap(d.a[i], d.b[i]);
+    std::swap(d.volume[0], d.volume[1]);
+    std::swap(d.extent[0], d.extent[1]);
+  }
+  return d;
+}
+
+// Errors, ordered as the serial builder meets them: per body (stage = body) the non-manifold
+// check (kind 0), a node too far from the origin to match (1), no touching pieces (2); then per
+// interface k (stage = bodies + k) a node of B too far (0), of A (1), no match (2).  Details:
+// the face's sorted mesh nodes (and the node's place in it).
+struct ErrorKey {
+  std::int64_t stage = std::numeric_limits<std::int64_t>::max(), kind = 0, detail[4] = {0, 0, 0, 0};
+  bool operator<(const ErrorKey& o) const {
+    if (stage != o.stage) return stage < o.stage;
+    if (kind != o.kind) return kind < o.kind;
+    return std::lexicographical_compare(detail, detail + 4, o.detail, o.detail + 4);
+  }
+  bool operator==(const ErrorKey& o) const { return !(*this < o) && !(o < *this); }
+};
+
+class FirstError {
+ public:
+  void offer(const ErrorKey& key, const std::function<std::string()>& message) {
+    if (key < key_) {
+      key_ = key;
+      message_ = message();
+    }
+  }
+  // Collective: every rank throws the error the serial builder would have met first.
+  void raise(const Communicator& comm) const {
+    const std::vector<ErrorKey> all = comm.allgather(key_);
+    const auto first = std::min_element(all.begin(), all.end());  // lowest rank among equals
+    if (first->stage == ErrorKey{}.stage) return;
+    const bool mine = first - all.begin() == comm.rank();
+    comm.run_collectively([&] {
+      if (mine) throw InputError(message_);
+    });
+  }
+
+ private:
+  ErrorKey key_;
+  std::string message_;
+};
+
+struct Roles {
+  std::vector<char> jointed, bonded;
+  std::vector<std::vector<std::int32_t>> as_a, as_b;  // per body: interfaces it is side A / B of
+  explicit Roles(const Scene& scene)
+      : jointed(scene.bodies.size()),
+        bonded(scene.bodies.size()),
+        as_a(scene.bodies.size()),
+        as_b(scene.bodies.size()) {
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+      jointed[b] = scene.bodies[b].joints == JointPlacement::all;
+      bonded[b] = scene.bodies[b].joints == JointPlacement::interfaces;
+    }
+    for (std::size_t k = 0; k < scene.interfaces.size(); ++k) {
+      as_a[static_cast<std::size_t>(scene.interfaces[k].body_a)].push_back(
+          static_cast<std::int32_t>(k));
+      as_b[static_cast<std::size_t>(scene.interfaces[k].body_b)].push_back(
+          static_cast<std::int32_t>(k));
+    }
+  }
+  // Whether the body's boundary faces are matched by position.
+  bool matched(std::size_t b) const { return bonded[b] || !as_a[b].empty() || !as_b[b].empty(); }
+};
+
+struct KeyHash {
+  std::size_t operator()(const Key& k) const {
+    return static_cast<std::size_t>(hash_of({k[0], k[1], k[2]}));
+  }
+};
+
+}  // namespace
+
+bool body_has_faces(const Scene& scene, std::size_t body) {
+  if (scene.bodies[body].joints != JointPlacement::none) return true;
+  for (const InterfaceSpec& i : scene.interfaces)
+    if (i.body_a == static_cast<int>(body) || i.body_b == static_cast<int>(body)) return true;
+  return false;
+}
+
+BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string>& sources,
+                               const Model& block, const std::vector<double>& tet_extent,
+                               const std::vector<FaceTet>& face_tets,
+                               const std::vector<GlobalId>& tet_block, double tol,
+                               const Communicator& comm) {
+  const int ranks = comm.size(), me = comm.rank();
+  const GlobalId first_tet = tet_block[static_cast<std::size_t>(me)];
+  const TetArrays& tets = block.tets;
+  const NodeArrays& nodes = block.nodes;
+  const std::int32_t n_bodies = static_cast<std::int32_t>(scene.bodies.size());
+  const std::int32_t n_materials = static_cast<std::int32_t>(scene.materials.size());
+  const Roles roles(scene);
+  FirstError error;
+  BlockJoints out;
+  out.bonded.assign(static_cast<std::size_t>(tets.size()), 0);
+  out.partner_extent.assign(static_cast<std::size_t>(tets.size()), 0.0);
+  const auto material_of = [&](std::int32_t b) { return scene.bodies[b].material; };
+  // The local node of a face tet at mesh node m.
+  const auto node_at = [&](const FaceTet& ft, std::int64_t m) {
+    for (int c = 0; c < 4; ++c)
+      if (ft.mesh_node[c] == m) return tets.nodes[4 * static_cast<std::size_t>(ft.tet) + c];
+    FDEM_VERIFY(false, "a face's mesh node is a corner of its tet");
+    return LocalIndex{-1};
+  };
+  const auto face_record = [&](const FaceTet& ft, const Key& key) {
+    FaceRecord r{};
+    std::copy_n(key.data(), 3, r.key);
+    r.tet = tets.gid[ft.tet];
+    for (int i = 0; i < 3; ++i) r.node[i] = nodes.gid[node_at(ft, key[i])];
+    r.volume = tets.volume0[ft.tet];
+    r.extent = tet_extent[static_cast<std::size_t>(ft.tet)];
+    r.body = ft.body;
+    r.piece = tets.piece[ft.tet];
+    return r;
+  };
+  std::vector<DraftRecord> local_drafts;  // found here for this rank
+  std::vector<std::vector<DraftRecord>> drafts(static_cast<std::size_t>(ranks));  // to owners
+  const auto send_draft = [&](const DraftRecord& d) {
+    DraftRecord bond = d;
+    bond.role = 1;
+    const int owner_a = block_owner(tet_block, d.tet[0]),
+              owner_b = block_owner(tet_block, d.tet[1]);
+    (owner_a == me ? local_drafts : drafts[static_cast<std::size_t>(owner_a)]).push_back(d);
+    (owner_b == me ? local_drafts : drafts[static_cast<std::size_t>(owner_b)]).push_back(bond);
+  };
+
+  // 1  Faces of the local tets; pairs within the block are joined here.
+  std::vector<std::vector<FaceRecord>> face_out(static_cast<std::size_t>(ranks));
+  std::vector<std::vector<FacePresence>> presence_out(static_cast<std::size_t>(ranks));
+  {
+    std::vector<LocalFace> faces;
+    faces.reserve(4 * face_tets.size());
+    for (std::size_t i = 0; i < face_tets.size(); ++i)
+      for (int skip = 0; skip < 4; ++skip) {
+        LocalFace f{{0, 0, 0}, face_tets[i].body, static_cast<LocalIndex>(i), skip};
+        int k = 0;
+        for (int c = 0; c < 4; ++c)
+          if (c != skip) f.key[k++] = face_tets[i].mesh_node[c];
+        std::sort(f.key.begin(), f.key.end());
+        faces.push_back(f);
+      }
+    std::sort(faces.begin(), faces.end(), [](const LocalFace& a, const LocalFace& b) {
+      if (a.body != b.body) return a.body < b.body;
+      return a.key != b.key ? a.key < b.key : a.tet < b.tet;
+    });
+    for (std::size_t i = 0; i < faces.size();) {
+      std::size_t j = i + 1;
+      while (j < faces.size() && faces[j].body == faces[i].body && faces[j].key == faces[i].key)
+        ++j;
+      const LocalFace& f = faces[i];
+      const int rank = face_rank(f.body, f.key.data(), ranks);
+      if (j - i == 1) {
+        face_out[static_cast<std::size_t>(rank)].push_back(face_record(face_tets[f.tet], f.key));
+      } else {
+        presence_out[static_cast<std::size_t>(rank)].push_back(
+            {{f.key[0], f.key[1], f.key[2]}, f.body, static_cast<std::int32_t>(j - i)});
+        if (j - i == 2 && roles.jointed[static_cast<std::size_t>(f.body)]) {
+          const FaceRecord p = face_record(face_tets[f.tet], f.key);
+          const FaceRecord q = face_record(face_tets[faces[i + 1].tet], f.key);
+          send_draft(make_draft(p.tet, p.node, p.volume, p.extent, q.tet, q.node, q.volume,
+                                q.extent, material_of(f.body)));
+        }
+      }
+      i = j;
+    }
+  }
+
+  // 1b Face directory: counts, joints across blocks, boundary faces.
+  std::vector<FaceRecord> boundary;  // boundary faces this rank answers for, by (body, key)
+  std::vector<std::vector<BoundaryNotice>> notices(static_cast<std::size_t>(ranks));
+  {
+    std::vector<FaceRecord> singles = comm.exchange(face_out);
+    face_out = {};
+    std::vector<FacePresence> presences = comm.exchange(presence_out);
+    presence_out = {};
+    // Both kinds as (body, key, count, single or −1), grouped by face.
+    struct Entry {
+      std::int32_t body;
+      Key key;
+      std::int32_t count;
+      std::int64_t single;
+    };
+    std::vector<Entry> entries;
+    entries.reserve(singles.size() + presences.size());
+    for (std::size_t i = 0; i < singles.size(); ++i)
+      entries.push_back({singles[i].body,
+                         {singles[i].key[0], singles[i].key[1], singles[i].key[2]},
+                         1,
+                         static_cast<std::int64_t>(i)});
+    for (const FacePresence& p : presences)
+      entries.push_back({p.body, {p.key[0], p.key[1], p.key[2]}, p.count, -1});
+    presences = {};
+    std::sort(entries.begin(), entries.end(), [&](const Entry& a, const Entry& b) {
+      if (a.body != b.body) return a.body < b.body;
+      if (a.key != b.key) return a.key < b.key;
+      const GlobalId ta = a.single < 0 ? -1 : singles[static_cast<std::size_t>(a.single)].tet;
+      const GlobalId tb = b.single < 0 ? -1 : singles[static_cast<std::size_t>(b.single)].tet;
+      return ta < tb;
+    });
+    for (std::size_t i = 0; i < entries.size();) {
+      std::size_t j = i;
+      std::int64_t count = 0;
+      std::vector<const FaceRecord*> here;
+      while (j < entries.size() && entries[j].body == entries[i].body &&
+             entries[j].key == entries[i].key) {
+        count += entries[j].count;
+        if (entries[j].single >= 0)
+          here.push_back(&singles[static_cast<std::size_t>(entries[j].single)]);
+        ++j;
+      }
+      const std::int32_t b = entries[i].body;
+      const Key& key = entries[i].key;
+      i = j;
+      if (count >= 3) {
+        error.offer({b, 0, {key[0], key[1], key[2], 0}},
+                    [&] { return non_manifold_message(scene.bodies[b].name, sources[b], key); });
+      } else if (count == 2 && here.size() == 2 && roles.jointed[static_cast<std::size_t>(b)]) {
+        const FaceRecord &p = *here[0], &q = *here[1];
+        send_draft(make_draft(p.tet, p.node, p.volume, p.extent, q.tet, q.node, q.volume, q.extent,
+                              material_of(b)));
+      } else if (count == 1 && roles.matched(static_cast<std::size_t>(b))) {
+        boundary.push_back(*here[0]);
+        notices[static_cast<std::size_t>(block_owner(tet_block, here[0]->tet))].push_back(
+            {here[0]->tet, {key[0], key[1], key[2]}});
+      }
+    }
+  }
+
+  // 2  Owners of boundary faces: their nodes to the position directories.
+  struct OwnedBoundary {
+    Key key;
+    LocalIndex tet;
+    std::int32_t body;
+    LocalIndex node[3];
+  };
+  std::vector<OwnedBoundary> owned_boundary;
+  std::vector<std::vector<PosNode>> positions(static_cast<std::size_t>(ranks));
+  {
+    for (const BoundaryNotice& n : comm.exchange(notices)) {
+      const LocalIndex t = static_cast<LocalIndex>(n.tet - first_tet);
+      const auto it = std::lower_bound(face_tets.begin(), face_tets.end(), t,
+                                       [](const FaceTet& f, LocalIndex v) { return f.tet < v; });
+      FDEM_VERIFY(it != face_tets.end() && it->tet == t, "a boundary face's tet is a face tet");
+      OwnedBoundary f{{n.key[0], n.key[1], n.key[2]}, t, it->body, {}};
+      for (int i = 0; i < 3; ++i) f.node[i] = node_at(*it, f.key[i]);
+      owned_boundary.push_back(f);
+    }
+    notices = {};
+    // Each boundary node once (a split body's copies of one mesh node: once), with its cell.
+    struct BoundaryNode {
+      std::int32_t body;
+      std::int64_t mesh_node;
+      LocalIndex node;
+    };
+    std::vector<BoundaryNode> list;
+    for (const OwnedBoundary& f : owned_boundary)
+      for (int i = 0; i < 3; ++i) list.push_back({f.body, f.key[i], f.node[i]});
+    const auto by_node = [](const BoundaryNode& a, const BoundaryNode& b) {
+      return a.body != b.body ? a.body < b.body : a.mesh_node < b.mesh_node;
+    };
+    std::sort(list.begin(), list.end(), by_node);
+    list.erase(std::unique(list.begin(), list.end(),
+                           [](const BoundaryNode& a, const BoundaryNode& b) {
+                             return a.body == b.body && a.mesh_node == b.mesh_node;
+                           }),
+               list.end());
+    const auto index_of = [&](std::int32_t body, std::int64_t mesh_node) {
+      return static_cast<std::size_t>(
+          std::lower_bound(list.begin(), list.end(), BoundaryNode{body, mesh_node, 0}, by_node) -
+          list.begin());
+    };
+    std::vector<char> far(list.size(), 0);
+    std::vector<std::string> far_message(list.size());
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const Vec3 x = vec3_at(nodes.x0.data(), list[i].node);
+      std::array<std::int64_t, 3> cell{};
+      try {
+        cell = tolerance_cell(x, tol);
+      } catch (const InputError& e) {
+        far[i] = 1;
+        far_message[i] = e.what();
+        continue;
+      }
+      // The directory blocks within one cell of this one: the node's home block's rank answers
+      // for it, every rank of those blocks may need it as a candidate.
+      std::int64_t options[3][3];
+      int n_options[3];
+      std::int64_t home[3];
+      for (int k = 0; k < 3; ++k) {
+        home[k] = floor_div(cell[k], block_cells);
+        const std::int64_t r = cell[k] - home[k] * block_cells;
+        n_options[k] = 0;
+        options[k][n_options[k]++] = home[k];
+        if (r == 0) options[k][n_options[k]++] = home[k] - 1;
+        if (r == block_cells - 1) options[k][n_options[k]++] = home[k] + 1;
+      }
+      const int home_rank = hashed_rank({home[0], home[1], home[2]}, ranks);
+      std::vector<int> to;
+      for (int a = 0; a < n_options[0]; ++a)
+        for (int b = 0; b < n_options[1]; ++b)
+          for (int c = 0; c < n_options[2]; ++c)
+            to.push_back(hashed_rank({options[0][a], options[1][b], options[2][c]}, ranks));
+      std::sort(to.begin(), to.end());
+      to.erase(std::unique(to.begin(), to.end()), to.end());
+      PosNode p{{cell[0], cell[1], cell[2]},
+                list[i].mesh_node,
+                {x[0], x[1], x[2]},
+                list[i].body,
+                nodes.piece[list[i].node],
+                0,
+                0};
+      for (int r : to) {
+        p.home = r == home_rank;
+        positions[static_cast<std::size_t>(r)].push_back(p);
+      }
+    }
+    // A node too far from the origin: where the serial builder meets it first.
+    for (const OwnedBoundary& f : owned_boundary)
+      for (int i = 0; i < 3; ++i) {
+        const std::size_t at = index_of(f.body, f.key[i]);
+        if (!far[at]) continue;
+        const auto b = static_cast<std::size_t>(f.body);
+        const ErrorKey where{0, 0, {f.key[0], f.key[1], f.key[2], i}};
+        const auto offer = [&](std::int64_t stage, std::int64_t kind) {
+          ErrorKey k = where;
+          k.stage = stage;
+          k.kind = kind;
+          error.offer(k, [&] { return far_message[at]; });
+        };
+        if (roles.bonded[b]) offer(f.body, 1);
+        for (std::int32_t k : roles.as_b[b]) offer(n_bodies + k, 0);
+        for (std::int32_t k : roles.as_a[b]) offer(n_bodies + k, 1);
+      }
+  }
+
+  // 3  Position directory: the partners of the nodes this rank answers for.
+  {
+    std::vector<int> asker;
+    std::vector<PosNode> seen = comm.exchange(positions, &asker);
+    positions = {};
+    std::vector<std::size_t> order(seen.size());
+    std::iota(order.begin(), order.end(), 0);
+    const auto same_node = [&](std::size_t a, std::size_t b) {
+      return seen[a].body == seen[b].body && seen[a].mesh_node == seen[b].mesh_node;
+    };
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      if (seen[a].body != seen[b].body) return seen[a].body < seen[b].body;
+      return seen[a].mesh_node != seen[b].mesh_node ? seen[a].mesh_node < seen[b].mesh_node : a < b;
+    });
+    std::vector<std::size_t> unique_nodes;  // first entry of each node
+    for (std::size_t i = 0; i < order.size(); ++i)
+      if (i == 0 || !same_node(order[i], order[i - 1])) unique_nodes.push_back(order[i]);
+    std::unordered_map<Key, std::vector<std::size_t>, KeyHash> grid;
+    for (std::size_t u : unique_nodes)
+      grid[{seen[u].cell[0], seen[u].cell[1], seen[u].cell[2]}].push_back(u);
+    std::vector<std::vector<NodeMatch>> answers(static_cast<std::size_t>(ranks));
+    std::vector<NodeMatch> found;
+    for (std::size_t i = 0; i < order.size();) {
+      std::size_t j = i;
+      while (j < order.size() && same_node(order[j], order[i])) ++j;
+      const PosNode& m = seen[order[i]];
+      const auto b = static_cast<std::size_t>(m.body);
+      bool home = false;
+      for (std::size_t k = i; k < j; ++k) home = home || seen[order[k]].home;
+      found.clear();
+      if (home) {
+        const Vec3 x(m.x[0], m.x[1], m.x[2]);
+        for (int dx = -1; dx <= 1; ++dx)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dz = -1; dz <= 1; ++dz) {
+              const int d[3] = {dx, dy, dz};
+              Key c;
+              bool inside = true;
+              for (int k = 0; k < 3; ++k) {
+                const std::int64_t limit = d[k] < 0 ? std::numeric_limits<std::int64_t>::min()
+                                                    : std::numeric_limits<std::int64_t>::max();
+                inside = inside && (d[k] == 0 || m.cell[k] != limit);
+                c[k] = inside ? m.cell[k] + d[k] : 0;
+              }
+              if (!inside) continue;
+              const auto g = grid.find(c);
+              if (g == grid.end()) continue;
+              for (std::size_t u : g->second) {
+                const PosNode& n = seen[u];
+                if (n.body == m.body && n.piece == m.piece) continue;
+                if (!((Vec3(n.x[0], n.x[1], n.x[2]) - x).norm() <= tol)) continue;
+                if (n.body == m.body) {
+                  if (roles.bonded[b] && n.piece > m.piece)
+                    found.push_back({m.mesh_node, n.mesh_node, m.body, n.piece});
+                  continue;
+                }
+                for (std::int32_t k : roles.as_a[b])
+                  if (scene.interfaces[static_cast<std::size_t>(k)].body_b == n.body)
+                    found.push_back({m.mesh_node, n.mesh_node, m.body, -1 - k});
+              }
+            }
+        // The lowest-numbered partner per piece or interface.
+        std::sort(found.begin(), found.end(), [](const NodeMatch& p, const NodeMatch& q) {
+          return p.target != q.target ? p.target < q.target : p.partner < q.partner;
+        });
+        found.erase(std::unique(found.begin(), found.end(),
+                                [](const NodeMatch& p, const NodeMatch& q) {
+                                  return p.target == q.target;
+                                }),
+                    found.end());
+        for (std::size_t k = i; k < j; ++k)
+          if (seen[order[k]].home)
+            answers[static_cast<std::size_t>(asker[order[k]])].insert(
+                answers[static_cast<std::size_t>(asker[order[k]])].end(), found.begin(),
+                found.end());
+      }
+      i = j;
+    }
+    seen = {};
+    grid.clear();
+
+    // 4  Owners of boundary faces: the partner triangles, asked of their face directories.
+    std::vector<NodeMatch> matches = comm.exchange(answers);
+    answers = {};
+    std::sort(matches.begin(), matches.end(), [](const NodeMatch& p, const NodeMatch& q) {
+      if (p.body != q.body) return p.body < q.body;
+      if (p.mesh_node != q.mesh_node) return p.mesh_node < q.mesh_node;
+      return p.target < q.target;
+    });
+    const auto partner = [&](std::int32_t body, std::int64_t mesh_node, std::int32_t target) {
+      const NodeMatch probe{mesh_node, 0, body, target};
+      const auto it = std::lower_bound(matches.begin(), matches.end(), probe,
+                                       [](const NodeMatch& p, const NodeMatch& q) {
+                                         if (p.body != q.body) return p.body < q.body;
+                                         if (p.mesh_node != q.mesh_node)
+                                           return p.mesh_node < q.mesh_node;
+                                         return p.target < q.target;
+                                       });
+      return it != matches.end() && it->body == body && it->mesh_node == mesh_node &&
+                     it->target == target
+                 ? it->partner
+                 : std::int64_t{-1};
+    };
+    std::vector<std::vector<FaceQuery>> queries(static_cast<std::size_t>(ranks));
+    for (const OwnedBoundary& f : owned_boundary) {
+      const auto b = static_cast<std::size_t>(f.body);
+      FaceQuery q{};
+      q.tet = tets.gid[f.tet];
+      for (int i = 0; i < 3; ++i) q.node[i] = nodes.gid[f.node[i]];
+      q.volume = tets.volume0[f.tet];
+      q.extent = tet_extent[static_cast<std::size_t>(f.tet)];
+      const auto ask = [&](std::int32_t target, std::int32_t body, std::int32_t group,
+                           std::int32_t counter) {
+        for (int i = 0; i < 3; ++i)
+          if ((q.partner[i] = partner(f.body, f.key[i], target)) < 0) return;
+        std::copy_n(q.partner, 3, q.key);
+        std::sort(q.key, q.key + 3);
+        q.body = body;
+        q.group = group;
+        q.counter = counter;
+        queries[static_cast<std::size_t>(face_rank(body, q.key, ranks))].push_back(q);
+      };
+      if (roles.bonded[b]) {
+        const NodeMatch probe{f.key[0], 0, f.body, 0};
+        auto it = std::lower_bound(matches.begin(), matches.end(), probe,
+                                   [](const NodeMatch& p, const NodeMatch& r) {
+                                     if (p.body != r.body) return p.body < r.body;
+                                     if (p.mesh_node != r.mesh_node)
+                                       return p.mesh_node < r.mesh_node;
+                                     return p.target < r.target;
+                                   });
+        for (; it != matches.end() && it->body == f.body && it->mesh_node == f.key[0]; ++it)
+          ask(it->target, f.body, material_of(f.body), f.body);
+      }
+      for (std::int32_t k : roles.as_a[b])
+        ask(-1 - k, scene.interfaces[static_cast<std::size_t>(k)].body_b, n_materials + k,
+            n_bodies + k);
+    }
+    owned_boundary = {};
+
+    // 5  Face directory: a partner triangle that is a boundary face makes a joint.
+    std::vector<std::int64_t> counts(static_cast<std::size_t>(n_bodies) + scene.interfaces.size(),
+                                     0);
+    const auto by_face = [](const FaceRecord& p, const FaceRecord& q) {
+      if (p.body != q.body) return p.body < q.body;
+      return std::lexicographical_compare(p.key, p.key + 3, q.key, q.key + 3);
+    };
+    std::sort(boundary.begin(), boundary.end(), by_face);
+    for (const FaceQuery& q : comm.exchange(queries)) {
+      FaceRecord probe{};
+      std::copy_n(q.key, 3, probe.key);
+      probe.body = q.body;
+      const auto it = std::lower_bound(boundary.begin(), boundary.end(), probe, by_face);
+      if (it == boundary.end() || by_face(probe, *it)) continue;  // not one boundary triangle
+      GlobalId b_nodes[3];
+      for (int i = 0; i < 3; ++i) {
+        const int at = static_cast<int>(std::find(it->key, it->key + 3, q.partner[i]) - it->key);
+        FDEM_VERIFY(at < 3, "a partner triangle holds the partner nodes");
+        b_nodes[i] = it->node[at];
+      }
+      send_draft(make_draft(q.tet, q.node, q.volume, q.extent, it->tet, b_nodes, it->volume,
+                            it->extent, q.group));
+      ++counts[static_cast<std::size_t>(q.counter)];
+    }
+    comm.sum_in_place(counts);
+    for (std::int32_t b = 0; b < n_bodies; ++b)
+      if (roles.bonded[static_cast<std::size_t>(b)] && counts[static_cast<std::size_t>(b)] == 0)
+        error.offer({b, 2, {0, 0, 0, 0}}, [&] {
+          return no_touching_pieces_message(scene, static_cast<std::size_t>(b), sources[b]);
+        });
+    for (std::size_t k = 0; k < scene.interfaces.size(); ++k)
+      if (counts[static_cast<std::size_t>(n_bodies) + k] == 0)
+        error.offer({n_bodies + static_cast<std::int64_t>(k), 2, {0, 0, 0, 0}},
+                    [&] { return no_interface_match_message(scene, k, tol); });
+  }
+  error.raise(comm);
+
+  // 6  Owners of tet A: orientation, area, size bin; bonds.
+  std::vector<DraftRecord> arrived = comm.exchange(drafts);
+  drafts = {};
+  arrived.insert(arrived.end(), local_drafts.begin(), local_drafts.end());
+  local_drafts = {};
+  struct Placed {
+    StartJoint joint;
+    std::int32_t group;
+    std::int64_t bin;
+  };
+  std::vector<Placed> placed;
+  const double* x0 = nodes.x0.data();
+  for (const DraftRecord& d : arrived) {
+    const int side = d.role;  // the local tet: A for a joint, B for a bond
+    const LocalIndex t = static_cast<LocalIndex>(d.tet[side] - first_tet);
+    FDEM_VERIFY(t >= 0 && t < tets.size(), "a joint reaches the owner of its tet");
+    out.bonded[static_cast<std::size_t>(t)] = 1;
+    double& extent = out.partner_extent[static_cast<std::size_t>(t)];
+    extent = std::max(extent, d.extent[1 - side]);
+    if (d.role != 0) continue;
+    Placed p{};
+    StartJoint& j = p.joint;
+    j.tets[0] = d.tet[0];
+    j.tets[1] = d.tet[1];
+    LocalIndex a[3] = {-1, -1, -1}, opposite = -1;
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = tets.nodes[4 * static_cast<std::size_t>(t) + c];
+      bool on_face = false;
+      for (int i = 0; i < 3; ++i)
+        if (nodes.gid[n] == d.a[i]) {
+          a[i] = n;
+          on_face = true;
+        }
+      if (!on_face) opposite = n;
+    }
+    FDEM_VERIFY(a[0] >= 0 && a[1] >= 0 && a[2] >= 0 && opposite >= 0,
+                "a joint's face nodes are three corners of its tet A");
+    GlobalId b[3] = {d.b[0], d.b[1], d.b[2]};
+    if (joint_face_turned(vec3_at(x0, a[0]), vec3_at(x0, a[1]), vec3_at(x0, a[2]),
+                          vec3_at(x0, opposite))) {
+      std::swap(a[1], a[2]);
+      std::swap(b[1], b[2]);
+    }
+    for (int i = 0; i < 3; ++i) {
+      j.nodes[i] = nodes.gid[a[i]];
+      j.nodes[3 + i] = b[i];
+    }
+    j.area0 = joint_face_area(vec3_at(x0, a[0]), vec3_at(x0, a[1]), vec3_at(x0, a[2]));
+    p.group = d.group;
+    p.bin = joint_size_bin(tets.volume0[t], d.volume[1], j.area0);
+    placed.push_back(p);
+  }
+  arrived = {};
+
+  // 7  Laws in ascending (group, bin) over all ranks; joint gids in ascending (gid A, gid B).
+  struct LawKey {
+    std::int64_t group, bin;
+    bool operator<(const LawKey& o) const {
+      return group != o.group ? group < o.group : bin < o.bin;
+    }
+    bool operator==(const LawKey& o) const { return group == o.group && bin == o.bin; }
+  };
+  std::vector<LawKey> keys;
+  for (const Placed& p : placed) keys.push_back({p.group, p.bin});
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  keys = comm.allgatherv(keys);
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  for (const LawKey& k : keys)
+    out.laws.push_back(
+        joint_law(scene, static_cast<std::int32_t>(k.group), static_cast<long>(k.bin)));
+  std::sort(placed.begin(), placed.end(), [](const Placed& p, const Placed& q) {
+    return p.joint.tets[0] != q.joint.tets[0] ? p.joint.tets[0] < q.joint.tets[0]
+                                              : p.joint.tets[1] < q.joint.tets[1];
+  });
+  const std::vector<std::int64_t> per_rank =
+      comm.allgather(static_cast<std::int64_t>(placed.size()));
+  const GlobalId base = std::accumulate(per_rank.begin(), per_rank.begin() + me, std::int64_t{0});
+  out.n_joints = std::accumulate(per_rank.begin(), per_rank.end(), std::int64_t{0});
+  out.joints.reserve(placed.size());
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    StartJoint j = placed[i].joint;
+    j.gid = base + static_cast<GlobalId>(i);
+    j.law = static_cast<std::int32_t>(
+        std::lower_bound(keys.begin(), keys.end(), LawKey{placed[i].group, placed[i].bin}) -
+        keys.begin());
+    out.joints.push_back(j);
+  }
+  return out;
+}
+
+}  // namespace fdem
