@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/joint_placement.hpp"
 #include "core/tet_kernels.hpp"
 #include "parallel/distributed_joints.hpp"
 
