@@ -3,7 +3,6 @@
 // shapes, initial velocities and kinematic constraints.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -85,36 +84,4 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes,
 
 // Applies fixed bodies and kinematic loads to the nodes' constraint masks.
 void apply_constraints(const Scene& scene, Model& model);
-
-// Joint placement pieces shared by build_model and the distributed start-up
-// (parallel/distributed_joints), so that both place the same joints with the same bits.
-
-// Touching pieces and interfaces match node positions within this distance (m): 1e-9 of the
-// extent of the box of all nodes.
-double matching_tolerance(const Vec3& extent);
-// The cell of a hash grid of spacing `tol` (m) that holds x; two nodes within tol lie in cells
-// at most one apart along each axis.  A coordinate so far from the origin that x / tol leaves the
-// 64-bit range cannot be matched to a neighbour's: InputError.
-std::array<std::int64_t, 3> tolerance_cell(const Vec3& x, double tol);
-
-// Whether the face (a0, a1, a2) of tet A must be turned (a1 ↔ a2, and b1 ↔ b2 on the other side)
-// so that (a1 − a0) × (a2 − a0) points away from A's fourth corner `opposite`.
-bool joint_face_turned(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& opposite);
-// Area (m²) of the joint face as oriented.
-double joint_face_area(const Vec3& a0, const Vec3& a1, const Vec3& a2);
-// Element-size bin of a joint: h = mean of the two tets' altitudes onto the face (volumes m³,
-// area m²), binned by a ratio of 1.02.
-long joint_size_bin(double volume_a, double volume_b, double area);
-// The law of a joint group (material index, or materials + interface index) and size bin.  Laws
-// are numbered in ascending (group, bin) — not in order of appearance — so that any placement
-// order, and any rank count, numbers them alike.
-JointLawSpec joint_law(const Scene& scene, std::int32_t group, long bin);
-
-// The builders' messages for a mesh joints cannot be placed on (mesh nodes 0-based).
-std::string non_manifold_message(const std::string& body, const std::string& source,
-                                 const std::array<std::int64_t, 3>& mesh_nodes);
-std::string no_touching_pieces_message(const Scene& scene, std::size_t body,
-                                       const std::string& source);
-std::string no_interface_match_message(const Scene& scene, std::size_t interface, double tol);
-
 }  // namespace fdem

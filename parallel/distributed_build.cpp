@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/joint_placement.hpp"
 #include "core/tet_kernels.hpp"
 #include "parallel/distributed_joints.hpp"
 
@@ -559,23 +560,27 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     node_extent[static_cast<std::size_t>(n)] = m.extent;
   }
 
-  // Joints (parallel/distributed_joints), and the reach of each tet over the whole model.
-  std::vector<std::string> sources;
-  for (const BodyChunks& body : chunks) sources.push_back(body.source);
-  BlockJoints joints = place_block_joints(scene, sources, model, tet_extent, face_tets,
-                                          out.tet_block, matching_tolerance(hi - lo), comm);
+  // Joints (parallel/distributed_joints; every rank knows from the scene whether there are any),
+  // and the reach of each tet over the whole model.
+  BlockJoints joints;
+  if (std::find(has_faces.begin(), has_faces.end(), 1) != has_faces.end()) {
+    std::vector<std::string> sources;
+    for (const BodyChunks& body : chunks) sources.push_back(body.source);
+    joints = place_block_joints(scene, sources, model, tet_extent, face_tets, out.tet_block,
+                                matching_tolerance(hi - lo), comm);
+  }
   face_tets = {};
   out.joints = std::move(joints.joints);
   out.n_joints = joints.n_joints;
   model.joint_laws = std::move(joints.laws);
   if (out.n_joints > 0) out.tet_joint_state = std::move(joints.bonded);
-  out.tet_reach.resize(static_cast<std::size_t>(n_tets));
+  out.tet_reach = std::move(tet_extent);
   for (LocalIndex t = 0; t < n_tets; ++t) {
-    double reach = std::max(tet_extent[static_cast<std::size_t>(t)],
-                            joints.partner_extent[static_cast<std::size_t>(t)]);
+    double& reach = out.tet_reach[static_cast<std::size_t>(t)];
+    if (!joints.partner_extent.empty())
+      reach = std::max(reach, joints.partner_extent[static_cast<std::size_t>(t)]);
     for (int c = 0; c < 4; ++c)
       reach = std::max(reach, node_extent[static_cast<std::size_t>(tets.nodes[4 * t + c])]);
-    out.tet_reach[static_cast<std::size_t>(t)] = reach;
   }
 
   // Pieces, velocities, constraints, force order.

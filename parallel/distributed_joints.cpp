@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <functional>
-#include <initializer_list>
 #include <limits>
 #include <numeric>
-#include <unordered_map>
 
 #include "core/error.hpp"
-#include "core/model_builder.hpp"
+#include "core/joint_placement.hpp"
+#include "parallel/boundary_matching.hpp"
+#include "parallel/directory_hash.hpp"
 
 namespace fdem {
 
@@ -17,41 +17,13 @@ namespace {
 
 using Key = std::array<std::int64_t, 3>;
 
-std::uint64_t mix(std::uint64_t h) {  // splitmix64's finaliser
-  h ^= h >> 30;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 27;
-  h *= 0x94d049bb133111ebULL;
-  return h ^ (h >> 31);
-}
-
-std::uint64_t hash_of(std::initializer_list<std::int64_t> values) {
-  std::uint64_t h = 0x9E3779B97F4A7C15ULL;
-  for (std::int64_t v : values) h = mix(h ^ static_cast<std::uint64_t>(v));
-  return h;
-}
-
-int hashed_rank(std::initializer_list<std::int64_t> values, int ranks) {
-  return static_cast<int>(hash_of(values) % static_cast<std::uint64_t>(ranks));
-}
-
 int face_rank(std::int32_t body, const std::int64_t* key, int ranks) {
-  return hashed_rank({body, key[0], key[1], key[2]}, ranks);
+  return directory_rank({body, key[0], key[1], key[2]}, ranks);
 }
 
 int block_owner(const std::vector<GlobalId>& block, GlobalId g) {
   return static_cast<int>(std::upper_bound(block.begin(), block.end(), g) - block.begin()) - 1;
 }
-
-// ⌊c / k⌋ for k > 0.
-std::int64_t floor_div(std::int64_t c, std::int64_t k) {
-  std::int64_t q = c / k;
-  if (c % k != 0 && c < 0) --q;
-  return q;
-}
-
-// Tolerance cells per position-directory block and axis.
-constexpr std::int64_t block_cells = 1024;
 
 // A face of a local tet: sorted mesh node numbers, body, tet, the corner left out.
 struct LocalFace {
@@ -79,19 +51,6 @@ struct FacePresence {
 struct BoundaryNotice {
   GlobalId tet;
   std::int64_t key[3];
-};
-// A boundary node on its way to a position directory.
-struct PosNode {
-  std::int64_t cell[3];  // tolerance cell
-  std::int64_t mesh_node;
-  double x[3];  // m
-  std::int32_t body, piece, home, unused;
-};
-// The partner of a boundary node: in piece `target` (>= 0) of its body, or in the other body of
-// interface −1 − target.
-struct NodeMatch {
-  std::int64_t mesh_node, partner;
-  std::int32_t body, target;
 };
 // Is `key` (sorted partner nodes) a boundary face of `body`?  Asked by the owner of the tet of
 // a boundary face whose node i has partner[i].
@@ -189,12 +148,6 @@ struct Roles {
   }
   // Whether the body's boundary faces are matched by position.
   bool matched(std::size_t b) const { return bonded[b] || !as_a[b].empty() || !as_b[b].empty(); }
-};
-
-struct KeyHash {
-  std::size_t operator()(const Key& k) const {
-    return static_cast<std::size_t>(hash_of({k[0], k[1], k[2]}));
-  }
 };
 
 }  // namespace
@@ -354,7 +307,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
     }
   }
 
-  // 2  Owners of boundary faces: their nodes to the position directories.
+  // 2–3  Owners of boundary faces: their nodes' partners (parallel/boundary_matching).
   struct OwnedBoundary {
     Key key;
     LocalIndex tet;
@@ -362,98 +315,46 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
     LocalIndex node[3];
   };
   std::vector<OwnedBoundary> owned_boundary;
-  std::vector<std::vector<PosNode>> positions(static_cast<std::size_t>(ranks));
+  std::vector<NodeMatch> matches;  // partners of this rank's boundary nodes
+  for (const BoundaryNotice& n : comm.exchange(notices)) {
+    const LocalIndex t = static_cast<LocalIndex>(n.tet - first_tet);
+    const auto it = std::lower_bound(face_tets.begin(), face_tets.end(), t,
+                                     [](const FaceTet& f, LocalIndex v) { return f.tet < v; });
+    FDEM_VERIFY(it != face_tets.end() && it->tet == t, "a boundary face's tet is a face tet");
+    OwnedBoundary f{{n.key[0], n.key[1], n.key[2]}, t, it->body, {}};
+    for (int i = 0; i < 3; ++i) f.node[i] = node_at(*it, f.key[i]);
+    owned_boundary.push_back(f);
+  }
+  notices = {};
   {
-    for (const BoundaryNotice& n : comm.exchange(notices)) {
-      const LocalIndex t = static_cast<LocalIndex>(n.tet - first_tet);
-      const auto it = std::lower_bound(face_tets.begin(), face_tets.end(), t,
-                                       [](const FaceTet& f, LocalIndex v) { return f.tet < v; });
-      FDEM_VERIFY(it != face_tets.end() && it->tet == t, "a boundary face's tet is a face tet");
-      OwnedBoundary f{{n.key[0], n.key[1], n.key[2]}, t, it->body, {}};
-      for (int i = 0; i < 3; ++i) f.node[i] = node_at(*it, f.key[i]);
-      owned_boundary.push_back(f);
-    }
-    notices = {};
-    // Each boundary node once (a split body's copies of one mesh node: once), with its cell.
-    struct BoundaryNode {
-      std::int32_t body;
-      std::int64_t mesh_node;
-      LocalIndex node;
-    };
-    std::vector<BoundaryNode> list;
-    for (const OwnedBoundary& f : owned_boundary)
-      for (int i = 0; i < 3; ++i) list.push_back({f.body, f.key[i], f.node[i]});
-    const auto by_node = [](const BoundaryNode& a, const BoundaryNode& b) {
-      return a.body != b.body ? a.body < b.body : a.mesh_node < b.mesh_node;
-    };
-    std::sort(list.begin(), list.end(), by_node);
-    list.erase(std::unique(list.begin(), list.end(),
-                           [](const BoundaryNode& a, const BoundaryNode& b) {
-                             return a.body == b.body && a.mesh_node == b.mesh_node;
-                           }),
-               list.end());
-    const auto index_of = [&](std::int32_t body, std::int64_t mesh_node) {
-      return static_cast<std::size_t>(
-          std::lower_bound(list.begin(), list.end(), BoundaryNode{body, mesh_node, 0}, by_node) -
-          list.begin());
-    };
-    std::vector<char> far(list.size(), 0);
-    std::vector<std::string> far_message(list.size());
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const Vec3 x = vec3_at(nodes.x0.data(), list[i].node);
-      std::array<std::int64_t, 3> cell{};
-      try {
-        cell = tolerance_cell(x, tol);
-      } catch (const InputError& e) {
-        far[i] = 1;
-        far_message[i] = e.what();
-        continue;
-      }
-      // The directory blocks within one cell of this one: the node's home block's rank answers
-      // for it, every rank of those blocks may need it as a candidate.
-      std::int64_t options[3][3];
-      int n_options[3];
-      std::int64_t home[3];
-      for (int k = 0; k < 3; ++k) {
-        home[k] = floor_div(cell[k], block_cells);
-        const std::int64_t r = cell[k] - home[k] * block_cells;
-        n_options[k] = 0;
-        options[k][n_options[k]++] = home[k];
-        if (r == 0) options[k][n_options[k]++] = home[k] - 1;
-        if (r == block_cells - 1) options[k][n_options[k]++] = home[k] + 1;
-      }
-      const int home_rank = hashed_rank({home[0], home[1], home[2]}, ranks);
-      std::vector<int> to;
-      for (int a = 0; a < n_options[0]; ++a)
-        for (int b = 0; b < n_options[1]; ++b)
-          for (int c = 0; c < n_options[2]; ++c)
-            to.push_back(hashed_rank({options[0][a], options[1][b], options[2][c]}, ranks));
-      std::sort(to.begin(), to.end());
-      to.erase(std::unique(to.begin(), to.end()), to.end());
-      PosNode p{{cell[0], cell[1], cell[2]},
-                list[i].mesh_node,
-                {x[0], x[1], x[2]},
-                list[i].body,
-                nodes.piece[list[i].node],
-                0,
-                0};
-      for (int r : to) {
-        p.home = r == home_rank;
-        positions[static_cast<std::size_t>(r)].push_back(p);
-      }
-    }
-    // A node too far from the origin: where the serial builder meets it first.
+    // Each boundary node once (a split body's copies of one mesh node: once).
+    std::vector<BoundaryPoint> points;
     for (const OwnedBoundary& f : owned_boundary)
       for (int i = 0; i < 3; ++i) {
-        const std::size_t at = index_of(f.body, f.key[i]);
-        if (!far[at]) continue;
+        const Vec3 x = vec3_at(nodes.x0.data(), f.node[i]);
+        points.push_back({f.body, nodes.piece[f.node[i]], f.key[i], {x[0], x[1], x[2]}});
+      }
+    const auto by_node = [](const BoundaryPoint& a, const BoundaryPoint& b) {
+      return a.body != b.body ? a.body < b.body : a.mesh_node < b.mesh_node;
+    };
+    std::sort(points.begin(), points.end(), by_node);
+    points.erase(std::unique(points.begin(), points.end(),
+                             [](const BoundaryPoint& a, const BoundaryPoint& b) {
+                               return a.body == b.body && a.mesh_node == b.mesh_node;
+                             }),
+                 points.end());
+    std::vector<std::string> far;
+    matches = match_boundary_points(scene, points, tol, comm, &far);
+    // A node too far from the origin to match: where the serial builder meets it first.
+    for (const OwnedBoundary& f : owned_boundary)
+      for (int i = 0; i < 3; ++i) {
+        const BoundaryPoint probe{f.body, 0, f.key[i], {0, 0, 0}};
+        const std::size_t at = static_cast<std::size_t>(
+            std::lower_bound(points.begin(), points.end(), probe, by_node) - points.begin());
+        if (far[at].empty()) continue;
         const auto b = static_cast<std::size_t>(f.body);
-        const ErrorKey where{0, 0, {f.key[0], f.key[1], f.key[2], i}};
         const auto offer = [&](std::int64_t stage, std::int64_t kind) {
-          ErrorKey k = where;
-          k.stage = stage;
-          k.kind = kind;
-          error.offer(k, [&] { return far_message[at]; });
+          error.offer({stage, kind, {f.key[0], f.key[1], f.key[2], i}}, [&] { return far[at]; });
         };
         if (roles.bonded[b]) offer(f.body, 1);
         for (std::int32_t k : roles.as_b[b]) offer(n_bodies + k, 0);
@@ -461,104 +362,11 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
       }
   }
 
-  // 3  Position directory: the partners of the nodes this rank answers for.
+  // 4  Owners of boundary faces: the partner triangles, asked of their face directories.
   {
-    std::vector<int> asker;
-    std::vector<PosNode> seen = comm.exchange(positions, &asker);
-    positions = {};
-    std::vector<std::size_t> order(seen.size());
-    std::iota(order.begin(), order.end(), 0);
-    const auto same_node = [&](std::size_t a, std::size_t b) {
-      return seen[a].body == seen[b].body && seen[a].mesh_node == seen[b].mesh_node;
-    };
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      if (seen[a].body != seen[b].body) return seen[a].body < seen[b].body;
-      return seen[a].mesh_node != seen[b].mesh_node ? seen[a].mesh_node < seen[b].mesh_node : a < b;
-    });
-    std::vector<std::size_t> unique_nodes;  // first entry of each node
-    for (std::size_t i = 0; i < order.size(); ++i)
-      if (i == 0 || !same_node(order[i], order[i - 1])) unique_nodes.push_back(order[i]);
-    std::unordered_map<Key, std::vector<std::size_t>, KeyHash> grid;
-    for (std::size_t u : unique_nodes)
-      grid[{seen[u].cell[0], seen[u].cell[1], seen[u].cell[2]}].push_back(u);
-    std::vector<std::vector<NodeMatch>> answers(static_cast<std::size_t>(ranks));
-    std::vector<NodeMatch> found;
-    for (std::size_t i = 0; i < order.size();) {
-      std::size_t j = i;
-      while (j < order.size() && same_node(order[j], order[i])) ++j;
-      const PosNode& m = seen[order[i]];
-      const auto b = static_cast<std::size_t>(m.body);
-      bool home = false;
-      for (std::size_t k = i; k < j; ++k) home = home || seen[order[k]].home;
-      found.clear();
-      if (home) {
-        const Vec3 x(m.x[0], m.x[1], m.x[2]);
-        for (int dx = -1; dx <= 1; ++dx)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dz = -1; dz <= 1; ++dz) {
-              const int d[3] = {dx, dy, dz};
-              Key c;
-              bool inside = true;
-              for (int k = 0; k < 3; ++k) {
-                const std::int64_t limit = d[k] < 0 ? std::numeric_limits<std::int64_t>::min()
-                                                    : std::numeric_limits<std::int64_t>::max();
-                inside = inside && (d[k] == 0 || m.cell[k] != limit);
-                c[k] = inside ? m.cell[k] + d[k] : 0;
-              }
-              if (!inside) continue;
-              const auto g = grid.find(c);
-              if (g == grid.end()) continue;
-              for (std::size_t u : g->second) {
-                const PosNode& n = seen[u];
-                if (n.body == m.body && n.piece == m.piece) continue;
-                if (!((Vec3(n.x[0], n.x[1], n.x[2]) - x).norm() <= tol)) continue;
-                if (n.body == m.body) {
-                  if (roles.bonded[b] && n.piece > m.piece)
-                    found.push_back({m.mesh_node, n.mesh_node, m.body, n.piece});
-                  continue;
-                }
-                for (std::int32_t k : roles.as_a[b])
-                  if (scene.interfaces[static_cast<std::size_t>(k)].body_b == n.body)
-                    found.push_back({m.mesh_node, n.mesh_node, m.body, -1 - k});
-              }
-            }
-        // The lowest-numbered partner per piece or interface.
-        std::sort(found.begin(), found.end(), [](const NodeMatch& p, const NodeMatch& q) {
-          return p.target != q.target ? p.target < q.target : p.partner < q.partner;
-        });
-        found.erase(std::unique(found.begin(), found.end(),
-                                [](const NodeMatch& p, const NodeMatch& q) {
-                                  return p.target == q.target;
-                                }),
-                    found.end());
-        for (std::size_t k = i; k < j; ++k)
-          if (seen[order[k]].home)
-            answers[static_cast<std::size_t>(asker[order[k]])].insert(
-                answers[static_cast<std::size_t>(asker[order[k]])].end(), found.begin(),
-                found.end());
-      }
-      i = j;
-    }
-    seen = {};
-    grid.clear();
-
-    // 4  Owners of boundary faces: the partner triangles, asked of their face directories.
-    std::vector<NodeMatch> matches = comm.exchange(answers);
-    answers = {};
-    std::sort(matches.begin(), matches.end(), [](const NodeMatch& p, const NodeMatch& q) {
-      if (p.body != q.body) return p.body < q.body;
-      if (p.mesh_node != q.mesh_node) return p.mesh_node < q.mesh_node;
-      return p.target < q.target;
-    });
     const auto partner = [&](std::int32_t body, std::int64_t mesh_node, std::int32_t target) {
       const NodeMatch probe{mesh_node, 0, body, target};
-      const auto it = std::lower_bound(matches.begin(), matches.end(), probe,
-                                       [](const NodeMatch& p, const NodeMatch& q) {
-                                         if (p.body != q.body) return p.body < q.body;
-                                         if (p.mesh_node != q.mesh_node)
-                                           return p.mesh_node < q.mesh_node;
-                                         return p.target < q.target;
-                                       });
+      const auto it = std::lower_bound(matches.begin(), matches.end(), probe, match_order);
       return it != matches.end() && it->body == body && it->mesh_node == mesh_node &&
                      it->target == target
                  ? it->partner
@@ -585,13 +393,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
       };
       if (roles.bonded[b]) {
         const NodeMatch probe{f.key[0], 0, f.body, 0};
-        auto it = std::lower_bound(matches.begin(), matches.end(), probe,
-                                   [](const NodeMatch& p, const NodeMatch& r) {
-                                     if (p.body != r.body) return p.body < r.body;
-                                     if (p.mesh_node != r.mesh_node)
-                                       return p.mesh_node < r.mesh_node;
-                                     return p.target < r.target;
-                                   });
+        auto it = std::lower_bound(matches.begin(), matches.end(), probe, match_order);
         for (; it != matches.end() && it->body == f.body && it->mesh_node == f.key[0]; ++it)
           ask(it->target, f.body, material_of(f.body), f.body);
       }
