@@ -42,24 +42,20 @@ std::string read_whole_file(const std::string& path) {
 
 // Every node and tet of the file, as the parser hands them over.
 struct WholeFile : GmshSink {
-  std::vector<std::int64_t> node_tags;
-  std::vector<double> node_xyz;
-  std::vector<std::int64_t> tet_nodes;  // 4 per tet, node indices
-  std::vector<std::int64_t> tet_tags;
-  std::vector<int> tet_entity;
+  GmshArrays all;
 
   void nodes_announced(std::int64_t count) override {
-    node_tags.reserve(static_cast<std::size_t>(count));
-    node_xyz.reserve(3 * static_cast<std::size_t>(count));
+    all.node_tags.reserve(static_cast<std::size_t>(count));
+    all.node_xyz.reserve(3 * static_cast<std::size_t>(count));
   }
-  void node_tag(std::int64_t, std::int64_t tag) override { node_tags.push_back(tag); }
+  void node_tag(std::int64_t, std::int64_t tag) override { all.node_tags.push_back(tag); }
   void node_coords(std::int64_t, const double (&x)[3]) override {
-    node_xyz.insert(node_xyz.end(), x, x + 3);
+    all.node_xyz.insert(all.node_xyz.end(), x, x + 3);
   }
   void tet(std::int64_t tag, int entity, const std::int64_t (&nodes)[4]) override {
-    tet_nodes.insert(tet_nodes.end(), nodes, nodes + 4);
-    tet_tags.push_back(tag);
-    tet_entity.push_back(entity);
+    all.tet_nodes.insert(all.tet_nodes.end(), nodes, nodes + 4);
+    all.tet_tags.push_back(tag);
+    all.tet_entity.push_back(entity);
   }
 };
 
@@ -74,31 +70,35 @@ GmshMesh parse_gmsh(const std::string& data, const std::string& path, const std:
   WholeFile mesh;
   const auto index = make_table_index();
   const GmshTables tables = parse_gmsh_sections(cur, path, *index, mesh);
-  const std::string file = "Gmsh file '" + path + "'";
+  return select_gmsh(tables, mesh.all, physical, "Gmsh file '" + path + "'");
+}
+
+GmshMesh select_gmsh(const GmshTables& tables, const GmshArrays& all, const std::string& physical,
+                     const std::string& file) {
   const GmshSelection selection(tables, physical, file);
-  if (mesh.tet_tags.empty()) throw InputError(no_tetrahedra_message(file));
+  if (all.tet_tags.empty()) throw InputError(no_tetrahedra_message(file));
 
   GmshMesh out;
   out.physical_names = tables.names_3d;
-  std::vector<std::int64_t> new_index(mesh.node_tags.size(), -1);
-  for (std::size_t t = 0; t < mesh.tet_tags.size(); ++t) {
-    const int entity = mesh.tet_entity[t];
+  std::vector<std::int64_t> new_index(all.node_tags.size(), -1);
+  for (std::size_t t = 0; t < all.tet_tags.size(); ++t) {
+    const int entity = all.tet_entity[t];
     if (!selection.kept(entity)) continue;
-    out.tet_tags.push_back(mesh.tet_tags[t]);
+    out.tet_tags.push_back(all.tet_tags[t]);
     out.tet_physical.push_back(selection.physical_of(entity));
-    for (int k = 0; k < 4; ++k) new_index[static_cast<std::size_t>(mesh.tet_nodes[4 * t + k])] = 0;
+    for (int k = 0; k < 4; ++k) new_index[static_cast<std::size_t>(all.tet_nodes[4 * t + k])] = 0;
   }
   if (out.tet_tags.empty())
-    throw InputError(selection.empty_message(static_cast<std::int64_t>(mesh.tet_tags.size())));
+    throw InputError(selection.empty_message(static_cast<std::int64_t>(all.tet_tags.size())));
 
   // Keep used nodes in file order.
   std::int64_t next = 0;
   for (std::size_t i = 0; i < new_index.size(); ++i) {
     if (new_index[i] < 0) continue;
     new_index[i] = next++;
-    out.node_tags.push_back(mesh.node_tags[i]);
-    out.coords.insert(out.coords.end(), mesh.node_xyz.begin() + 3 * i,
-                      mesh.node_xyz.begin() + 3 * i + 3);
+    out.node_tags.push_back(all.node_tags[i]);
+    out.coords.insert(out.coords.end(), all.node_xyz.begin() + 3 * i,
+                      all.node_xyz.begin() + 3 * i + 3);
   }
   if (next > std::numeric_limits<std::int32_t>::max()) {
     throw InputError(file + ": " + std::to_string(next) +
@@ -106,11 +106,11 @@ GmshMesh parse_gmsh(const std::string& data, const std::string& path, const std:
                      "model into several bodies.");
   }
   out.tets.reserve(4 * out.tet_tags.size());
-  for (std::size_t t = 0; t < mesh.tet_tags.size(); ++t) {
-    if (!selection.kept(mesh.tet_entity[t])) continue;
+  for (std::size_t t = 0; t < all.tet_tags.size(); ++t) {
+    if (!selection.kept(all.tet_entity[t])) continue;
     for (int k = 0; k < 4; ++k) {
-      out.tets.push_back(static_cast<std::int32_t>(
-          new_index[static_cast<std::size_t>(mesh.tet_nodes[4 * t + k])]));
+      out.tets.push_back(
+          static_cast<std::int32_t>(new_index[static_cast<std::size_t>(all.tet_nodes[4 * t + k])]));
     }
   }
   return out;
