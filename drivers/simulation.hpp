@@ -181,8 +181,9 @@ class Simulation {
   long startup_peak_rss_kib_ = 0;                             // this rank, end of start-up
 };
 
-// Whether N ranks can start the scene without any rank holding the whole model: every mesh is
-// generated (box, wall, arch, tower) and no body has joints (docs/parallel.md).
+// Whether N ranks can start the scene without any rank holding the whole model: no body has
+// joints (docs/parallel.md).  Generated meshes are made chunk by chunk, file meshes read slice by
+// slice from a model file (a Gmsh file is prepared into one first).
 bool distributed_start_possible(const Scene& scene);
 
 // Builds a Simulation from a scene file (meshes loaded or generated).

@@ -71,4 +71,9 @@ struct ModelFileContent {
 };
 ModelFileContent read_model_file_content(const std::string& path);
 
+// Writes `content` as the model file `h5` (checksums, seal): tests and tools that need a model
+// file with given content (header: source, source_bytes, source_mtime_ns are kept; tet_physical
+// is derived from the tables as prepare derives it).  Throws IoError.
+void write_model_file(const ModelFileContent& content, const std::string& h5);
+
 }  // namespace fdem

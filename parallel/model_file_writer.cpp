@@ -282,24 +282,14 @@ void write_header(const Context& ctx, hid_t file, const ModelFileHeader& header)
   attribute("header_checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &checksum);
 }
 
-}  // namespace
-
-PrepareReport prepare_model_file(const std::string& msh, const std::string& h5,
-                                 const PrepareOptions& options) {
-  FDEM_VERIFY(options.block_rows > 0, "prepare: block_rows must be positive");
+// Writes the model file `h5` (under .tmp, sealed, renamed): `feed` hands the nodes and tets to
+// the writer and returns the tables.
+template <class Feed>
+PrepareReport write_model(const std::string& h5, const PrepareOptions& options,
+                          ModelFileHeader header, Feed&& feed) {
+  FDEM_VERIFY(options.block_rows > 0, "model file: block_rows must be positive");
   const Context ctx(h5, "model file", Context::Mode::write);
   const std::string tmp = h5 + ".tmp";
-  gmsh::Cursor cur(msh, options.window_bytes);  // InputError for a missing or unreadable file
-  ModelFileHeader header;
-  header.version = model_file_version;
-  header.source = msh;
-  struct stat status {};
-  if (::stat(msh.c_str(), &status) == 0) {
-    header.source_bytes = static_cast<std::int64_t>(status.st_size);
-    header.source_mtime_ns =
-        static_cast<std::int64_t>(status.st_mtim.tv_sec) * 1000000000 + status.st_mtim.tv_nsec;
-  }
-
   std::vector<FileRegion> regions;
   {
     const SilenceHdf5Errors silence;
@@ -314,15 +304,9 @@ PrepareReport prepare_model_file(const std::string& msh, const std::string& h5,
     try {
       Spill spill(ctx, h5 + ".tets.tmp");
       TableWriter writer(ctx, file.get(), spill, options.block_rows);
-      const auto index = make_run_index();
-      const GmshTables tables = parse_gmsh_sections(cur, msh, *index, writer);
-      if (tables.n_tets == 0) {  // as read_gmsh says it: unusable volume elements first
-        const std::string label = "Gmsh file '" + msh + "'";
-        if (!tables.unsupported.empty())
-          throw InputError(label + ", " + tables.unsupported.front().message);
-        throw InputError(no_tetrahedra_message(label));
-      }
+      const GmshTables tables = feed(writer);
       if (!H5Lexists(file.get(), "/nodes", H5P_DEFAULT)) writer.nodes_announced(0);
+      header.version = model_file_version;
       header.n_nodes = tables.n_nodes;
       header.n_tets = tables.n_tets;
       regions = writer.finish(tables);
@@ -348,6 +332,57 @@ PrepareReport prepare_model_file(const std::string& msh, const std::string& h5,
   }
   sync_directory_of(h5);
   return {header.n_nodes, header.n_tets};
+}
+
+}  // namespace
+
+PrepareReport prepare_model_file(const std::string& msh, const std::string& h5,
+                                 const PrepareOptions& options) {
+  gmsh::Cursor cur(msh, options.window_bytes);  // InputError for a missing or unreadable file
+  ModelFileHeader header;
+  header.source = msh;
+  struct stat status {};
+  if (::stat(msh.c_str(), &status) == 0) {
+    header.source_bytes = static_cast<std::int64_t>(status.st_size);
+    header.source_mtime_ns =
+        static_cast<std::int64_t>(status.st_mtim.tv_sec) * 1000000000 + status.st_mtim.tv_nsec;
+  }
+  return write_model(h5, options, header, [&](GmshSink& writer) {
+    const auto index = make_run_index();
+    GmshTables tables = parse_gmsh_sections(cur, msh, *index, writer);
+    if (tables.n_tets == 0) {  // as read_gmsh says it: unusable volume elements first
+      const std::string label = "Gmsh file '" + msh + "'";
+      if (!tables.unsupported.empty())
+        throw InputError(label + ", " + tables.unsupported.front().message);
+      throw InputError(no_tetrahedra_message(label));
+    }
+    return tables;
+  });
+}
+
+void write_model_file(const ModelFileContent& content, const std::string& h5) {
+  const std::size_t n = content.node_tag.size(), m = content.tet_tag.size();
+  FDEM_VERIFY(content.node_x.size() == 3 * n && content.tet_nodes.size() == 4 * m &&
+                  content.tet_entity.size() == m,
+              "model file content: array sizes do not match");
+  write_model(h5, {}, content.header, [&](GmshSink& writer) {
+    writer.nodes_announced(static_cast<std::int64_t>(n));
+    for (std::size_t i = 0; i < n; ++i) writer.node_tag(std::int64_t(i), content.node_tag[i]);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x[3] = {content.node_x[3 * i], content.node_x[3 * i + 1],
+                           content.node_x[3 * i + 2]};
+      writer.node_coords(std::int64_t(i), x);
+    }
+    for (std::size_t t = 0; t < m; ++t) {
+      const std::int64_t nodes[4] = {content.tet_nodes[4 * t], content.tet_nodes[4 * t + 1],
+                                     content.tet_nodes[4 * t + 2], content.tet_nodes[4 * t + 3]};
+      writer.tet(content.tet_tag[t], content.tet_entity[t], nodes);
+    }
+    GmshTables tables = content.tables;
+    tables.n_nodes = static_cast<std::int64_t>(n);
+    tables.n_tets = static_cast<std::int64_t>(m);
+    return tables;
+  });
 }
 
 }  // namespace fdem
