@@ -27,9 +27,11 @@ struct BodyMesh {
 // exactly the mesh the whole generator gives.
 struct MeshChunk {
   BodyMesh mesh;
-  std::vector<std::int64_t> node_id;  // per chunk node: its number in the whole body mesh
-  std::vector<std::int64_t> tet_id;   // per chunk tet: its number in the whole body mesh
-  std::int32_t piece = 0;             // the connected piece of the body the chunk lies in
+  std::vector<std::int64_t> node_id;    // per chunk node: its number in the whole body mesh
+  std::vector<std::int64_t> tet_id;     // per chunk tet: its number in the whole body mesh
+  std::int32_t piece = 0;               // the connected piece of the body the chunk lies in
+  std::vector<std::int32_t> tet_piece;  // per chunk tet, when the chunk spans several pieces
+                                        // (empty: every tet is in `piece`)
 };
 
 // How a body's mesh splits into chunks, without generating it.
@@ -42,6 +44,9 @@ struct BodyChunks {
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // box of the body's nodes (m; for curved units
                                               // that of their corners)
   std::string source;                         // the whole mesh's BodyMesh::source (for messages)
+  // Empty: chunks are dealt to ranks along a space-filling curve.  Else chunk c is generated on
+  // rank chunk_rank[c] (a plan made on the ranks already: slices of a model file).
+  std::vector<int> chunk_rank;
   std::function<MeshChunk(std::int64_t chunk)> generate;
 };
 

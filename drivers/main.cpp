@@ -14,6 +14,7 @@
 #include "fracture/joint_stage.hpp"
 #include "io/scene_reader.hpp"
 #include "parallel/communicator.hpp"
+#include "parallel/model_file.hpp"
 
 namespace {
 
@@ -28,6 +29,7 @@ const char* usage =
     "  fdem run SCENE.yaml [-o OUTDIR] [--set key.path=value ...] [--restart CHECKPOINT.h5] [-q]\n"
     "  mpirun -np N fdem run SCENE.yaml ...   (N ranks; results identical to one rank)\n"
     "  fdem check SCENE.yaml [--set key.path=value ...]\n"
+    "  fdem prepare MESH.msh [-o MODEL.h5] [--block-rows N]   (a Gmsh mesh into a model file)\n"
     "  fdem --version\n";
 
 int check(const fdem::Scene& scene) {
@@ -78,6 +80,7 @@ int check(const fdem::Scene& scene) {
 }  // namespace
 
 int run_command(int argc, char** argv, const fdem::Communicator& world);
+int prepare_command(const std::vector<std::string>& args, const fdem::Communicator& world);
 
 int main(int argc, char** argv) {
   // Under mpirun every rank runs the same command; one rank alone is a serial run.
@@ -111,6 +114,7 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
     return 0;
   }
   const std::string command = args[0];
+  if (command == "prepare") return prepare_command(args, world);
   if (command != "run" && command != "check") {
     std::fprintf(stderr, "fdem: unknown command '%s'\n%s", command.c_str(), usage);
     return exit_bad_input;
@@ -191,5 +195,66 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
   } catch (const std::exception& e) {
     return fail(world, e, dynamic_cast<const fdem::CollectiveFailure*>(&e) != nullptr, 1,
                 "error: ");
+  }
+}
+
+// fdem prepare MESH.msh [-o MODEL.h5] [--block-rows N]: the Gmsh file streamed once into a model
+// file (parallel/model_file.hpp) that N ranks read slice by slice.  One process does the work.
+int prepare_command(const std::vector<std::string>& args, const fdem::Communicator& world) {
+  std::string mesh, output;
+  fdem::PrepareOptions options;
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool has_value = i + 1 < args.size();
+    if ((a == "-o" || a == "--output") && has_value) {
+      output = args[++i];
+    } else if (a == "--block-rows" && has_value) {
+      const std::string& text = args[++i];
+      char* end = nullptr;
+      options.block_rows = std::strtoll(text.c_str(), &end, 10);
+      if (end == text.c_str() || *end != '\0' || options.block_rows < 1) {
+        std::fprintf(stderr, "fdem: --block-rows needs a positive integer, found '%s'\n%s",
+                     text.c_str(), usage);
+        return exit_bad_input;
+      }
+    } else if (a == "-o" || a == "--output" || a == "--block-rows") {
+      std::fprintf(stderr, "fdem: %s needs a value\n%s", a.c_str(), usage);
+      return exit_bad_input;
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "fdem: unknown option '%s'\n%s", a.c_str(), usage);
+      return exit_bad_input;
+    } else if (mesh.empty()) {
+      mesh = a;
+    } else {
+      std::fprintf(stderr, "fdem: unexpected argument '%s' (one mesh per prepare)\n%s", a.c_str(),
+                   usage);
+      return exit_bad_input;
+    }
+  }
+  if (mesh.empty()) {
+    std::fprintf(stderr, "fdem: prepare needs a Gmsh mesh file\n%s", usage);
+    return exit_bad_input;
+  }
+  if (output.empty()) {
+    const std::size_t dot = mesh.find_last_of('.'), slash = mesh.find_last_of('/');
+    output = (dot != std::string::npos && (slash == std::string::npos || dot > slash)
+                  ? mesh.substr(0, dot)
+                  : mesh) +
+             ".h5";
+  }
+  try {
+    fdem::PrepareReport report;
+    world.run_collectively([&] {
+      if (world.is_root()) report = fdem::prepare_model_file(mesh, output, options);
+    });
+    if (world.is_root())
+      std::printf("%s: %lld nodes, %lld tetrahedra from %s\n", output.c_str(),
+                  static_cast<long long>(report.nodes), static_cast<long long>(report.tets),
+                  mesh.c_str());
+    return 0;
+  } catch (const fdem::InputError& e) {
+    return fail(world, e, true, exit_bad_input, "error: ");
+  } catch (const fdem::IoError& e) {
+    return fail(world, e, true, exit_io_failure, "I/O failure: ");
   }
 }

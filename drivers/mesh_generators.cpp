@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/tet_kernels.hpp"
 #include "io/gmsh_reader.hpp"
+#include "parallel/model_file.hpp"
 
 namespace fdem {
 
@@ -367,6 +368,10 @@ BodyChunks body_chunks(const MeshSpec& mesh, int ranks) {
   throw InputError("mesh file '" + mesh.file + "' has no chunked form");
 }
 
+std::string mesh_source(const MeshSpec& mesh) {
+  return mesh.file + (mesh.physical.empty() ? "" : " [" + mesh.physical + "]");
+}
+
 std::vector<BodyMesh> load_body_meshes(const Scene& scene) {
   std::vector<BodyMesh> meshes;
   for (const BodySpec& body : scene.bodies) {
@@ -379,10 +384,12 @@ std::vector<BodyMesh> load_body_meshes(const Scene& scene) {
     } else if (body.mesh.kind == MeshSpec::Kind::tower) {
       meshes.push_back(tower_mesh(body.mesh.tower));
     } else {
-      const GmshMesh g = read_gmsh(body.mesh.file, body.mesh.physical);
+      // A model file (fdem prepare) gives the mesh of the .msh it was prepared from.
+      const GmshMesh g = is_hdf5_file(body.mesh.file)
+                             ? read_model_file(body.mesh.file, body.mesh.physical)
+                             : read_gmsh(body.mesh.file, body.mesh.physical);
       BodyMesh mesh;
-      mesh.source =
-          body.mesh.file + (body.mesh.physical.empty() ? "" : " [" + body.mesh.physical + "]");
+      mesh.source = mesh_source(body.mesh);
       mesh.coords = g.coords;
       mesh.tets.assign(g.tets.begin(), g.tets.end());
       mesh.source_tags.assign(g.tet_tags.begin(), g.tet_tags.end());

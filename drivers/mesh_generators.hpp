@@ -39,7 +39,11 @@ void append_piece(BodyMesh& mesh, const BodyMesh& piece);
 // the space-filling curve more closely), large enough that the plan stays small.
 BodyChunks body_chunks(const MeshSpec& mesh, int ranks = 1);
 
-// Loads or generates the mesh of every body of the scene, in scene order.
+// How messages name a file mesh: "part.msh [group]".
+std::string mesh_source(const MeshSpec& mesh);
+
+// Loads or generates the mesh of every body of the scene, in scene order.  A file mesh is a Gmsh
+// file or a model file prepared from one (`fdem prepare`; the same mesh).
 std::vector<BodyMesh> load_body_meshes(const Scene& scene);
 
 }  // namespace fdem

@@ -19,6 +19,7 @@
 #include "core/time_step.hpp"
 #include "drivers/interrupt.hpp"
 #include "drivers/loads.hpp"
+#include "drivers/mesh_files.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/process_memory.hpp"
 #include "drivers/restart_check.hpp"
@@ -29,6 +30,7 @@
 #include "parallel/checkpoint.hpp"
 #include "parallel/communicator.hpp"
 #include "parallel/distribution.hpp"
+#include "parallel/file_mesh_chunks.hpp"
 
 namespace fdem {
 
@@ -910,10 +912,7 @@ RunReport Simulation::run() {
 }
 
 bool distributed_start_possible(const Scene& scene) {
-  if (!scene.parallel.distributed_start) return false;
-  for (const BodySpec& body : scene.bodies)
-    if (body.mesh.kind == MeshSpec::Kind::file) return false;
-  return true;
+  return scene.parallel.distributed_start;
 }
 
 std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions options,
@@ -940,11 +939,24 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
   if (distributed) {
     // Each rank generates its chunks of the meshes and keeps its block
     // (parallel/distributed_build).
-    std::vector<BodyChunks> chunks;
+    // A file mesh: each rank reads its slice of the model file (a Gmsh file is prepared into one
+    // first), then its size is checked as the generated meshes' was.
+    std::vector<BodyChunks> chunks(scene.bodies.size());
     comm->run_collectively([&] {
-      for (const BodySpec& body : scene.bodies)
-        chunks.push_back(body_chunks(body.mesh, comm->size()));
+      for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+        if (scene.bodies[b].mesh.kind != MeshSpec::Kind::file)
+          chunks[b] = body_chunks(scene.bodies[b].mesh, comm->size());
     });
+    ModelSize size = estimate_generated_size(scene);
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+      const MeshSpec& mesh = scene.bodies[b].mesh;
+      if (mesh.kind != MeshSpec::Kind::file) continue;
+      chunks[b] = file_mesh_chunks(model_file_for(mesh, options.output_dir, *comm), mesh.physical,
+                                   mesh_source(mesh), *comm);
+      size.nodes += static_cast<double>(chunks[b].n_nodes);
+      for (std::int64_t tets : chunks[b].chunk_tets) size.tets += static_cast<double>(tets);
+    }
+    if (size.tets > estimate_generated_size(scene).tets) check_memory(size, "the meshes");
     DistributedModel start = build_distributed_model(scene, chunks, *comm);
     chunks.clear();
     double buffer = 0.0;  // contact buffer (m): as the contact stage sets it on one rank

@@ -185,8 +185,10 @@ class Simulation {
   long startup_peak_rss_kib_ = 0;     // this rank, end of start-up
 };
 
-// Whether N ranks can start the scene without any rank holding the whole model: every mesh is
-// generated (box, wall, arch, tower), and parallel.distributed_start is on (docs/parallel.md).
+// Whether N ranks can start the scene without any rank holding the whole model
+// (parallel.distributed_start, docs/parallel.md): generated meshes are made chunk by chunk, file
+// meshes read slice by slice from a model file (a Gmsh file is prepared into one first), joints
+// placed through face and position directories.
 bool distributed_start_possible(const Scene& scene);
 
 // Builds a Simulation from a scene file (meshes loaded or generated).

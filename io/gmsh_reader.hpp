@@ -41,4 +41,21 @@ GmshMesh read_gmsh(const std::string& path, const std::string& physical = "");
 GmshMesh parse_gmsh(const std::string& data, const std::string& path,
                     const std::string& physical = "");
 
+struct GmshTables;
+
+// Every node and 4-node tet of a file, in file order, as io/gmsh_parser reads them (or as a
+// prepared model file holds them).
+struct GmshArrays {
+  std::vector<std::int64_t> node_tags;
+  std::vector<double> node_xyz;         // 3 per node
+  std::vector<std::int64_t> tet_nodes;  // 4 per tet, indices into the nodes
+  std::vector<std::int64_t> tet_tags;
+  std::vector<std::int32_t> tet_entity;  // volume entity tag (-1: not in a volume block)
+};
+
+// What read_gmsh keeps of a parsed file: the selected tets, the nodes they use (file order).
+// `file` starts the messages ("Gmsh file 'x.msh'").  Throws InputError as read_gmsh does.
+GmshMesh select_gmsh(const GmshTables& tables, const GmshArrays& all, const std::string& physical,
+                     const std::string& file);
+
 }  // namespace fdem

@@ -56,7 +56,8 @@ std::string hex(std::uint64_t value) {
 
 }  // namespace
 
-void write_checkpoint_seal(const std::string& path, std::vector<FileRegion> data) {
+void write_checkpoint_seal(const std::string& path, std::vector<FileRegion> data,
+                           const std::string& kind) {
   data.erase(std::remove_if(data.begin(), data.end(), [](const FileRegion& r) { return !r.size; }),
              data.end());
   std::sort(data.begin(), data.end(),
@@ -64,7 +65,7 @@ void write_checkpoint_seal(const std::string& path, std::vector<FileRegion> data
   std::ifstream in(path, std::ios::binary);
   std::uint64_t hash = 0;
   if (!in || !metadata_checksum(in, checkpoint_seal_bytes, file_size(in), data, hash))
-    throw IoError("checkpoint '" + path + "': cannot read it back to seal it");
+    throw IoError(kind + " '" + path + "': cannot read it back to seal it");
   in.close();
   std::ostringstream text;
   text << seal_magic << "metadata " << hex(hash) << "\nregions " << data.size() << "\n";
@@ -76,7 +77,7 @@ void write_checkpoint_seal(const std::string& path, std::vector<FileRegion> data
   out.write(seal.data(), static_cast<std::streamsize>(seal.size()));
   out.flush();
   if (!out)
-    throw IoError("checkpoint '" + path +
+    throw IoError(kind + " '" + path +
                   "': cannot write its checksum block: " + std::strerror(errno));
 }
 

@@ -19,8 +19,10 @@ struct FileRegion {
   std::uint64_t offset = 0, size = 0;
 };
 
-// Writes the seal of the closed HDF5 file `path` into its userblock.  Throws IoError.
-void write_checkpoint_seal(const std::string& path, std::vector<FileRegion> data);
+// Writes the seal of the closed HDF5 file `path` into its userblock.  Throws IoError naming the
+// file as a `kind` ("checkpoint", "model file").
+void write_checkpoint_seal(const std::string& path, std::vector<FileRegion> data,
+                           const std::string& kind = "checkpoint");
 
 enum class SealState { intact, absent, damaged };
 

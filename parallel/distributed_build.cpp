@@ -152,62 +152,77 @@ std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<Bo
                                         const std::vector<std::int64_t>& node_base,
                                         const std::vector<std::int32_t>& piece_base,
                                         const Communicator& comm, Vec3* node_lo, Vec3* node_hi) {
-  std::int64_t total = 0;
+  std::int64_t total = 0, dealt = 0;
   for (const BodyChunks& body : chunks)
-    for (std::int64_t n : body.chunk_tets) total += n;
+    for (std::int64_t n : body.chunk_tets) {
+      total += n;
+      dealt += body.chunk_rank.empty() ? n : 0;
+    }
   if (total == 0) throw InputError(scene.source_path + ": the scene has no tetrahedra");
   // Chunks are dealt along a Morton curve of their centres, in equal shares of tets, so that most
   // tets are generated on the rank whose block (a stretch of the same kind of curve) they join.
+  // Chunks placed on their ranks already (chunk_rank) are not dealt.
   struct ChunkRef {
     std::uint64_t key;
     std::int32_t body;
     std::int64_t chunk;
   };
-  std::vector<ChunkRef> deal;
+  std::vector<ChunkRef> deal, placed;
   Vec3 centre_lo = Vec3::Constant(1e300), centre_hi = Vec3::Constant(-1e300);
   for (const BodyChunks& body : chunks) {  // ≈ the box of all nodes, as the tets' keys use
     centre_lo = centre_lo.cwiseMin(body.lo);
     centre_hi = centre_hi.cwiseMax(body.hi);
   }
   for (std::size_t b = 0; b < chunks.size(); ++b)
-    for (std::size_t c = 0; c < chunks[b].chunk_tets.size(); ++c)
-      deal.push_back({morton_key(chunks[b].chunk_centre[c], centre_lo, centre_hi),
-                      static_cast<std::int32_t>(b), static_cast<std::int64_t>(c)});
+    for (std::size_t c = 0; c < chunks[b].chunk_tets.size(); ++c) {
+      const ChunkRef ref{morton_key(chunks[b].chunk_centre[c], centre_lo, centre_hi),
+                         static_cast<std::int32_t>(b), static_cast<std::int64_t>(c)};
+      if (chunks[b].chunk_rank.empty())
+        deal.push_back(ref);
+      else if (chunks[b].chunk_rank[c] == comm.rank())
+        placed.push_back(ref);
+    }
   std::stable_sort(deal.begin(), deal.end(),
                    [](const ChunkRef& a, const ChunkRef& b) { return a.key < b.key; });
   std::vector<TetRecord> records;
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  const auto add_chunk = [&](const ChunkRef& ref) {
+    const std::size_t b = static_cast<std::size_t>(ref.body);
+    const MeshChunk chunk = chunks[b].generate(ref.chunk);
+    const std::vector<double>& coords = chunk.mesh.coords;
+    for (std::size_t n = 0; n < coords.size() / 3; ++n) {
+      lo = lo.cwiseMin(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
+      hi = hi.cwiseMax(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
+    }
+    for (std::size_t t = 0; t < chunk.mesh.tets.size() / 4; ++t) {
+      TetRecord r{};
+      r.body = static_cast<std::int32_t>(b);
+      r.piece = piece_base[b] + (chunk.tet_piece.empty() ? chunk.piece : chunk.tet_piece[t]);
+      r.mesh_tet = chunk.tet_id[t];
+      Vec3 X[4];
+      for (int k = 0; k < 4; ++k) {
+        const LocalIndex n = chunk.mesh.tets[4 * t + k];
+        r.node[k] = node_base[b] + chunk.node_id[static_cast<std::size_t>(n)];
+        X[k] = vec3_at(coords.data(), n);
+        for (int d = 0; d < 3; ++d) r.x[3 * k + d] = X[k][d];
+      }
+      // Named as the serial builder names it: the file's element tag, or its number + 1.
+      check_tet_shape(X, scene.bodies[b].name,
+                      chunk.mesh.source.empty() ? chunks[b].source : chunk.mesh.source,
+                      chunk.mesh.source_tags.empty() ? r.mesh_tet + 1 : chunk.mesh.source_tags[t]);
+      records.push_back(r);
+    }
+  };
   comm.run_collectively([&] {
+    for (const ChunkRef& ref : placed) add_chunk(ref);
     std::int64_t before = 0;  // tets of the chunks dealt before this one
     for (const ChunkRef& ref : deal) {
-      const std::size_t b = static_cast<std::size_t>(ref.body);
-      const std::size_t c = static_cast<std::size_t>(ref.chunk);
-      const std::int64_t tets = chunks[b].chunk_tets[c];
+      const std::int64_t tets = chunks[static_cast<std::size_t>(ref.body)]
+                                    .chunk_tets[static_cast<std::size_t>(ref.chunk)];
       // Each chunk goes to the rank whose share of the tets it starts in.
-      const int rank = static_cast<int>(mul_div(before, comm.size(), total));
+      const int rank = static_cast<int>(mul_div(before, comm.size(), dealt));
       before += tets;
-      if (rank != comm.rank()) continue;
-      const MeshChunk chunk = chunks[b].generate(static_cast<std::int64_t>(c));
-      const std::vector<double>& coords = chunk.mesh.coords;
-      for (std::size_t n = 0; n < coords.size() / 3; ++n) {
-        lo = lo.cwiseMin(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
-        hi = hi.cwiseMax(vec3_at(coords.data(), static_cast<LocalIndex>(n)));
-      }
-      for (std::size_t t = 0; t < chunk.mesh.tets.size() / 4; ++t) {
-        TetRecord r{};
-        r.body = static_cast<std::int32_t>(b);
-        r.piece = piece_base[b] + chunk.piece;
-        r.mesh_tet = chunk.tet_id[t];
-        Vec3 X[4];
-        for (int k = 0; k < 4; ++k) {
-          const LocalIndex n = chunk.mesh.tets[4 * t + k];
-          r.node[k] = node_base[b] + chunk.node_id[static_cast<std::size_t>(n)];
-          X[k] = vec3_at(coords.data(), n);
-          for (int d = 0; d < 3; ++d) r.x[3 * k + d] = X[k][d];
-        }
-        check_tet_shape(X, scene.bodies[b].name, chunks[b].source, r.mesh_tet + 1);
-        records.push_back(r);
-      }
+      if (rank == comm.rank()) add_chunk(ref);
     }
   });
   std::vector<double> low(lo.data(), lo.data() + 3), high(hi.data(), hi.data() + 3);

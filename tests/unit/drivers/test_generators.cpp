@@ -368,9 +368,9 @@ BodyMesh mesh_from_chunks(const BodyChunks& chunks, std::vector<std::int32_t>* t
       const auto id = static_cast<std::size_t>(chunk.tet_id[t]);
       REQUIRE((*tet_piece)[id] == -1);  // every tet in exactly one chunk
       (*tet_piece)[id] = chunk.piece;
-      for (int c = 0; c < 4; ++c)
-        whole.tets[4 * id + c] = static_cast<LocalIndex>(
-            chunk.node_id[static_cast<std::size_t>(chunk.mesh.tets[4 * t + c])]);
+      for (int corner = 0; corner < 4; ++corner)
+        whole.tets[4 * id + corner] = static_cast<LocalIndex>(
+            chunk.node_id[static_cast<std::size_t>(chunk.mesh.tets[4 * t + corner])]);
     }
   }
   return whole;

@@ -1,0 +1,43 @@
+# A Gmsh body on 1 rank (the .msh read whole), on 2 ranks (the .msh prepared into the output
+# directory, then read slice by slice), on 3 ranks and on 1 rank from that prepared model file:
+# every run completes with the same state_hash (and elements, nodes, fragments).
+# -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list of the .h5 runs after the first two)
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+
+function(run_fdem ranks out)
+  execute_process(COMMAND ${MPIEXEC} ${NP_FLAG} ${ranks} --oversubscribe ${FDEM} run ${SCENE}
+                          -o ${out} -q ${ARGN}
+                  RESULT_VARIABLE result OUTPUT_VARIABLE stdout ERROR_VARIABLE stderr)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "fdem on ${ranks} ranks (${ARGN}) exited with ${result}:\n${stdout}${stderr}")
+  endif()
+  file(READ ${out}/summary.json summary)
+  string(REGEX MATCH "\"state_hash\": \"([0-9a-f]+)\"" _ "${summary}")
+  set(hash ${CMAKE_MATCH_1})
+  foreach(count elements nodes fragments)
+    string(REGEX MATCH "\"${count}\": ([0-9]+)" _ "${summary}")
+    string(APPEND hash "/${count}=${CMAKE_MATCH_1}")
+  endforeach()
+  message("${out}: state_hash ${hash}")
+  set(hash ${hash} PARENT_SCOPE)
+endfunction()
+
+run_fdem(1 ${WORK}/msh1)
+set(reference ${hash})
+run_fdem(2 ${WORK}/msh2)
+if(NOT hash STREQUAL reference)
+  message(FATAL_ERROR "2 ranks from the .msh: ${hash}, 1 rank: ${reference}")
+endif()
+file(GLOB prepared ${WORK}/msh2/prepared/*.h5)
+list(LENGTH prepared count)
+if(NOT count EQUAL 1)
+  message(FATAL_ERROR "the 2-rank run prepared no model file in its output directory")
+endif()
+foreach(ranks ${RANKS})
+  run_fdem(${ranks} ${WORK}/h5_${ranks} --set bodies.0.mesh.file=${prepared})
+  if(NOT hash STREQUAL reference)
+    message(FATAL_ERROR "${ranks} ranks from ${prepared}: ${hash}, 1 rank from the .msh: ${reference}")
+  endif()
+endforeach()
+message("all runs: state_hash ${reference}")

@@ -1,0 +1,86 @@
+// A rank's block of the distributed start-up against the serial builder's whole model, bit for
+// bit (tests/mpi/test_distributed_build.cpp, test_file_mesh.cpp).  CHECK only: a rank leaving a
+// test case early would skip its collectives.
+#pragma once
+
+#include <catch2/catch.hpp>
+#include <cstring>
+
+#include "core/model.hpp"
+#include "parallel/communicator.hpp"
+#include "parallel/distributed_build.hpp"
+
+namespace fdem::testing {
+
+inline bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof(double)) == 0;
+}
+
+// Collective (sums over the ranks).  `serial`: build_model's model (gid = index).
+inline void check_block_is_serial_model(const DistributedModel& block, const Model& serial,
+                                        const Communicator& comm) {
+  const Model& local = block.model;
+  CHECK(block.n_tets == serial.tets.size());
+  CHECK(block.n_nodes == serial.nodes.size());
+  CHECK(comm.sum(std::int64_t{local.tets.size()}) == serial.tets.size());
+  CHECK(comm.sum(std::int64_t{local.nodes.n_owned}) == serial.nodes.size());
+  // Blocks are contiguous gid ranges, in rank order.
+  CHECK(local.tets.size() == block.tet_block[comm.rank() + 1] - block.tet_block[comm.rank()]);
+
+  long tet_mismatches = 0, node_mismatches = 0;
+  for (LocalIndex t = 0; t < local.tets.size(); ++t) {
+    const auto g = static_cast<std::size_t>(local.tets.gid[t]);
+    if (g >= static_cast<std::size_t>(serial.tets.size())) {
+      ++tet_mismatches;
+      continue;
+    }
+    bool same = local.tets.material[t] == serial.tets.material[g] &&
+                local.tets.piece[t] == serial.tets.piece[g] &&
+                local.tets.group_of(static_cast<LocalIndex>(t)) ==
+                    serial.tets.group_of(static_cast<LocalIndex>(g)) &&
+                same_bits(local.tets.volume0[t], serial.tets.volume0[g]) &&
+                same_bits(local.tets.viscosity[t], serial.tets.viscosity[g]);
+    for (int k = 0; k < 9; ++k)
+      same = same && same_bits(local.tets.dm_inv[9 * t + k], serial.tets.dm_inv[9 * g + k]);
+    for (int c = 0; c < 4; ++c)
+      same = same && local.nodes.gid[local.tets.nodes[4 * t + c]] == serial.tets.nodes[4 * g + c];
+    tet_mismatches += !same;
+  }
+  for (LocalIndex n = 0; n < local.nodes.size(); ++n) {
+    const auto g = static_cast<std::size_t>(local.nodes.gid[n]);
+    if (g >= static_cast<std::size_t>(serial.nodes.size())) {
+      ++node_mismatches;
+      continue;
+    }
+    bool same = local.nodes.piece[n] == serial.nodes.piece[g] &&
+                same_bits(local.nodes.mass[n], serial.nodes.mass[g]) &&
+                local.nodes.constrained[n] == serial.nodes.constrained[g];
+    for (int k = 0; k < 3; ++k)
+      same = same && same_bits(local.nodes.x0[3 * n + k], serial.nodes.x0[3 * g + k]) &&
+             same_bits(local.nodes.x[3 * n + k], serial.nodes.x[3 * g + k]) &&
+             same_bits(local.nodes.v[3 * n + k], serial.nodes.v[3 * g + k]) &&
+             same_bits(local.nodes.prescribed_velocity[3 * n + k],
+                       serial.nodes.prescribed_velocity[3 * g + k]);
+    // Owned nodes: their first tet is in this block; the owner table says so.
+    same = same && (n < local.nodes.n_owned) == (block.node_owner[n] == comm.rank());
+    node_mismatches += !same;
+  }
+  CHECK(tet_mismatches == 0);
+  CHECK(node_mismatches == 0);
+  CHECK(local.pieces.size() == serial.pieces.size());
+  long piece_mismatches = 0;
+  for (std::size_t p = 0; p < std::min(local.pieces.size(), serial.pieces.size()); ++p) {
+    bool same = local.pieces[p].body == serial.pieces[p].body &&
+                local.pieces[p].index_in_body == serial.pieces[p].index_in_body &&
+                same_bits(local.pieces[p].mass, serial.pieces[p].mass);
+    for (int k = 0; k < 3; ++k)
+      same = same && same_bits(local.pieces[p].centroid0[k], serial.pieces[p].centroid0[k]);
+    piece_mismatches += !same;
+  }
+  CHECK(piece_mismatches == 0);
+  // Every rank holds the same whole-model ranks of the blocks, and they cover all tets.
+  CHECK(block.tet_block.front() == 0);
+  CHECK(block.tet_block.back() == serial.tets.size());
+}
+
+}  // namespace fdem::testing
