@@ -278,10 +278,11 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
       const GlobalId tb = b.single < 0 ? -1 : singles[static_cast<std::size_t>(b.single)].tet;
       return ta < tb;
     });
+    std::vector<const FaceRecord*> here;  // the singles of one face
     for (std::size_t i = 0; i < entries.size();) {
       std::size_t j = i;
       std::int64_t count = 0;
-      std::vector<const FaceRecord*> here;
+      here.clear();
       while (j < entries.size() && entries[j].body == entries[i].body &&
              entries[j].key == entries[i].key) {
         count += entries[j].count;
