@@ -520,6 +520,23 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   std::vector<NodeRow> node_rows;
   std::vector<JointRow> joint_rows;
   std::vector<FrictionRow> friction_rows;
+  {  // exact sizes first: grown by doubling, the row vectors would need up to 3× their rows
+    BlockHeader total;
+    for (const std::vector<char>* rows : buffers)
+      for (const char* p = rows->data(); p < rows->data() + rows->size();) {
+        const BlockHeader header = take<BlockHeader>(p);
+        total.tets += header.tets;
+        total.nodes += header.nodes;
+        total.joints += header.joints;
+        total.friction += header.friction;
+        p += header.tets * sizeof(TetRow) + header.nodes * sizeof(NodeRow) +
+             header.joints * sizeof(JointRow) + header.friction * sizeof(FrictionRow);
+      }
+    tet_rows.reserve(static_cast<std::size_t>(total.tets));
+    node_rows.reserve(static_cast<std::size_t>(total.nodes));
+    joint_rows.reserve(static_cast<std::size_t>(total.joints));
+    friction_rows.reserve(static_cast<std::size_t>(total.friction));
+  }
   for (std::vector<char>* rows : buffers) {
     for (const char* p = rows->data(); p < rows->data() + rows->size();) {
       const BlockHeader header = take<BlockHeader>(p);
