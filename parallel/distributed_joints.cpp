@@ -194,15 +194,76 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
     r.piece = tets.piece[ft.tet];
     return r;
   };
-  std::vector<DraftRecord> local_drafts;  // found here for this rank
-  std::vector<std::vector<DraftRecord>> drafts(static_cast<std::size_t>(ranks));  // to owners
+  // At the owner of tet A: the joint oriented, its area and size bin (role 0).  At the owner of
+  // a tet: it is bonded, to a tet of that extent.
+  struct Placed {
+    StartJoint joint;
+    std::int32_t group;
+    std::int64_t bin;
+  };
+  std::vector<Placed> placed;
+  const double* x0 = nodes.x0.data();
+  const auto bonded = [&](GlobalId tet, double partner_extent) {
+    const LocalIndex t = static_cast<LocalIndex>(tet - first_tet);
+    FDEM_VERIFY(t >= 0 && t < tets.size(), "a joint reaches the owners of its tets");
+    out.bonded[static_cast<std::size_t>(t)] = 1;
+    double& extent = out.partner_extent[static_cast<std::size_t>(t)];
+    extent = std::max(extent, partner_extent);
+    return t;
+  };
+  const std::function<void(const DraftRecord&)> bond = [&](const DraftRecord& d) {
+    bonded(d.tet[1], d.extent[0]);
+  };
+  const std::function<void(const DraftRecord&)> place = [&](const DraftRecord& d) {
+    const LocalIndex t = bonded(d.tet[0], d.extent[1]);
+    Placed p{};
+    StartJoint& j = p.joint;
+    j.tets[0] = d.tet[0];
+    j.tets[1] = d.tet[1];
+    LocalIndex a[3] = {-1, -1, -1}, opposite = -1;
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = tets.nodes[4 * static_cast<std::size_t>(t) + c];
+      bool on_face = false;
+      for (int i = 0; i < 3; ++i)
+        if (nodes.gid[n] == d.a[i]) {
+          a[i] = n;
+          on_face = true;
+        }
+      if (!on_face) opposite = n;
+    }
+    FDEM_VERIFY(a[0] >= 0 && a[1] >= 0 && a[2] >= 0 && opposite >= 0,
+                "a joint's face nodes are three corners of its tet A");
+    GlobalId b[3] = {d.b[0], d.b[1], d.b[2]};
+    if (joint_face_turned(vec3_at(x0, a[0]), vec3_at(x0, a[1]), vec3_at(x0, a[2]),
+                          vec3_at(x0, opposite))) {
+      std::swap(a[1], a[2]);
+      std::swap(b[1], b[2]);
+    }
+    for (int i = 0; i < 3; ++i) {
+      j.nodes[i] = nodes.gid[a[i]];
+      j.nodes[3 + i] = b[i];
+    }
+    j.area0 = joint_face_area(vec3_at(x0, a[0]), vec3_at(x0, a[1]), vec3_at(x0, a[2]));
+    p.group = d.group;
+    p.bin = joint_size_bin(tets.volume0[t], d.volume[1], j.area0);
+    placed.push_back(p);
+  };
+  // Joints found here go to the owners of their tets (this rank's: at once).
+  std::vector<std::vector<DraftRecord>> drafts(static_cast<std::size_t>(ranks));
   const auto send_draft = [&](const DraftRecord& d) {
-    DraftRecord bond = d;
-    bond.role = 1;
     const int owner_a = block_owner(tet_block, d.tet[0]),
               owner_b = block_owner(tet_block, d.tet[1]);
-    (owner_a == me ? local_drafts : drafts[static_cast<std::size_t>(owner_a)]).push_back(d);
-    (owner_b == me ? local_drafts : drafts[static_cast<std::size_t>(owner_b)]).push_back(bond);
+    if (owner_a == me)
+      place(d);
+    else
+      drafts[static_cast<std::size_t>(owner_a)].push_back(d);
+    if (owner_b == me) {
+      bond(d);
+    } else {
+      DraftRecord b = d;
+      b.role = 1;
+      drafts[static_cast<std::size_t>(owner_b)].push_back(b);
+    }
   };
 
   // 1  Faces of the local tets; pairs within the block are joined here.
@@ -278,10 +339,11 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
       const GlobalId tb = b.single < 0 ? -1 : singles[static_cast<std::size_t>(b.single)].tet;
       return ta < tb;
     });
+    std::vector<const FaceRecord*> here;  // the singles of one face
     for (std::size_t i = 0; i < entries.size();) {
       std::size_t j = i;
       std::int64_t count = 0;
-      std::vector<const FaceRecord*> here;
+      here.clear();
       while (j < entries.size() && entries[j].body == entries[i].body &&
              entries[j].key == entries[i].key) {
         count += entries[j].count;
@@ -440,58 +502,10 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
   }
   error.raise(comm);
 
-  // 6  Owners of tet A: orientation, area, size bin; bonds.
+  // 6  Owners of tet A (joints) and of tet B (bonds) not reached yet.
   std::vector<DraftRecord> arrived = comm.exchange(drafts);
   drafts = {};
-  arrived.insert(arrived.end(), local_drafts.begin(), local_drafts.end());
-  local_drafts = {};
-  struct Placed {
-    StartJoint joint;
-    std::int32_t group;
-    std::int64_t bin;
-  };
-  std::vector<Placed> placed;
-  const double* x0 = nodes.x0.data();
-  for (const DraftRecord& d : arrived) {
-    const int side = d.role;  // the local tet: A for a joint, B for a bond
-    const LocalIndex t = static_cast<LocalIndex>(d.tet[side] - first_tet);
-    FDEM_VERIFY(t >= 0 && t < tets.size(), "a joint reaches the owner of its tet");
-    out.bonded[static_cast<std::size_t>(t)] = 1;
-    double& extent = out.partner_extent[static_cast<std::size_t>(t)];
-    extent = std::max(extent, d.extent[1 - side]);
-    if (d.role != 0) continue;
-    Placed p{};
-    StartJoint& j = p.joint;
-    j.tets[0] = d.tet[0];
-    j.tets[1] = d.tet[1];
-    LocalIndex a[3] = {-1, -1, -1}, opposite = -1;
-    for (int c = 0; c < 4; ++c) {
-      const LocalIndex n = tets.nodes[4 * static_cast<std::size_t>(t) + c];
-      bool on_face = false;
-      for (int i = 0; i < 3; ++i)
-        if (nodes.gid[n] == d.a[i]) {
-          a[i] = n;
-          on_face = true;
-        }
-      if (!on_face) opposite = n;
-    }
-    FDEM_VERIFY(a[0] >= 0 && a[1] >= 0 && a[2] >= 0 && opposite >= 0,
-                "a joint's face nodes are three corners of its tet A");
-    GlobalId b[3] = {d.b[0], d.b[1], d.b[2]};
-    if (joint_face_turned(vec3_at(x0, a[0]), vec3_at(x0, a[1]), vec3_at(x0, a[2]),
-                          vec3_at(x0, opposite))) {
-      std::swap(a[1], a[2]);
-      std::swap(b[1], b[2]);
-    }
-    for (int i = 0; i < 3; ++i) {
-      j.nodes[i] = nodes.gid[a[i]];
-      j.nodes[3 + i] = b[i];
-    }
-    j.area0 = joint_face_area(vec3_at(x0, a[0]), vec3_at(x0, a[1]), vec3_at(x0, a[2]));
-    p.group = d.group;
-    p.bin = joint_size_bin(tets.volume0[t], d.volume[1], j.area0);
-    placed.push_back(p);
-  }
+  for (const DraftRecord& d : arrived) (d.role == 0 ? place : bond)(d);
   arrived = {};
 
   // 7  Laws in ascending (group, bin) over all ranks; joint gids in ascending (gid A, gid B).

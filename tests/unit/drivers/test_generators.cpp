@@ -389,6 +389,7 @@ void require_chunks_give(const MeshSpec& spec, const BodyMesh& expected, int ran
                                         static_cast<LocalIndex>(expected.coords.size() / 3),
                                         &n_pieces));
   REQUIRE(n_pieces == chunks.n_pieces);
+  REQUIRE(chunks.source == expected.source);  // messages name the mesh as the whole generator
 }
 
 }  // namespace
