@@ -1,6 +1,7 @@
 # A Gmsh body on 1 rank (the .msh read whole), on 2 ranks (the .msh prepared into the output
 # directory, then read slice by slice), on 3 ranks and on 1 rank from that prepared model file:
-# every run completes with the same state_hash (and elements, nodes, fragments).
+# every run completes with the same state_hash (and elements, nodes, fragments); and the 1-rank
+# run's earliest checkpoint continued on 2 ranks (the .msh prepared again) gives it too.
 # -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list of the .h5 runs after the first two)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -40,4 +41,11 @@ foreach(ranks ${RANKS})
     message(FATAL_ERROR "${ranks} ranks from ${prepared}: ${hash}, 1 rank from the .msh: ${reference}")
   endif()
 endforeach()
+file(GLOB checkpoints ${WORK}/msh1/checkpoint_*.h5)
+list(SORT checkpoints)
+list(GET checkpoints 0 earliest)
+run_fdem(2 ${WORK}/restart2 --restart ${earliest})
+if(NOT hash STREQUAL reference)
+  message(FATAL_ERROR "restart from ${earliest} on 2 ranks: ${hash}, uninterrupted ${reference}")
+endif()
 message("all runs: state_hash ${reference}")
