@@ -181,8 +181,9 @@ struct OutputSpec {
 struct ParallelSpec {
   double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this
   long redistribute_every = 0;        // steps; also redistribute this often (0: at detections only)
-  // N ranks, generated meshes without joints: each rank builds only its part (false: every rank
-  // builds the whole model first, as scenes with Gmsh meshes or joints always do).
+  // N ranks, scenes without joints: each rank builds only its part (generated meshes chunk by
+  // chunk, Gmsh meshes slice by slice from a model file; false: every rank builds the whole model
+  // first, as scenes with joints always do).
   bool distributed_start = true;
   // Re-partition method (Zoltan): rib (inertial bisection), rcb (coordinate bisection), hsfc
   // (Hilbert curve: least data moved while partitioning); random (a test mode: each re-partition
