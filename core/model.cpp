@@ -17,6 +17,18 @@ void NodeArrays::resize(LocalIndex n) {
   prescribed_velocity.resize(3 * n);
 }
 
+LocalIndex NodeArrays::find(GlobalId id) const {
+  const auto owned_end = gid.begin() + n_owned;
+  auto it = std::lower_bound(gid.begin(), owned_end, id);
+  if (it == owned_end || *it != id) it = std::lower_bound(owned_end, gid.end(), id);
+  return it != gid.end() && *it == id ? static_cast<LocalIndex>(it - gid.begin()) : LocalIndex{-1};
+}
+
+LocalIndex TetArrays::find(GlobalId id) const {
+  const auto it = std::lower_bound(gid.begin(), gid.end(), id);
+  return it != gid.end() && *it == id ? static_cast<LocalIndex>(it - gid.begin()) : LocalIndex{-1};
+}
+
 void TetArrays::resize(LocalIndex n) {
   gid.resize(n);
   nodes.resize(4 * n);

@@ -26,6 +26,9 @@ struct NodeArrays {
 
   LocalIndex size() const { return static_cast<LocalIndex>(gid.size()); }
   void resize(LocalIndex n);
+  // Local index of the node with global id `gid` (the owned and the ghost range are each in
+  // ascending gid), or −1 when it is not held here.
+  LocalIndex find(GlobalId gid) const;
 };
 
 // Linear tetrahedra.
@@ -51,6 +54,8 @@ struct TetArrays {
 
   LocalIndex size() const { return static_cast<LocalIndex>(gid.size()); }
   void resize(LocalIndex n);
+  // Local index of the tet with global id `gid` (local tets are in ascending gid), or −1.
+  LocalIndex find(GlobalId gid) const;
   bool is_owned(LocalIndex t) const { return owned.empty() || owned[t]; }
   bool is_active(LocalIndex t) const { return active.empty() || active[t]; }
   std::int32_t group_of(LocalIndex t) const {

@@ -20,21 +20,6 @@
 
 namespace fdem {
 
-namespace {
-
-// Local index of the node with global id `gid` (owned and ghost ranges are each in ascending
-// gid), or −1 when this rank does not hold it.
-LocalIndex local_node(const NodeArrays& nodes, GlobalId gid) {
-  const auto owned_end = nodes.gid.begin() + nodes.n_owned;
-  auto it = std::lower_bound(nodes.gid.begin(), owned_end, gid);
-  if (it != owned_end && *it == gid) return static_cast<LocalIndex>(it - nodes.gid.begin());
-  it = std::lower_bound(owned_end, nodes.gid.end(), gid);
-  if (it != nodes.gid.end() && *it == gid) return static_cast<LocalIndex>(it - nodes.gid.begin());
-  return -1;
-}
-
-}  // namespace
-
 // ---------------------------------------------------------------------------------------------
 // Checkpoint and restart (parallel/checkpoint.hpp): rows keyed by global id, so any rank count can
 // continue any checkpoint; the run scalars make the continuation bit-identical.
@@ -94,9 +79,8 @@ void Simulation::write_checkpoint() {
   }
   if (contact_)
     for (const FrictionEntry& e : contact_->friction_entries()) {
-      const auto it = std::lower_bound(model_.tets.gid.begin(), model_.tets.gid.end(), e.a);
-      if (it == model_.tets.gid.end() || *it != e.a ||
-          !model_.tets.is_owned(static_cast<LocalIndex>(it - model_.tets.gid.begin())))
+      const LocalIndex a = model_.tets.find(e.a);
+      if (a < 0 || !model_.tets.is_owned(a))
         continue;  // the owner of the pair's first tet writes it
       rows.friction_a.push_back(e.a);
       rows.friction_b.push_back(e.b);
@@ -123,20 +107,19 @@ void Simulation::restore_checkpoint(const std::string& path) {
   CheckpointWanted wanted;
   const NodeArrays& held = model_.nodes;
   wanted.nodes = held.gid;
-  std::inplace_merge(wanted.nodes.begin(), wanted.nodes.begin() + held.n_owned,
-                     wanted.nodes.end());
+  std::inplace_merge(wanted.nodes.begin(), wanted.nodes.begin() + held.n_owned, wanted.nodes.end());
   wanted.joints = model_.joints.gid;
   wanted.tets = model_.tets.gid;
   const auto same_scene = [&](const CheckpointHeader& header) {
     if (header.n_nodes != whole_nodes_ || header.n_tets != whole_tets_ ||
         header.n_joints != whole_joints_ || header.reference_hash != reference_hash_)
-      throw InputError(
-          "checkpoint '" + path + "' was written for a different scene (" +
-          std::to_string(header.n_nodes) + " nodes, " + std::to_string(header.n_tets) +
-          " tetrahedra, " + std::to_string(header.n_joints) + " joints; this scene has " +
-          std::to_string(whole_nodes_) + ", " + std::to_string(whole_tets_) + ", " +
-          std::to_string(whole_joints_) +
-          (header.n_nodes == whole_nodes_ ? ", and other reference positions" : "") + ")");
+      throw InputError("checkpoint '" + path + "' was written for a different scene (" +
+                       std::to_string(header.n_nodes) + " nodes, " + std::to_string(header.n_tets) +
+                       " tetrahedra, " + std::to_string(header.n_joints) +
+                       " joints; this scene has " + std::to_string(whole_nodes_) + ", " +
+                       std::to_string(whole_tets_) + ", " + std::to_string(whole_joints_) +
+                       (header.n_nodes == whole_nodes_ ? ", and other reference positions" : "") +
+                       ")");
   };
   const auto [header, rows] = read_checkpoint(path, *comm_, &wanted, same_scene);
   if (header.n_joints > 0 && rows.joint_history_bytes != sizeof(JointHistory))
@@ -168,7 +151,7 @@ void Simulation::restore_checkpoint(const std::string& path) {
   NodeArrays& nodes = model_.nodes;
   std::vector<double> at_detection = nodes.x;
   for (std::size_t i = 0; i < rows.node_gid.size(); ++i) {
-    const LocalIndex local = local_node(nodes, rows.node_gid[i]);
+    const LocalIndex local = nodes.find(rows.node_gid[i]);
     if (local < 0) continue;
     const auto n = static_cast<std::size_t>(local);
     for (int k = 0; k < 3; ++k) {

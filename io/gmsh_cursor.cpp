@@ -35,11 +35,7 @@ std::string excerpt(std::string_view text) {
   return out;
 }
 
-Cursor::Cursor(const std::string& path, std::string_view data)
-    : path_(path), base_(data.data()), end_(data.size()), size_(data.size()) {}
-
-Cursor::Cursor(const std::string& path, std::size_t window_bytes)
-    : path_(path), window_(std::max<std::size_t>(window_bytes, 64)), streaming_(true) {
+std::ifstream open_mesh_file(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::exists(path, ec)) {
@@ -50,11 +46,20 @@ Cursor::Cursor(const std::string& path, std::size_t window_bytes)
   if (fs::is_directory(path, ec)) {
     throw InputError("Gmsh mesh file '" + path + "' is a directory; expected an MSH 4.1 file.");
   }
-  in_.open(path, std::ios::binary);
-  if (!in_) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
     throw InputError("Gmsh mesh file '" + path +
                      "' exists but cannot be opened for reading (check its permissions).");
   }
+  return in;
+}
+
+Cursor::Cursor(const std::string& path, std::string_view data)
+    : path_(path), base_(data.data()), end_(data.size()), size_(data.size()) {}
+
+Cursor::Cursor(const std::string& path, std::size_t window_bytes)
+    : path_(path), window_(std::max<std::size_t>(window_bytes, 64)), streaming_(true) {
+  in_ = open_mesh_file(path);
   in_.seekg(0, std::ios::end);
   const std::streamoff size = in_.tellg();
   in_.seekg(0, std::ios::beg);

@@ -15,6 +15,10 @@ namespace fdem::gmsh {
 // Printable excerpt of what was found, for messages.
 std::string excerpt(std::string_view text);
 
+// Opens the mesh file `path` for binary reading; a missing file, a directory or an unreadable file
+// is an InputError naming it.
+std::ifstream open_mesh_file(const std::string& path);
+
 class Cursor {
  public:
   // The whole file in memory (`data` must outlive the cursor); `path` names it in messages.

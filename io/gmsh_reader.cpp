@@ -15,21 +15,7 @@ namespace fdem {
 namespace {
 
 std::string read_whole_file(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) {
-    throw InputError("Gmsh mesh file '" + path +
-                     "' does not exist (relative paths are taken from " +
-                     fs::current_path(ec).string() + "); expected an MSH 4.1 file from Gmsh.");
-  }
-  if (fs::is_directory(path, ec)) {
-    throw InputError("Gmsh mesh file '" + path + "' is a directory; expected an MSH 4.1 file.");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError("Gmsh mesh file '" + path +
-                     "' exists but cannot be opened for reading (check its permissions).");
-  }
+  std::ifstream in = gmsh::open_mesh_file(path);
   in.seekg(0, std::ios::end);
   const std::streamoff size = in.tellg();
   in.seekg(0, std::ios::beg);

@@ -461,11 +461,9 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   std::fill(nodes.constrained.begin(), nodes.constrained.end(), 0);
   std::fill(nodes.prescribed_velocity.begin(), nodes.prescribed_velocity.end(), 0.0);
   const auto local_node = [&](GlobalId gid) {
-    const auto owned_end = nodes.gid.begin() + nodes.n_owned;
-    auto it = std::lower_bound(nodes.gid.begin(), owned_end, gid);
-    if (it == owned_end || *it != gid) it = std::lower_bound(owned_end, nodes.gid.end(), gid);
-    FDEM_VERIFY(it != nodes.gid.end() && *it == gid, "a node of a local tet is local");
-    return static_cast<LocalIndex>(it - nodes.gid.begin());
+    const LocalIndex n = nodes.find(gid);
+    FDEM_VERIFY(n >= 0, "a node of a local tet is local");
+    return n;
   };
 
   // Tets: reference shapes, viscosities; node masses summed at the owners in tet-gid order, with

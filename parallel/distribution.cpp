@@ -326,20 +326,8 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   for (LocalIndex n = 0; n < n_nodes; ++n) {
     const NodeRow& r = node_rows[n];
     if (r.owner == me) nodes.n_owned = n + 1;
-    nodes.gid[n] = r.gid;
-    node_owner_[n] = r.owner;
-    node_first_tet_[n] = r.first_tet;
-    for (int k = 0; k < 3; ++k) {
-      nodes.x[3 * n + k] = r.x[k];
-      nodes.x0[3 * n + k] = r.x0[k];
-      nodes.v[3 * n + k] = r.v[k];
-      nodes.f[3 * n + k] = 0.0;
-      nodes.prescribed_velocity[3 * n + k] = r.prescribed_velocity[k];
-      state.x_at_detection[3 * n + k] = r.x_at_detection[k];
-    }
-    nodes.mass[n] = r.mass;
-    nodes.piece[n] = r.piece;
-    nodes.constrained[n] = r.constrained;
+    store_node_row(r, static_cast<std::size_t>(n), nodes, node_owner_, node_first_tet_,
+                   state.x_at_detection);
   }
 
   node_rows = std::vector<NodeRow>{};
@@ -352,36 +340,10 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   tets.active.assign(n_tets, 0);
   tet_owner_.resize(static_cast<std::size_t>(n_tets));
   state.tet_joint_state.assign(has_joint_state_ ? n_tets : 0, 0);
-  // Lookups by gid in the sorted ranges (no hash tables: they cost more than the arrays).
-  const auto node_index = [&](GlobalId gid) {
-    const auto owned_end = nodes.gid.begin() + nodes.n_owned;
-    auto it = std::lower_bound(nodes.gid.begin(), owned_end, gid);
-    if (it == owned_end || *it != gid) it = std::lower_bound(owned_end, nodes.gid.end(), gid);
-    return it != nodes.gid.end() && *it == gid ? static_cast<LocalIndex>(it - nodes.gid.begin())
-                                               : LocalIndex{-1};
-  };
-  const auto tet_index = [&](GlobalId gid) {
-    const auto it = std::lower_bound(tets.gid.begin(), tets.gid.end(), gid);
-    return it != tets.gid.end() && *it == gid ? static_cast<LocalIndex>(it - tets.gid.begin())
-                                              : LocalIndex{-1};
-  };
   for (LocalIndex t = 0; t < n_tets; ++t) {
     const TetRow& r = tet_rows[t];
-    tets.gid[t] = r.gid;
-    tet_owner_[t] = r.owner;
-    bool touches_owned = false;
-    for (int c = 0; c < 4; ++c) {
-      const LocalIndex n = node_index(r.nodes[c]);
-      FDEM_VERIFY(n >= 0, "a tet arrives with its nodes");
-      tets.nodes[4 * t + c] = n;
-      touches_owned = touches_owned || n < nodes.n_owned;
-    }
-    std::copy_n(r.dm_inv, 9, &tets.dm_inv[9 * static_cast<std::size_t>(t)]);
-    tets.volume0[t] = r.volume0;
-    tets.viscosity[t] = r.viscosity;
-    tets.material[t] = r.material;
-    tets.piece[t] = r.piece;
-    tets.contact_group[t] = r.contact_group;
+    const bool touches_owned =
+        store_tet_row(r, static_cast<std::size_t>(t), tets, tet_owner_, nodes);
     tets.owned[t] = r.owner == me;
     tets.active[t] = tets.owned[t] || touches_owned;
     tets.n_owned += tets.owned[t];
@@ -395,7 +357,7 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   joint_rows.erase(std::unique(joint_rows.begin(), joint_rows.end(), same_gid), joint_rows.end());
   joint_rows.erase(std::remove_if(joint_rows.begin(), joint_rows.end(),
                                   [&](const JointRow& r) {
-                                    return tet_index(r.tets[0]) < 0 || tet_index(r.tets[1]) < 0;
+                                    return tets.find(r.tets[0]) < 0 || tets.find(r.tets[1]) < 0;
                                   }),
                    joint_rows.end());
   JointArrays& joints = model.joints;
@@ -407,11 +369,11 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
     const JointRow& r = joint_rows[j];
     joints.gid[j] = r.gid;
     for (int i = 0; i < 6; ++i) {
-      const LocalIndex n = node_index(r.nodes[i]);
+      const LocalIndex n = nodes.find(r.nodes[i]);
       FDEM_VERIFY(n >= 0, "a joint's nodes are those of its tets");
       joints.nodes[6 * j + i] = n;
     }
-    for (int i = 0; i < 2; ++i) joints.tets[2 * j + i] = tet_index(r.tets[i]);
+    for (int i = 0; i < 2; ++i) joints.tets[2 * j + i] = tets.find(r.tets[i]);
     joints.area0[j] = r.area0;
     joints.failure_time[j] = r.failure_time;
     joints.damage[j] = r.damage;

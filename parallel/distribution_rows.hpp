@@ -3,6 +3,7 @@
 // parallel/.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
@@ -10,6 +11,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/model.hpp"
 #include "parallel/distribution.hpp"
 
@@ -222,6 +224,50 @@ class RowPacker {
   std::vector<std::int64_t> joint_offsets_;
   std::vector<LocalIndex> joint_list_;
 };
+
+// Writes node row `r` into entry n of the arrays (its force zeroed).
+inline void store_node_row(const NodeRow& r, std::size_t n, NodeArrays& nodes,
+                           std::vector<std::int32_t>& node_owner,
+                           std::vector<GlobalId>& node_first_tet,
+                           std::vector<double>& x_at_detection) {
+  nodes.gid[n] = r.gid;
+  node_owner[n] = r.owner;
+  node_first_tet[n] = r.first_tet;
+  for (std::size_t k = 0; k < 3; ++k) {
+    nodes.x[3 * n + k] = r.x[k];
+    nodes.x0[3 * n + k] = r.x0[k];
+    nodes.v[3 * n + k] = r.v[k];
+    nodes.f[3 * n + k] = 0.0;
+    nodes.prescribed_velocity[3 * n + k] = r.prescribed_velocity[k];
+    x_at_detection[3 * n + k] = r.x_at_detection[k];
+  }
+  nodes.mass[n] = r.mass;
+  nodes.piece[n] = r.piece;
+  nodes.constrained[n] = r.constrained;
+}
+
+// Writes tet row `r` into entry t of the arrays, its nodes found by gid in `nodes` (which must
+// hold them); the roles (owned, active) are the caller's.  Returns whether it touches a node
+// owned here.
+inline bool store_tet_row(const TetRow& r, std::size_t t, TetArrays& tets,
+                          std::vector<std::int32_t>& tet_owner, const NodeArrays& nodes) {
+  tets.gid[t] = r.gid;
+  tet_owner[t] = r.owner;
+  bool touches_owned = false;
+  for (std::size_t c = 0; c < 4; ++c) {
+    const LocalIndex n = nodes.find(r.nodes[c]);
+    FDEM_VERIFY(n >= 0, "a tet arrives with its nodes");
+    tets.nodes[4 * t + c] = n;
+    touches_owned = touches_owned || n < nodes.n_owned;
+  }
+  std::copy_n(r.dm_inv, 9, &tets.dm_inv[9 * t]);
+  tets.volume0[t] = r.volume0;
+  tets.viscosity[t] = r.viscosity;
+  tets.material[t] = r.material;
+  tets.piece[t] = r.piece;
+  tets.contact_group[t] = r.contact_group;
+  return touches_owned;
+}
 
 // The rows of packed buffers (each emptied once parsed), in the order they come.
 struct ParsedRows {

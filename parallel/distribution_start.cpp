@@ -83,19 +83,12 @@ void Distribution::append_halo(Model& model, TravellingState& state,
   const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
   NodeArrays& nodes = model.nodes;
   TetArrays& tets = model.tets;
-  const auto find_node = [&](GlobalId gid) {
-    const auto owned_end = nodes.gid.begin() + nodes.n_owned;
-    auto it = std::lower_bound(nodes.gid.begin(), owned_end, gid);
-    if (it == owned_end || *it != gid) it = std::lower_bound(owned_end, nodes.gid.end(), gid);
-    return it != nodes.gid.end() && *it == gid ? static_cast<LocalIndex>(it - nodes.gid.begin())
-                                               : LocalIndex{-1};
-  };
 
   // Nodes: the ones not held yet are ghosts, appended, then the ghost range sorted by gid.
   std::sort(rows.nodes.begin(), rows.nodes.end(), by_gid);
   rows.nodes.erase(std::unique(rows.nodes.begin(), rows.nodes.end(), same_gid), rows.nodes.end());
   rows.nodes.erase(std::remove_if(rows.nodes.begin(), rows.nodes.end(),
-                                  [&](const NodeRow& r) { return find_node(r.gid) >= 0; }),
+                                  [&](const NodeRow& r) { return nodes.find(r.gid) >= 0; }),
                    rows.nodes.end());
   const auto n_old = static_cast<std::size_t>(nodes.size());
   const std::size_t n_all = n_old + rows.nodes.size();
@@ -108,20 +101,7 @@ void Distribution::append_halo(Model& model, TravellingState& state,
     const NodeRow& r = rows.nodes[k];
     const std::size_t n = n_old + k;
     FDEM_VERIFY(r.owner != comm_.rank(), "a node owned here is held already");
-    nodes.gid[n] = r.gid;
-    node_owner_[n] = r.owner;
-    node_first_tet_[n] = r.first_tet;
-    for (int i = 0; i < 3; ++i) {
-      nodes.x[3 * n + i] = r.x[i];
-      nodes.x0[3 * n + i] = r.x0[i];
-      nodes.v[3 * n + i] = r.v[i];
-      nodes.f[3 * n + i] = 0.0;
-      nodes.prescribed_velocity[3 * n + i] = r.prescribed_velocity[i];
-      state.x_at_detection[3 * n + i] = r.x_at_detection[i];
-    }
-    nodes.mass[n] = r.mass;
-    nodes.piece[n] = r.piece;
-    nodes.constrained[n] = r.constrained;
+    store_node_row(r, n, nodes, node_owner_, node_first_tet_, state.x_at_detection);
   }
   rows.nodes = std::vector<NodeRow>{};
   std::vector<std::size_t> order(n_all - n_owned);
@@ -175,21 +155,7 @@ void Distribution::append_halo(Model& model, TravellingState& state,
     FDEM_VERIFY(
         r.owner != comm_.rank() && (k < lower || t_old == 0 || r.gid > tets.gid[lower + t_old - 1]),
         "halo tets lie outside the block");
-    tets.gid[t] = r.gid;
-    tet_owner_[t] = r.owner;
-    bool touches_owned = false;
-    for (int c = 0; c < 4; ++c) {
-      const LocalIndex n = find_node(r.nodes[c]);
-      FDEM_VERIFY(n >= 0, "a tet arrives with its nodes");
-      tets.nodes[4 * t + c] = n;
-      touches_owned = touches_owned || n < nodes.n_owned;
-    }
-    std::copy_n(r.dm_inv, 9, &tets.dm_inv[9 * t]);
-    tets.volume0[t] = r.volume0;
-    tets.viscosity[t] = r.viscosity;
-    tets.material[t] = r.material;
-    tets.piece[t] = r.piece;
-    tets.contact_group[t] = r.contact_group;
+    const bool touches_owned = store_tet_row(r, t, tets, tet_owner_, nodes);
     tets.owned[t] = 0;
     tets.active[t] = touches_owned;
   }
