@@ -69,10 +69,10 @@ class TableIndex : public NodeTagIndex {
  public:
   void reserve(std::int64_t min_tag, std::int64_t max_tag, std::int64_t count) override {
     min_tag_ = min_tag;
-    const std::int64_t span = max_tag - min_tag + 1;
-    dense_ = count > 0 && max_tag >= min_tag && span <= 4 * count + 1024;
+    // Tags are non-negative and count is bounded by the file size, so neither side overflows.
+    dense_ = count > 0 && max_tag >= min_tag && max_tag - min_tag < 4 * count + 1024;
     if (dense_) {
-      table_.assign(static_cast<std::size_t>(span), -1);
+      table_.assign(static_cast<std::size_t>(max_tag - min_tag + 1), -1);
     } else {
       map_.reserve(static_cast<std::size_t>(count));
     }
@@ -102,7 +102,8 @@ class TableIndex : public NodeTagIndex {
   std::unordered_map<std::int64_t, std::int64_t> map_;
 };
 
-// Disjoint runs [first, first + count) of tags at indices [index, index + count).
+// Disjoint runs [first, first + count) of tags at indices [index, index + count). Tags are
+// non-negative, so run ends are compared as differences: first + count may exceed int64.
 class RunIndex : public NodeTagIndex {
  public:
   void reserve(std::int64_t, std::int64_t, std::int64_t) override {}
@@ -110,7 +111,7 @@ class RunIndex : public NodeTagIndex {
     if (last_ != runs_.end()) {  // the common case: the next tag of the last run
       Run& run = last_->second;
       const auto next = std::next(last_);
-      if (tag == last_->first + run.count && index == run.index + run.count &&
+      if (tag > last_->first && tag - last_->first == run.count && index == run.index + run.count &&
           (next == runs_.end() || next->first > tag)) {
         ++run.count;
         return true;
@@ -119,18 +120,18 @@ class RunIndex : public NodeTagIndex {
     auto after = runs_.upper_bound(tag);
     if (after != runs_.begin()) {
       const auto before = std::prev(after);
-      if (tag < before->first + before->second.count) return false;
+      if (tag - before->first < before->second.count) return false;  // before->first <= tag
     }
     last_ = runs_.emplace_hint(after, tag, Run{1, index});
     return true;
   }
   std::int64_t find(std::int64_t tag) override {
     if (found_ == runs_.end() || tag < found_->first ||
-        tag >= found_->first + found_->second.count) {
+        tag - found_->first >= found_->second.count) {
       auto after = runs_.upper_bound(tag);
       if (after == runs_.begin()) return -1;
       found_ = std::prev(after);
-      if (tag >= found_->first + found_->second.count) {
+      if (tag - found_->first >= found_->second.count) {
         found_ = runs_.end();
         return -1;
       }

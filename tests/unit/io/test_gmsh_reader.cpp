@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/gmsh_cursor.hpp"
+#include "io/gmsh_parser.hpp"
 #include "io/gmsh_reader.hpp"
 
 namespace {
@@ -108,6 +110,35 @@ TEST_CASE("sparse node tags, parametric block, groups sharing a volume", "[io][g
     CHECK(lower.tets == std::vector<std::int32_t>{2, 1, 0, 3});
     CHECK(lower.tet_physical == std::vector<int>{12});
   }
+}
+
+// Node tags as the streaming parse (fdem prepare) hands them over, read through a 64-byte window.
+struct TagList : fdem::GmshSink {
+  std::vector<std::int64_t> tags, tet_nodes;
+  void node_tag(std::int64_t, std::int64_t tag) override { tags.push_back(tag); }
+  void node_coords(std::int64_t, const double (&)[3]) override {}
+  void tet(std::int64_t, int, const std::int64_t (&nodes)[4]) override {
+    tet_nodes.insert(tet_nodes.end(), nodes, nodes + 4);
+  }
+};
+
+TEST_CASE("node and element tags at the int64 limit (whole-file and streamed parse)",
+          "[io][gmsh]") {
+  // A run of node tags ending at 2^63 - 1: its end (first + count) is not representable.
+  const std::string path = data_file("tags_at_int64_limit.msh");
+  const fdem::GmshMesh mesh = fdem::read_gmsh(path);
+  const std::int64_t top = INT64_MAX;
+  CHECK(mesh.node_tags == std::vector<std::int64_t>{top - 3, top - 2, top - 1, top});
+  CHECK(mesh.tets == std::vector<std::int32_t>{0, 1, 2, 3});
+  CHECK(tet_volume(mesh, 0) == 4.0);
+
+  fdem::gmsh::Cursor window(path, 64);
+  TagList streamed;
+  const auto index = fdem::make_run_index();
+  const fdem::GmshTables tables = fdem::parse_gmsh_sections(window, path, *index, streamed);
+  CHECK(tables.n_tets == 1);
+  CHECK(streamed.tags == mesh.node_tags);
+  CHECK(streamed.tet_nodes == std::vector<std::int64_t>{0, 1, 2, 3});
 }
 
 TEST_CASE("cube from Gmsh: binary and ASCII MSH 4.1 give identical arrays", "[io][gmsh]") {
