@@ -25,12 +25,11 @@ int block_owner(const std::vector<GlobalId>& block, GlobalId g) {
   return static_cast<int>(std::upper_bound(block.begin(), block.end(), g) - block.begin()) - 1;
 }
 
-// A face of a local tet: sorted mesh node numbers, body, tet, the corner left out.
+// A face of a local tet: sorted mesh node numbers, body, the tet (index in face_tets).
 struct LocalFace {
   Key key;
   std::int32_t body;
   LocalIndex tet;
-  std::int32_t skip;
 };
 
 // A face travelling to its face directory.
@@ -100,7 +99,6 @@ struct ErrorKey {
     if (kind != o.kind) return kind < o.kind;
     return std::lexicographical_compare(detail, detail + 4, o.detail, o.detail + 4);
   }
-  bool operator==(const ErrorKey& o) const { return !(*this < o) && !(o < *this); }
 };
 
 class FirstError {
@@ -274,7 +272,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
     faces.reserve(4 * face_tets.size());
     for (std::size_t i = 0; i < face_tets.size(); ++i)
       for (int skip = 0; skip < 4; ++skip) {
-        LocalFace f{{0, 0, 0}, face_tets[i].body, static_cast<LocalIndex>(i), skip};
+        LocalFace f{{0, 0, 0}, face_tets[i].body, static_cast<LocalIndex>(i)};
         int k = 0;
         for (int c = 0; c < 4; ++c)
           if (c != skip) f.key[k++] = face_tets[i].mesh_node[c];
