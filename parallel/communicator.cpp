@@ -1,5 +1,6 @@
 #include "parallel/communicator.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <climits>
 #include <cstdio>
@@ -10,6 +11,30 @@ namespace fdem {
 namespace {
 
 std::atomic<int> g_live_collective{0};
+std::atomic<std::int64_t> g_message_limit{INT_MAX};
+constexpr int chunk_tag = 7001;  // point-to-point chunks of exchange_rows (halo uses 8)
+
+// A contiguous MPI type of `bytes` bytes (freed at scope exit).
+class RowType {
+ public:
+  explicit RowType(std::size_t bytes) {
+    MPI_Type_contiguous(detail::checked_count(bytes, 1), MPI_BYTE, &type_);
+    MPI_Type_commit(&type_);
+  }
+  ~RowType() { MPI_Type_free(&type_); }
+  RowType(const RowType&) = delete;
+  RowType& operator=(const RowType&) = delete;
+  MPI_Datatype get() const { return type_; }
+
+ private:
+  MPI_Datatype type_ = MPI_DATATYPE_NULL;
+};
+
+std::vector<std::int64_t> exclusive_sum(const std::vector<std::int64_t>& counts) {
+  std::vector<std::int64_t> at(counts.size(), 0);
+  for (std::size_t r = 1; r < counts.size(); ++r) at[r] = at[r - 1] + counts[r - 1];
+  return at;
+}
 std::terminate_handler g_previous_terminate = nullptr;
 
 // An exception escaping on one rank: the other ranks may be waiting in a collective, so end them.
@@ -102,6 +127,14 @@ int detail::checked_count(std::size_t n, int scale) {
   return static_cast<int>(scaled);
 }
 
+std::int64_t detail::message_limit() {
+  return g_message_limit.load();
+}
+
+void detail::set_message_limit(std::int64_t limit) {
+  g_message_limit = limit > 0 && limit < INT_MAX ? limit : INT_MAX;
+}
+
 // ---------------------------------------------------------------------------------------------
 Communicator::Communicator(MPI_Comm comm) : comm_(comm) {
   MPI_Comm_rank(comm_, &rank_);
@@ -125,8 +158,143 @@ std::string Communicator::broadcast(const std::string& text, int root) const {
   std::uint64_t length = rank_ == root ? text.size() : 0;
   MPI_Bcast(&length, 1, MPI_UINT64_T, root, comm_);
   std::string result = rank_ == root ? text : std::string(length, '\0');
-  MPI_Bcast(result.data(), detail::checked_count(length, 1), MPI_CHAR, root, comm_);
+  const auto limit = static_cast<std::uint64_t>(detail::message_limit());
+  for (std::uint64_t first = 0; first < length; first += limit)
+    MPI_Bcast(result.data() + first, static_cast<int>(std::min(limit, length - first)), MPI_CHAR,
+              root, comm_);
   return result;
+}
+
+std::vector<std::int64_t> Communicator::exchange_counts(
+    const std::vector<std::size_t>& send_rows) const {
+  FDEM_VERIFY(static_cast<int>(send_rows.size()) == size_, "one count per rank");
+  const std::vector<std::int64_t> send(send_rows.begin(), send_rows.end());
+  std::vector<std::int64_t> receive(static_cast<std::size_t>(size_), 0);
+  MPI_Alltoall(send.data(), 1, MPI_INT64_T, receive.data(), 1, MPI_INT64_T, comm_);
+  return receive;
+}
+
+void Communicator::exchange_rows(const void* send, const std::vector<std::int64_t>& send_rows,
+                                 void* receive, const std::vector<std::int64_t>& receive_rows,
+                                 std::size_t row_bytes) const {
+  FDEM_VERIFY(
+      static_cast<int>(send_rows.size()) == size_ && static_cast<int>(receive_rows.size()) == size_,
+      "one count per rank");
+  if (row_bytes == 0) return;  // nothing travels (every rank passes the same width)
+  const std::int64_t limit = detail::message_limit();
+  // A pair's rows go in the collective when at most `cap`: then a rank's collective rows total
+  // at most `limit`, so every count and (compacted) displacement fits an int.
+  const std::int64_t cap = limit / size_;
+  const RowType row(row_bytes);
+  const auto* out = static_cast<const char*>(send);
+  auto* in = static_cast<char*>(receive);
+  const std::vector<std::int64_t> send_at = exclusive_sum(send_rows),
+                                  receive_at = exclusive_sum(receive_rows);
+  const auto bytes = [&](std::int64_t rows) { return static_cast<std::size_t>(rows) * row_bytes; };
+  const auto collective = [&](int r, std::int64_t rows) { return r != rank_ && rows <= cap; };
+
+  // The collective part: at its place when every displacement fits, else through a compact copy.
+  std::vector<int> sc(size_, 0), sd(size_, 0), rc(size_, 0), rd(size_, 0);
+  bool send_in_place = true, receive_in_place = true;
+  for (int r = 0; r < size_; ++r) {
+    if (collective(r, send_rows[r])) {
+      sc[r] = static_cast<int>(send_rows[r]);
+      send_in_place = send_in_place && send_at[r] + send_rows[r] <= limit;
+    }
+    if (collective(r, receive_rows[r])) {
+      rc[r] = static_cast<int>(receive_rows[r]);
+      receive_in_place = receive_in_place && receive_at[r] + receive_rows[r] <= limit;
+    }
+  }
+  std::vector<char> send_copy, receive_copy;
+  const char* send_base = out;
+  char* receive_base = in;
+  std::int64_t at = 0;
+  for (int r = 0; r < size_; ++r) {
+    sd[r] = sc[r] == 0 ? 0 : static_cast<int>(send_in_place ? send_at[r] : at);
+    at += sc[r];
+  }
+  if (!send_in_place) {
+    send_copy.resize(bytes(at));
+    for (int r = 0; r < size_; ++r)
+      std::copy_n(out + bytes(send_at[r]), bytes(sc[r]), send_copy.data() + bytes(sd[r]));
+    send_base = send_copy.data();
+  }
+  at = 0;
+  for (int r = 0; r < size_; ++r) {
+    rd[r] = rc[r] == 0 ? 0 : static_cast<int>(receive_in_place ? receive_at[r] : at);
+    at += rc[r];
+  }
+  if (!receive_in_place) {
+    receive_copy.resize(bytes(at));
+    receive_base = receive_copy.data();
+  }
+
+  // Larger pairs: point-to-point chunks of at most `limit` rows, posted before the collective
+  // (messages of one pair and tag arrive in the order sent).
+  std::vector<MPI_Request> requests;
+  const auto post = [&](bool sending, int r, std::int64_t first, std::int64_t rows) {
+    for (std::int64_t k = 0; k < rows; k += limit) {
+      const int n = static_cast<int>(std::min(limit, rows - k));
+      requests.emplace_back();
+      if (sending)
+        MPI_Isend(out + bytes(first + k), n, row.get(), r, chunk_tag, comm_, &requests.back());
+      else
+        MPI_Irecv(in + bytes(first + k), n, row.get(), r, chunk_tag, comm_, &requests.back());
+    }
+  };
+  for (int r = 0; r < size_; ++r)
+    if (r != rank_ && !collective(r, receive_rows[r]))
+      post(false, r, receive_at[r], receive_rows[r]);
+  for (int r = 0; r < size_; ++r)
+    if (r != rank_ && !collective(r, send_rows[r])) post(true, r, send_at[r], send_rows[r]);
+  // This rank's own rows: a copy.
+  FDEM_VERIFY(send_rows[rank_] == receive_rows[rank_], "a rank receives what it sends itself");
+  std::copy_n(out + bytes(send_at[rank_]), bytes(send_rows[rank_]), in + bytes(receive_at[rank_]));
+  MPI_Alltoallv(send_base, sc.data(), sd.data(), row.get(), receive_base, rc.data(), rd.data(),
+                row.get(), comm_);
+  if (!requests.empty())
+    MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+  if (!receive_in_place)
+    for (int r = 0; r < size_; ++r)
+      std::copy_n(receive_copy.data() + bytes(rd[r]), bytes(rc[r]), in + bytes(receive_at[r]));
+}
+
+void Communicator::allgather_rows(const void* local, const std::vector<std::int64_t>& counts,
+                                  void* all, std::size_t row_bytes) const {
+  if (row_bytes == 0) return;
+  const std::int64_t limit = detail::message_limit();
+  const RowType row(row_bytes);
+  const std::vector<std::int64_t> at = exclusive_sum(counts);
+  const std::int64_t total = at.back() + counts.back();
+  auto* out = static_cast<char*>(all);
+  const auto bytes = [&](std::int64_t rows) { return static_cast<std::size_t>(rows) * row_bytes; };
+  std::vector<int> rc(size_), rd(size_);
+  if (total <= limit) {  // one call, straight into place
+    for (int r = 0; r < size_; ++r) {
+      rc[r] = static_cast<int>(counts[r]);
+      rd[r] = static_cast<int>(at[r]);
+    }
+    MPI_Allgatherv(local, rc[rank_], row.get(), out, rc.data(), rd.data(), row.get(), comm_);
+    return;
+  }
+  // Rounds: each rank sends up to `share` rows per round (counts are known everywhere, so every
+  // rank makes the same rounds), gathered compactly and copied into place.
+  const std::int64_t share = std::max<std::int64_t>(limit / size_, 1);
+  const std::int64_t most = *std::max_element(counts.begin(), counts.end());
+  std::vector<char> round(bytes(share * size_));
+  for (std::int64_t first = 0; first < most; first += share) {
+    std::int64_t filled = 0;
+    for (int r = 0; r < size_; ++r) {
+      rc[r] = static_cast<int>(std::clamp<std::int64_t>(counts[r] - first, 0, share));
+      rd[r] = static_cast<int>(filled);
+      filled += rc[r];
+    }
+    MPI_Allgatherv(static_cast<const char*>(local) + bytes(std::min(first, counts[rank_])),
+                   rc[rank_], row.get(), round.data(), rc.data(), rd.data(), row.get(), comm_);
+    for (int r = 0; r < size_; ++r)
+      std::copy_n(round.data() + bytes(rd[r]), bytes(rc[r]), out + bytes(at[r] + first));
+  }
 }
 
 void Communicator::check_errors(const LocalError& local) const {

@@ -19,6 +19,7 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <exception>
 #include <stdexcept>
@@ -124,15 +125,17 @@ MPI_Datatype mpi_type() {
     return MPI_BYTE;  // other plain structs travel as bytes (count scaled by sizeof)
 }
 template <class T>
-constexpr int mpi_scale() {
-  return std::is_arithmetic_v<T> ? 1 : static_cast<int>(sizeof(T));
-}
-template <class T>
 constexpr bool reducible() {
   return std::is_same_v<T, double> || std::is_same_v<T, float> || std::is_same_v<T, std::int32_t> ||
          std::is_same_v<T, std::int64_t> || std::is_same_v<T, std::uint64_t>;
 }
 int checked_count(std::size_t n, int scale);  // n·scale as an MPI count, or an internal error
+// Most elements one MPI call carries, and the largest displacement it may use: INT_MAX (MPI 3.1
+// counts are int).  Larger messages are cut (Communicator::exchange_rows, allgatherv,
+// broadcast, element-wise reductions).  Tests lower it to run the chunked paths on small data;
+// set_message_limit(0) restores INT_MAX.  Every rank must use the same limit.
+std::int64_t message_limit();
+void set_message_limit(std::int64_t limit);
 }  // namespace detail
 
 // Phases of a run, marked for profiling tools with MPI_Pcontrol(100 + phase) (a no-op without
@@ -200,14 +203,16 @@ class Communicator {
   template <class T>
   std::vector<T> allgather(const T& value) const;
   // Every rank's array concatenated in rank order, on every rank; `counts` (optional) receives
-  // each rank's length.
+  // each rank's length.  Counts and offsets are 64-bit (rounds of at most message_limit() rows
+  // when the whole does not fit one call).
   template <class T>
-  std::vector<T> allgatherv(const std::vector<T>& local, std::vector<int>* counts = nullptr) const;
+  std::vector<T> allgatherv(const std::vector<T>& local,
+                            std::vector<std::int64_t>* counts = nullptr) const;
 
   // Personalised all-to-all: `outbox[r]` goes to rank r (outbox has size() entries); returns
   // what every rank sent here, concatenated in rank order.  `sources` (optional) receives the
-  // sending rank of each element.  Elements travel as one MPI type of sizeof(T) bytes, so a
-  // message may hold up to 2^31 − 1 elements whatever their size.
+  // sending rank of each element.  Elements travel as one MPI type of sizeof(T) bytes; counts
+  // and offsets are 64-bit (exchange_rows).
   template <class T>
   std::vector<T> exchange(const std::vector<std::vector<T>>& outbox,
                           std::vector<int>* sources = nullptr) const;
@@ -217,6 +222,16 @@ class Communicator {
   std::vector<T> exchange_grouped(const std::vector<T>& grouped,
                                   const std::vector<std::size_t>& counts,
                                   std::vector<int>* sources = nullptr) const;
+  // The all-to-all underneath, for rows of a width known at run time: counts first (one
+  // MPI_Alltoall of 64-bit counts: what rank r sends here), then the rows.  `send` holds
+  // send_rows[r] rows for each rank r in rank order; `receive` gets receive_rows[r] rows from
+  // each rank in rank order.  A pair's rows go in the one MPI_Alltoallv when they are at most
+  // message_limit() / size() (so no count or displacement of it overflows int), else as
+  // point-to-point messages of at most message_limit() rows: any count a 64-bit size allows.
+  std::vector<std::int64_t> exchange_counts(const std::vector<std::size_t>& send_rows) const;
+  void exchange_rows(const void* send, const std::vector<std::int64_t>& send_rows, void* receive,
+                     const std::vector<std::int64_t>& receive_rows, std::size_t row_bytes) const;
+
   // Returns root's string on every rank.
   std::string broadcast(const std::string& text, int root = 0) const;
 
@@ -252,9 +267,15 @@ class Communicator {
   template <class T>
   void reduce_in_place(std::vector<T>& values, MPI_Op op) const {
     static_assert(detail::reducible<T>(), "reductions take double, float, int32, int64 or uint64");
-    MPI_Allreduce(MPI_IN_PLACE, values.data(), detail::checked_count(values.size(), 1),
-                  detail::mpi_type<T>(), op, comm_);
+    const auto limit = static_cast<std::size_t>(detail::message_limit());
+    for (std::size_t first = 0; first < values.size(); first += limit)  // same sizes everywhere
+      MPI_Allreduce(MPI_IN_PLACE, values.data() + first,
+                    static_cast<int>(std::min(limit, values.size() - first)), detail::mpi_type<T>(),
+                    op, comm_);
   }
+  // Rounds of MPI_Allgatherv of rows of `row_bytes` (counts[r] rows of rank r, known to all).
+  void allgather_rows(const void* local, const std::vector<std::int64_t>& counts, void* all,
+                      std::size_t row_bytes) const;
 
   MPI_Comm comm_;
   int rank_ = 0;
@@ -267,9 +288,10 @@ class Communicator {
 
 template <class T>
 std::vector<T> Communicator::allgather(const T& value) const {
+  static_assert(std::is_trivially_copyable_v<T>, "allgather moves plain values only");
   std::vector<T> all(static_cast<std::size_t>(size_));
-  const int n = detail::mpi_scale<T>();
-  MPI_Allgather(&value, n, detail::mpi_type<T>(), all.data(), n, detail::mpi_type<T>(), comm_);
+  MPI_Allgather(&value, static_cast<int>(sizeof(T)), MPI_BYTE, all.data(),
+                static_cast<int>(sizeof(T)), MPI_BYTE, comm_);
   return all;
 }
 
@@ -292,57 +314,34 @@ std::vector<T> Communicator::exchange_grouped(const std::vector<T>& grouped,
                                               std::vector<int>* sources) const {
   static_assert(std::is_trivially_copyable_v<T>, "exchange moves plain values only");
   FDEM_VERIFY(static_cast<int>(counts.size()) == size_, "one count per rank");
-  std::vector<int> send_counts(size_), send_displs(size_), receive_counts(size_),
-      receive_displs(size_);
   std::size_t total = 0;
-  for (int r = 0; r < size_; ++r) {
-    send_displs[r] = detail::checked_count(total, 1);
-    send_counts[r] = detail::checked_count(counts[r], 1);
-    total += counts[r];
-  }
+  for (std::size_t c : counts) total += c;
   FDEM_VERIFY(total == grouped.size(), "the counts cover the grouped array");
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_);
+  const std::vector<std::int64_t> send_rows(counts.begin(), counts.end());
+  const std::vector<std::int64_t> receive_rows = exchange_counts(counts);
   total = 0;
-  for (int r = 0; r < size_; ++r) {
-    receive_displs[r] = detail::checked_count(total, 1);
-    total += static_cast<std::size_t>(receive_counts[r]);
-  }
-  detail::checked_count(total, 1);
+  for (std::int64_t c : receive_rows) total += static_cast<std::size_t>(c);
   std::vector<T> received(total);
-  MPI_Datatype type;
-  MPI_Type_contiguous(static_cast<int>(sizeof(T)), MPI_BYTE, &type);
-  MPI_Type_commit(&type);
-  MPI_Alltoallv(grouped.data(), send_counts.data(), send_displs.data(), type, received.data(),
-                receive_counts.data(), receive_displs.data(), type, comm_);
-  MPI_Type_free(&type);
+  exchange_rows(grouped.data(), send_rows, received.data(), receive_rows, sizeof(T));
   if (sources) {
     sources->clear();
     sources->reserve(total);
-    for (int r = 0; r < size_; ++r) sources->insert(sources->end(), receive_counts[r], r);
+    for (int r = 0; r < size_; ++r)
+      sources->insert(sources->end(), static_cast<std::size_t>(receive_rows[r]), r);
   }
   return received;
 }
 
 template <class T>
 std::vector<T> Communicator::allgatherv(const std::vector<T>& local,
-                                        std::vector<int>* counts) const {
-  const int scale = detail::mpi_scale<T>();
-  const int my_count = detail::checked_count(local.size(), scale);
-  std::vector<int> raw_counts = allgather(my_count);
-  std::vector<int> displs(raw_counts.size(), 0);
+                                        std::vector<std::int64_t>* counts) const {
+  static_assert(std::is_trivially_copyable_v<T>, "allgatherv moves plain values only");
+  const std::vector<std::int64_t> rows = allgather(static_cast<std::int64_t>(local.size()));
   std::size_t total = 0;
-  for (std::size_t r = 0; r < raw_counts.size(); ++r) {
-    displs[r] = detail::checked_count(total, 1);
-    total += static_cast<std::size_t>(raw_counts[r]);
-  }
-  detail::checked_count(total, 1);
-  std::vector<T> all(total / static_cast<std::size_t>(scale));
-  MPI_Allgatherv(local.data(), my_count, detail::mpi_type<T>(), all.data(), raw_counts.data(),
-                 displs.data(), detail::mpi_type<T>(), comm_);
-  if (counts) {
-    counts->resize(raw_counts.size());
-    for (std::size_t r = 0; r < raw_counts.size(); ++r) (*counts)[r] = raw_counts[r] / scale;
-  }
+  for (std::int64_t c : rows) total += static_cast<std::size_t>(c);
+  std::vector<T> all(total);
+  allgather_rows(local.data(), rows, all.data(), sizeof(T));
+  if (counts) *counts = rows;
   return all;
 }
 

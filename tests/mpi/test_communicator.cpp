@@ -113,7 +113,7 @@ TEST_CASE("allgather and allgatherv reassemble the global array in rank order", 
   const std::int64_t begin = std::int64_t(r) * (r - 1) / 2;
   std::vector<std::int64_t> local;
   for (int k = 0; k < r; ++k) local.push_back(begin + k);
-  std::vector<int> counts;
+  std::vector<std::int64_t> counts;
   const auto all = comm.allgatherv(local, &counts);
   CHECK(all.size() == static_cast<std::size_t>(n * (n - 1) / 2));
   bool in_order = true;
@@ -235,4 +235,101 @@ TEST_CASE("an exception escaping on one rank ends all ranks", "[.uncaught]") {
   }
   comm.barrier();
   FAIL("a rank got past the barrier");
+}
+
+namespace {
+// Lowers detail::message_limit() for one scope (every rank alike), so that the chunked paths —
+// point-to-point pieces, compacted collective parts, rounds — run on small data.
+struct MessageLimit {
+  explicit MessageLimit(std::int64_t limit) { detail::set_message_limit(limit); }
+  ~MessageLimit() { detail::set_message_limit(0); }
+};
+
+// What rank `from` sends rank `to`: a length that varies by pair (0 for some), values naming both.
+struct Row {
+  std::int64_t from, to, k;
+  double x;
+};
+std::vector<Row> rows_for(int from, int to) {
+  std::vector<Row> rows;
+  const int n = (3 * from + 5 * to) % 11;
+  for (int k = 0; k < n; ++k) rows.push_back({from, to, k, 0.5 * k + from - to});
+  return rows;
+}
+}  // namespace
+
+TEST_CASE("64-bit counts: exchanges cut into pieces give what one message gives", "[mpi]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const int n = comm.size(), me = comm.rank();
+  std::vector<std::vector<Row>> outbox(static_cast<std::size_t>(n));
+  for (int to = 0; to < n; ++to) outbox[static_cast<std::size_t>(to)] = rows_for(me, to);
+  std::vector<int> whole_sources;
+  const std::vector<Row> whole = comm.exchange(outbox, &whole_sources);
+  std::vector<std::int64_t> local;  // rank r holds 7r + 3 values
+  for (int k = 0; k < 7 * me + 3; ++k) local.push_back(1000 * me + k);
+  std::vector<std::int64_t> whole_counts;
+  const std::vector<std::int64_t> gathered = comm.allgatherv(local, &whole_counts);
+  std::vector<double> sums(23);
+  for (std::size_t i = 0; i < sums.size(); ++i) sums[i] = 0.25 * static_cast<double>(i) * (me + 1);
+  std::vector<double> whole_sums = sums;
+  comm.sum_in_place(whole_sums);
+  const std::string text(1000, static_cast<char>('a' + me));
+  // Limits below the rank count (every pair as point-to-point pieces), between (some pairs in
+  // the collective, compacted), and large (one call, as before).
+  for (std::int64_t limit : {1, 2, 3, 5, 8, 40, 1000}) {
+    INFO("message limit " << limit);
+    const MessageLimit scope(limit);
+    std::vector<int> sources;
+    const std::vector<Row> got = comm.exchange(outbox, &sources);
+    bool same = got.size() == whole.size() && sources == whole_sources;
+    for (std::size_t i = 0; same && i < got.size(); ++i)
+      same = got[i].from == whole[i].from && got[i].to == me && got[i].k == whole[i].k &&
+             got[i].x == whole[i].x;
+    CHECK(same);
+    std::vector<std::int64_t> counts;
+    CHECK(comm.allgatherv(local, &counts) == gathered);
+    CHECK(counts == whole_counts);
+    std::vector<double> reduced = sums;
+    comm.sum_in_place(reduced);
+    CHECK(reduced == whole_sums);
+    CHECK(comm.broadcast(text, n - 1) == std::string(1000, static_cast<char>('a' + n - 1)));
+  }
+  // Every element arrived once, in rank order, with what its sender meant for this rank.
+  std::int64_t expected = 0;
+  for (int from = 0; from < n; ++from) expected += static_cast<std::int64_t>(rows_for(from, me).size());
+  CHECK(static_cast<std::int64_t>(whole.size()) == expected);
+  CHECK(gathered.size() == static_cast<std::size_t>(7 * n * (n - 1) / 2 + 3 * n));
+}
+
+TEST_CASE("64-bit counts: rows of any width, own rows included, exchanged in pieces", "[mpi]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const int n = comm.size(), me = comm.rank();
+  // 24-byte rows: rank `from` sends rank `to` (from + 2·to) % 5 + 4 of them, its own too.
+  const std::size_t width = 24;
+  std::vector<std::size_t> rows(static_cast<std::size_t>(n));
+  std::vector<unsigned char> send;
+  for (int to = 0; to < n; ++to) {
+    rows[static_cast<std::size_t>(to)] = static_cast<std::size_t>((me + 2 * to) % 5 + 4);
+    for (std::size_t r = 0; r < rows[static_cast<std::size_t>(to)]; ++r)
+      for (std::size_t b = 0; b < width; ++b)
+        send.push_back(static_cast<unsigned char>(31 * me + 7 * to + 3 * r + b));
+  }
+  const MessageLimit scope(3);  // below the largest pair: pieces, and compacted collective parts
+  const std::vector<std::int64_t> incoming = comm.exchange_counts(rows);
+  std::size_t total = 0;
+  for (std::int64_t c : incoming) total += static_cast<std::size_t>(c);
+  std::vector<unsigned char> received(total * width);
+  comm.exchange_rows(send.data(), std::vector<std::int64_t>(rows.begin(), rows.end()),
+                     received.data(), incoming, width);
+  long wrong = 0;
+  std::size_t at = 0;
+  for (int from = 0; from < n; ++from) {
+    wrong += incoming[static_cast<std::size_t>(from)] != (from + 2 * me) % 5 + 4;
+    for (std::int64_t r = 0; r < incoming[static_cast<std::size_t>(from)]; ++r)
+      for (std::size_t b = 0; b < width; ++b)
+        wrong += received[at++] != static_cast<unsigned char>(31 * from + 7 * me + 3 * r + b);
+  }
+  CHECK(wrong == 0);
 }
