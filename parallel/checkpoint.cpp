@@ -99,21 +99,20 @@ class BlockExchange {
     rows_ = blocks.count(comm.rank());
     auto owner = [&](GlobalId g) { return blocks.owner(g); };
 
-    // Local rows grouped by destination rank (a counting sort keeps it linear).
-    detail::checked_count(gids.size(), 1);
+    // Local rows grouped by destination rank (a counting sort keeps it linear).  Counts and
+    // offsets are 64-bit (Communicator::exchange_rows).
     std::vector<int> destination(gids.size());
-    send_counts_.assign(static_cast<std::size_t>(ranks), 0);
+    std::vector<std::size_t> counts(static_cast<std::size_t>(ranks), 0);
     for (std::size_t i = 0; i < gids.size(); ++i)
-      ++send_counts_[static_cast<std::size_t>(destination[i] = owner(gids[i]))];
-    send_displs_ = exclusive_sum(send_counts_);
+      ++counts[static_cast<std::size_t>(destination[i] = owner(gids[i]))];
+    send_counts_.assign(counts.begin(), counts.end());
+    std::vector<std::int64_t> next(static_cast<std::size_t>(ranks), 0);
+    for (int r = 1; r < ranks; ++r) next[r] = next[r - 1] + send_counts_[r - 1];
     send_order_.resize(gids.size());
-    std::vector<int> next = send_displs_;
     for (std::size_t i = 0; i < gids.size(); ++i)
       send_order_[static_cast<std::size_t>(next[static_cast<std::size_t>(destination[i])]++)] = i;
-    recv_counts_.assign(static_cast<std::size_t>(ranks), 0);
-    MPI_Alltoall(send_counts_.data(), 1, MPI_INT, recv_counts_.data(), 1, MPI_INT, comm.handle());
-    recv_displs_ = exclusive_sum(recv_counts_);
-    received_rows_ = static_cast<std::size_t>(recv_displs_.back() + recv_counts_.back());
+    recv_counts_ = comm.exchange_counts(counts);
+    for (std::int64_t c : recv_counts_) received_rows_ += static_cast<std::size_t>(c);
 
     // Where each received row goes in the block: the gids of all ranks are 0..n-1 exactly once
     // iff every block slot of every rank is hit exactly once.
@@ -153,17 +152,6 @@ class BlockExchange {
   }
 
  private:
-  static std::vector<int> exclusive_sum(const std::vector<int>& counts) {
-    std::vector<int> displs(counts.size(), 0);
-    std::size_t total = 0;
-    for (std::size_t r = 0; r < counts.size(); ++r) {
-      displs[r] = detail::checked_count(total, 1);
-      total += static_cast<std::size_t>(counts[r]);
-    }
-    detail::checked_count(total, 1);
-    return displs;
-  }
-
   // Rows (`width` values of T each) sent to their block ranks, in the order received.
   template <class T>
   std::vector<T> exchange(const std::vector<T>& values, std::size_t width) const {
@@ -174,18 +162,14 @@ class BlockExchange {
     for (std::size_t i = 0; i < send_order_.size(); ++i)
       std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(send_order_[i] * width), width,
                   send.begin() + static_cast<std::ptrdiff_t>(i * width));
-    MPI_Datatype row = MPI_DATATYPE_NULL;
-    MPI_Type_contiguous(detail::checked_count(width * sizeof(T), 1), MPI_BYTE, &row);
-    MPI_Type_commit(&row);
-    MPI_Alltoallv(send.data(), send_counts_.data(), send_displs_.data(), row, received.data(),
-                  recv_counts_.data(), recv_displs_.data(), row, comm_.handle());
-    MPI_Type_free(&row);
+    comm_.exchange_rows(send.data(), send_counts_, received.data(), recv_counts_,
+                        width * sizeof(T));
     return received;
   }
 
   Communicator comm_;
   std::int64_t begin_ = 0, rows_ = 0;
-  std::vector<int> send_counts_, send_displs_, recv_counts_, recv_displs_;
+  std::vector<std::int64_t> send_counts_, recv_counts_;  // rows per rank
   std::vector<std::size_t> send_order_, slot_;
   std::size_t received_rows_ = 0;
   std::string problem_;

@@ -230,7 +230,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
 // and lists[me] into `own` when given.
 void Distribution::pack_rows(const Model& model, const TravellingState& state,
                              const std::vector<std::vector<LocalIndex>>& lists,
-                             std::vector<char>& send, std::vector<int>& send_counts,
+                             std::vector<char>& send, std::vector<std::size_t>& send_counts,
                              std::vector<char>* own,
                              const std::vector<StartJoint>* start_joints) const {
   const int ranks = comm_.size(), me = comm_.rank();
@@ -244,34 +244,20 @@ void Distribution::pack_rows(const Model& model, const TravellingState& state,
     }
     const std::size_t before = send.size();
     packer.pack(lists[p], send);
-    // Counts in 8-byte words (every row is a multiple of 8 bytes): up to 16 GiB per rank.
-    FDEM_VERIFY(send.size() / 8 < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-                "migration data under 16 GiB per rank");
-    send_counts[p] = static_cast<int>((send.size() - before) / 8);
+    send_counts[p] = (send.size() - before) / 8;  // in 8-byte words: every row is a multiple
   }
 }
 
 // Sends the packed rows (freeing `send`) and returns what the other ranks sent here.
+// (Counts and offsets are 64-bit: Communicator::exchange_rows cuts what one call cannot hold.)
 std::vector<char> Distribution::exchange_rows(std::vector<char>& send,
-                                              const std::vector<int>& send_counts) const {
-  const int ranks = comm_.size();
-  std::vector<int> send_offsets(ranks, 0), receive_counts(ranks, 0), receive_offsets(ranks, 0);
-  for (int p = 1; p < ranks; ++p) send_offsets[p] = send_offsets[p - 1] + send_counts[p - 1];
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
+                                              const std::vector<std::size_t>& send_counts) const {
+  const std::vector<std::int64_t> send_words(send_counts.begin(), send_counts.end());
+  const std::vector<std::int64_t> receive_words = comm_.exchange_counts(send_counts);
   std::size_t received = 0;  // words
-  for (int p = 0; p < ranks; ++p) {
-    receive_offsets[p] = static_cast<int>(received);
-    received += static_cast<std::size_t>(receive_counts[p]);
-  }
-  FDEM_VERIFY(received < static_cast<std::size_t>(std::numeric_limits<int>::max()),
-              "migration data under 16 GiB per rank");
+  for (std::int64_t w : receive_words) received += static_cast<std::size_t>(w);
   std::vector<char> receive(8 * received);
-  MPI_Datatype word;
-  MPI_Type_contiguous(8, MPI_BYTE, &word);
-  MPI_Type_commit(&word);
-  MPI_Alltoallv(send.data(), send_counts.data(), send_offsets.data(), word, receive.data(),
-                receive_counts.data(), receive_offsets.data(), word, comm_.handle());
-  MPI_Type_free(&word);
+  comm_.exchange_rows(send.data(), send_words, receive.data(), receive_words, 8);
   send = std::vector<char>{};
   return receive;
 }
@@ -284,7 +270,7 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   const std::vector<std::vector<LocalIndex>> lists = destinations(model, false, start_reach);
   // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
   std::vector<char> send, own;
-  std::vector<int> send_counts;
+  std::vector<std::size_t> send_counts;
   pack_rows(model, state, lists, send, send_counts, &own, start_joints);
   // The rows hold everything that travels: the source arrays can go before the new ones come.
   model.nodes = NodeArrays{};
@@ -645,34 +631,22 @@ void Distribution::build_exchange(const Model& model) {
     receive[owner].push_back(n);
     request[owner].push_back(nodes.gid[n]);
   }
-  std::vector<int> send_counts(ranks), send_offsets(ranks), receive_counts(ranks),
-      receive_offsets(ranks);
-  std::vector<GlobalId> flat;
-  for (int p = 0; p < ranks; ++p) {
-    send_offsets[p] = static_cast<int>(flat.size());
-    send_counts[p] = static_cast<int>(request[p].size());
-    flat.insert(flat.end(), request[p].begin(), request[p].end());
-  }
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm_.handle());
-  int total = 0;
-  for (int p = 0; p < ranks; ++p) {
-    receive_offsets[p] = total;
-    total += receive_counts[p];
-  }
-  std::vector<GlobalId> asked(static_cast<std::size_t>(total));
-  MPI_Alltoallv(flat.data(), send_counts.data(), send_offsets.data(), MPI_INT64_T, asked.data(),
-                receive_counts.data(), receive_offsets.data(), MPI_INT64_T, comm_.handle());
+  std::vector<int> asker;  // the rank of each asked gid (in rank order)
+  const std::vector<GlobalId> asked = comm_.exchange(request, &asker);
   std::unordered_map<GlobalId, LocalIndex> owned_index;
   owned_index.reserve(static_cast<std::size_t>(nodes.n_owned));
   for (LocalIndex n = 0; n < nodes.n_owned; ++n) owned_index.emplace(nodes.gid[n], n);
   neighbours_.clear();
+  std::size_t next = 0;  // first asked gid of rank p
   for (int p = 0; p < ranks; ++p) {
-    if (receive[p].empty() && receive_counts[p] == 0) continue;
+    const std::size_t first = next;
+    while (next < asked.size() && asker[next] == p) ++next;
+    if (receive[p].empty() && next == first) continue;
     Neighbour nb;
     nb.rank = p;
     nb.receive = std::move(receive[p]);
-    for (int i = 0; i < receive_counts[p]; ++i) {
-      const auto it = owned_index.find(asked[receive_offsets[p] + i]);
+    for (std::size_t i = first; i < next; ++i) {
+      const auto it = owned_index.find(asked[i]);
       FDEM_VERIFY(it != owned_index.end(), "a rank asks for a node this rank owns");
       nb.send.push_back(it->second);
     }

@@ -117,10 +117,10 @@ class Distribution {
   // `own` when given; exchange_rows sends them (freeing `send`) and returns what arrived.
   void pack_rows(const Model& model, const TravellingState& state,
                  const std::vector<std::vector<LocalIndex>>& lists, std::vector<char>& send,
-                 std::vector<int>& send_counts, std::vector<char>* own,
+                 std::vector<std::size_t>& send_counts, std::vector<char>* own,
                  const std::vector<StartJoint>* start_joints = nullptr) const;
   std::vector<char> exchange_rows(std::vector<char>& send,
-                                  const std::vector<int>& send_counts) const;
+                                  const std::vector<std::size_t>& send_counts) const;
   // Builds `model` from packed rows; empties each buffer once parsed.
   void assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
                 TravellingState& state);

@@ -74,7 +74,7 @@ void Distribution::append_halo(Model& model, TravellingState& state,
   FDEM_VERIFY(model.joints.size() == 0 && state.friction.empty() && !has_joint_state_,
               "append_halo: a model without joints or friction history");
   std::vector<char> send;
-  std::vector<int> send_counts;
+  std::vector<std::size_t> send_counts;
   pack_rows(model, state, destinations(model, false, start_reach), send, send_counts, nullptr);
   std::vector<char> receive = exchange_rows(send, send_counts);
   ParsedRows rows = parse_rows({&receive});
