@@ -316,7 +316,7 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     return pa != qa ? pa < qa : tets.gid[drafts[p].tet_b] < tets.gid[drafts[q].tet_b];
   });
   JointArrays& joints = model.joints;
-  joints.resize(static_cast<LocalIndex>(drafts.size()));
+  joints.resize(local_count(drafts.size(), "joints"));
   for (std::size_t j = 0; j < order.size(); ++j) {
     const JointDraft& d = drafts[order[j]];
     joints.gid[j] = static_cast<GlobalId>(j);

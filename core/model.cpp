@@ -2,8 +2,19 @@
 
 #include <algorithm>
 #include <numeric>
+#include <string>
+
+#include "core/error.hpp"
 
 namespace fdem {
+
+LocalIndex local_count(std::size_t n, const char* what) {
+  if (n > static_cast<std::size_t>(max_local_entries))
+    throw InputError("one rank would hold " + std::to_string(n) + " " + what + ", more than the " +
+                     std::to_string(max_local_entries) +
+                     " one rank can index (32-bit local indices): run on more ranks");
+  return static_cast<LocalIndex>(n);
+}
 
 void NodeArrays::resize(LocalIndex n) {
   gid.resize(n);

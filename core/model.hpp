@@ -126,6 +126,10 @@ struct Model {
   std::vector<JointLawSpec> joint_laws;
 };
 
+// `n` (how many nodes, tets or joints — `what` — one rank is to hold) as a LocalIndex; throws
+// InputError when it exceeds max_local_entries, before any array of that size is indexed.
+LocalIndex local_count(std::size_t n, const char* what);
+
 // Builds tet_force_order from the tets' global ids (call after any change of the tet arrays).
 void build_tet_force_order(const TetArrays& tets, std::vector<LocalIndex>& order);
 

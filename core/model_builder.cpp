@@ -145,6 +145,16 @@ Model model_frame(const Scene& scene) {
 Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, ElementOrder order) {
   FDEM_VERIFY(meshes.size() == scene.bodies.size(), "one mesh per body");
   Model model = model_frame(scene);
+  // The whole model is local here: its counts must fit local indices (split bodies: 4 nodes a tet).
+  std::size_t all_tets = 0, all_nodes = 0;
+  for (std::size_t b = 0; b < meshes.size(); ++b) {
+    const std::size_t tets = meshes[b].tets.size() / 4;
+    all_tets += tets;
+    all_nodes +=
+        scene.bodies[b].joints == JointPlacement::all ? 4 * tets : meshes[b].coords.size() / 3;
+  }
+  local_count(all_tets, "tetrahedra");
+  local_count(all_nodes, "nodes");
 
   // Gather every tet of every body with its body, piece and source position.
   struct TetRecord {

@@ -14,6 +14,11 @@ using Mat3 = Eigen::Matrix3d;
 using GlobalId = std::int64_t;
 using LocalIndex = std::int32_t;
 
+// Most nodes, tets or joints one rank may hold.  Local indices are 32-bit, and the arrays are
+// addressed as k·index + c with k up to 9 (Dm⁻¹: 9 doubles per tet), so 9·index must fit an
+// int32 too: 238,609,294 (a whole model is bounded only by its 64-bit gids: use more ranks).
+constexpr std::int64_t max_local_entries = 0x7fffffff / 9;
+
 // View of node i's xyz triple inside a flat array of 3*n doubles.
 inline Eigen::Map<Vec3> vec3_at(double* xyz, LocalIndex i) {
   return Eigen::Map<Vec3>(xyz + 3 * i);

@@ -440,7 +440,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     return oa != ob ? oa : a.gid < b.gid;
   });
   NodeArrays& nodes = model.nodes;
-  const LocalIndex n_local = static_cast<LocalIndex>(local_nodes.size());
+  const LocalIndex n_local = local_count(local_nodes.size(), "nodes");
   nodes.resize(n_local);
   nodes.n_owned = 0;
   out.node_first_tet.resize(static_cast<std::size_t>(n_local));
@@ -469,7 +469,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   // Tets: reference shapes, viscosities; node masses summed at the owners in tet-gid order, with
   // the largest extent among each node's tets (the reach of the first halo).
   TetArrays& tets = model.tets;
-  const LocalIndex n_tets = static_cast<LocalIndex>(records.size());
+  const LocalIndex n_tets = local_count(records.size(), "tetrahedra");
   tets.resize(n_tets);
   tets.n_owned = n_tets;
   tets.contact_group.resize(n_tets);

@@ -165,6 +165,11 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
   const int ranks = comm.size(), me = comm.rank();
   const GlobalId first_tet = tet_block[static_cast<std::size_t>(me)];
   const TetArrays& tets = block.tets;
+  // Local index of a tet of this block, checked in 64 bits before it is narrowed.
+  const auto block_tet = [&](GlobalId tet) {
+    FDEM_VERIFY(tet >= first_tet && tet - first_tet < tets.size(), "a tet of this rank's block");
+    return static_cast<LocalIndex>(tet - first_tet);
+  };
   const NodeArrays& nodes = block.nodes;
   const std::int32_t n_bodies = static_cast<std::int32_t>(scene.bodies.size());
   const std::int32_t n_materials = static_cast<std::int32_t>(scene.materials.size());
@@ -202,8 +207,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
   std::vector<Placed> placed;
   const double* x0 = nodes.x0.data();
   const auto bonded = [&](GlobalId tet, double partner_extent) {
-    const LocalIndex t = static_cast<LocalIndex>(tet - first_tet);
-    FDEM_VERIFY(t >= 0 && t < tets.size(), "a joint reaches the owners of its tets");
+    const LocalIndex t = block_tet(tet);  // a joint reaches the owners of its tets
     out.bonded[static_cast<std::size_t>(t)] = 1;
     double& extent = out.partner_extent[static_cast<std::size_t>(t)];
     extent = std::max(extent, partner_extent);
@@ -377,7 +381,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
   std::vector<OwnedBoundary> owned_boundary;
   std::vector<NodeMatch> matches;  // partners of this rank's boundary nodes
   for (const BoundaryNotice& n : comm.exchange(notices)) {
-    const LocalIndex t = static_cast<LocalIndex>(n.tet - first_tet);
+    const LocalIndex t = block_tet(n.tet);
     const auto it = std::lower_bound(face_tets.begin(), face_tets.end(), t,
                                      [](const FaceTet& f, LocalIndex v) { return f.tet < v; });
     FDEM_VERIFY(it != face_tets.end() && it->tet == t, "a boundary face's tet is a face tet");

@@ -303,7 +303,7 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
                         [&](const NodeRow& r) { return r.owner == me; });
 
   NodeArrays& nodes = model.nodes;
-  const LocalIndex n_nodes = static_cast<LocalIndex>(node_rows.size());
+  const LocalIndex n_nodes = local_count(node_rows.size(), "nodes");
   nodes.resize(n_nodes);
   nodes.n_owned = 0;
   node_owner_.resize(static_cast<std::size_t>(n_nodes));
@@ -318,7 +318,7 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
 
   node_rows = std::vector<NodeRow>{};
   TetArrays& tets = model.tets;
-  const LocalIndex n_tets = static_cast<LocalIndex>(tet_rows.size());
+  const LocalIndex n_tets = local_count(tet_rows.size(), "tetrahedra");
   tets.resize(n_tets);
   tets.n_owned = 0;
   tets.contact_group.resize(n_tets);
@@ -347,7 +347,7 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
                                   }),
                    joint_rows.end());
   JointArrays& joints = model.joints;
-  const LocalIndex n_joints = static_cast<LocalIndex>(joint_rows.size());
+  const LocalIndex n_joints = local_count(joint_rows.size(), "joints");
   joints = JointArrays{};
   joints.resize(n_joints);
   state.joint_history.assign(static_cast<std::size_t>(n_joints), JointHistory{});
@@ -662,8 +662,9 @@ void Distribution::start_halo_exchange(const NodeArrays& nodes) {
   for (Neighbour& nb : neighbours_)
     if (!nb.receive.empty()) {
       requests_.emplace_back();
-      MPI_Irecv(nb.receive_buffer.data(), static_cast<int>(nb.receive_buffer.size()), MPI_DOUBLE,
-                nb.rank, tag, comm_.handle(), &requests_.back());
+      // 6 doubles per node: fits an int, local counts being at most max_local_entries.
+      MPI_Irecv(nb.receive_buffer.data(), detail::checked_count(nb.receive_buffer.size(), 1),
+                MPI_DOUBLE, nb.rank, tag, comm_.handle(), &requests_.back());
     }
   for (Neighbour& nb : neighbours_)
     if (!nb.send.empty()) {
@@ -673,8 +674,8 @@ void Distribution::start_halo_exchange(const NodeArrays& nodes) {
         for (int k = 0; k < 3; ++k) *out++ = nodes.v[3 * n + k];
       }
       requests_.emplace_back();
-      MPI_Isend(nb.send_buffer.data(), static_cast<int>(nb.send_buffer.size()), MPI_DOUBLE, nb.rank,
-                tag, comm_.handle(), &requests_.back());
+      MPI_Isend(nb.send_buffer.data(), detail::checked_count(nb.send_buffer.size(), 1), MPI_DOUBLE,
+                nb.rank, tag, comm_.handle(), &requests_.back());
     }
 }
 

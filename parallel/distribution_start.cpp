@@ -93,7 +93,7 @@ void Distribution::append_halo(Model& model, TravellingState& state,
   const auto n_old = static_cast<std::size_t>(nodes.size());
   const std::size_t n_all = n_old + rows.nodes.size();
   const auto n_owned = static_cast<std::size_t>(nodes.n_owned);
-  nodes.resize(static_cast<LocalIndex>(n_all));
+  nodes.resize(local_count(n_all, "nodes"));
   node_owner_.resize(n_all);
   node_first_tet_.resize(n_all);
   state.x_at_detection.resize(3 * n_all);
@@ -130,6 +130,7 @@ void Distribution::append_halo(Model& model, TravellingState& state,
   std::sort(rows.tets.begin(), rows.tets.end(), by_gid);
   const auto t_old = static_cast<std::size_t>(tets.size());
   const std::size_t t_all = t_old + rows.tets.size();
+  local_count(t_all, "tetrahedra");
   const GlobalId block_first = t_old ? tets.gid[0] : 0;
   const auto lower = static_cast<std::size_t>(
       std::lower_bound(rows.tets.begin(), rows.tets.end(), block_first,

@@ -158,6 +158,7 @@ BodyChunks file_mesh_chunks(const std::string& path, const std::string& physical
   auto chunk = std::make_shared<MeshChunk>();
   chunk->mesh.source = source;
   chunk->mesh.coords = std::move(coords);
+  local_count(ids.size(), "nodes");  // chunk node numbers are local indices
   chunk->mesh.tets.reserve(kept_nodes.size());
   for (std::int64_t id : kept_nodes)
     chunk->mesh.tets.push_back(

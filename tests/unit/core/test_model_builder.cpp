@@ -158,3 +158,14 @@ TEST_CASE("nodal forces are bit-identical whatever the local order of the tets",
   CHECK(largest > 0);
   CHECK(a.nodes.f == b.nodes.f);  // bit for bit
 }
+
+TEST_CASE("local_count refuses more entries than one rank can index", "[model]") {
+  CHECK(local_count(0, "nodes") == 0);
+  CHECK(local_count(static_cast<std::size_t>(max_local_entries), "tetrahedra") ==
+        max_local_entries);
+  // 9 values per tet (Dm⁻¹) must stay addressable by a 32-bit index.
+  CHECK(9 * static_cast<std::int64_t>(max_local_entries) <= 0x7fffffff);
+  CHECK_THROWS_WITH(local_count(static_cast<std::size_t>(max_local_entries) + 1, "tetrahedra"),
+                    Catch::Contains("238609295 tetrahedra") && Catch::Contains("more ranks"));
+  CHECK_THROWS_AS(local_count(std::size_t{1} << 33, "nodes"), InputError);
+}
