@@ -319,7 +319,7 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
   joints.resize(local_count(drafts.size(), "joints"));
   for (std::size_t j = 0; j < order.size(); ++j) {
     const JointDraft& d = drafts[order[j]];
-    joints.gid[j] = static_cast<GlobalId>(j);
+    joints.gid[j] = model.gid_offset + static_cast<GlobalId>(j);
     for (int i = 0; i < 3; ++i) {
       joints.nodes[6 * j + i] = d.a[i];
       joints.nodes[6 * j + 3 + i] = d.b[i];

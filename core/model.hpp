@@ -124,6 +124,10 @@ struct Model {
   Vec3 gravity = Vec3::Zero();
   JointArrays joints;
   std::vector<JointLawSpec> joint_laws;
+  // Node, tet and joint gids are gid_offset + their index 0..N−1 in the whole model (scene key
+  // parallel.gid_offset, a testing aid).  Whatever maps a gid to a dense position — directories,
+  // checkpoint rows, hashes — uses gid − gid_offset.
+  GlobalId gid_offset = 0;
 };
 
 // `n` (how many nodes, tets or joints — `what` — one rank is to hold) as a LocalIndex; throws

@@ -134,6 +134,7 @@ void set_initial_velocities(const Scene& scene, Model& model) {
 Model model_frame(const Scene& scene) {
   Model model;
   model.gravity = scene.gravity;
+  model.gid_offset = scene.parallel.gid_offset;
   for (const auto& spec : scene.materials) model.materials.push_back(resolve_material(spec));
   for (const auto& body : scene.bodies) {
     model.body_names.push_back(body.name);
@@ -246,7 +247,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
       nodes.x0[3 * n + k] = meshes[b].coords[3 * (old - node_offset[b]) + k];
   }
   nodes.x = nodes.x0;
-  for (LocalIndex n = 0; n < n_nodes; ++n) nodes.gid[n] = n;
+  for (LocalIndex n = 0; n < n_nodes; ++n) nodes.gid[n] = model.gid_offset + n;
 
   TetArrays& tets = model.tets;
   const LocalIndex n_tets = static_cast<LocalIndex>(records.size());
@@ -256,7 +257,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     const TetRecord& r = records[t];
     const BodySpec& body = scene.bodies[r.body];
     const MaterialProperties& mat = model.materials[body.material];
-    tets.gid[t] = t;
+    tets.gid[t] = model.gid_offset + t;
     tets.material[t] = body.material;
     tets.piece[t] = r.piece;
     Vec3 X[4];

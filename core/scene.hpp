@@ -189,6 +189,10 @@ struct ParallelSpec {
   // (Hilbert curve: least data moved while partitioning); random (a test mode: each re-partition
   // scatters the tets to ranks at random — results must not change).
   std::string partitioner = "rib";
+  // Testing aid: every node, tet and joint gid is this plus its index 0..N−1 (0: gids are the
+  // indices), so a small scene runs with gids above 2^32 through every path that handles them.
+  // Results and state_hash do not depend on it.  0 <= gid_offset < 2^62.
+  std::int64_t gid_offset = 0;
 };
 
 // Ceilings between a valid scene and a runnable one (drivers/run_limits): checked by `fdem check`

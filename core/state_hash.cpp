@@ -14,15 +14,16 @@ inline void fnv_mix(std::uint64_t& h, const void* data, std::size_t bytes) {
     h *= 0x100000001b3ULL;
   }
 }
-// Σ over nodes [0, count) of mix(FNV-1a of (gid, the given 3-vectors)), modulo 2^64.  A sum of
-// per-node fingerprints does not depend on the order the nodes are visited in nor on how they are
-// split among ranks (partial sums add up exactly), so no rank ever needs the whole state.
-std::uint64_t sum_of_node_hashes(const NodeArrays& nodes, LocalIndex count,
+// Σ over nodes [0, count) of mix(FNV-1a of (gid − gid_offset, the given 3-vectors)), mod 2^64.  A
+// sum of per-node fingerprints does not depend on the order the nodes are visited in nor on how
+// they are split among ranks (partial sums add up exactly), so no rank ever needs the whole state.
+std::uint64_t sum_of_node_hashes(const NodeArrays& nodes, LocalIndex count, GlobalId gid_offset,
                                  std::initializer_list<const std::vector<double>*> fields) {
   std::uint64_t sum = 0;
   for (LocalIndex n = 0; n < count; ++n) {
     std::uint64_t h = 0xcbf29ce484222325ULL;
-    fnv_mix(h, &nodes.gid[n], sizeof(GlobalId));
+    const GlobalId index = nodes.gid[n] - gid_offset;
+    fnv_mix(h, &index, sizeof(GlobalId));
     for (const std::vector<double>* field : fields)
       fnv_mix(h, field->data() + 3 * static_cast<std::size_t>(n), 3 * sizeof(double));
     // splitmix64 finaliser: every input bit reaches every output bit before the sum.
@@ -37,12 +38,12 @@ std::uint64_t sum_of_node_hashes(const NodeArrays& nodes, LocalIndex count,
 }
 }  // namespace
 
-std::uint64_t state_hash(const NodeArrays& nodes) {
-  return sum_of_node_hashes(nodes, nodes.n_owned, {&nodes.x, &nodes.v});
+std::uint64_t state_hash(const NodeArrays& nodes, GlobalId gid_offset) {
+  return sum_of_node_hashes(nodes, nodes.n_owned, gid_offset, {&nodes.x, &nodes.v});
 }
 
-std::uint64_t reference_hash(const NodeArrays& nodes) {
-  return sum_of_node_hashes(nodes, nodes.n_owned, {&nodes.x0});
+std::uint64_t reference_hash(const NodeArrays& nodes, GlobalId gid_offset) {
+  return sum_of_node_hashes(nodes, nodes.n_owned, gid_offset, {&nodes.x0});
 }
 
 std::string hash_to_hex(std::uint64_t hash) {

@@ -11,11 +11,13 @@
 
 namespace fdem {
 
-// Σ mix(FNV-1a(gid, x, v)) over the owned nodes (mod 2^64).
-std::uint64_t state_hash(const NodeArrays& nodes);
+// Σ mix(FNV-1a(gid − gid_offset, x, v)) over the owned nodes (mod 2^64).  Hashing the node's
+// index rather than its gid makes the hash the same for any Model::gid_offset (the offset is a
+// testing aid: the same run with gids above 2^32 must give the same hash).
+std::uint64_t state_hash(const NodeArrays& nodes, GlobalId gid_offset);
 std::string hash_to_hex(std::uint64_t hash);
-// Σ mix(FNV-1a(gid, x0)) over the owned nodes: with the sum over ranks, identifies the scene a
-// checkpoint belongs to.
-std::uint64_t reference_hash(const NodeArrays& nodes);
+// Σ mix(FNV-1a(gid − gid_offset, x0)) over the owned nodes: with the sum over ranks, identifies
+// the scene a checkpoint belongs to.
+std::uint64_t reference_hash(const NodeArrays& nodes, GlobalId gid_offset);
 
 }  // namespace fdem

@@ -215,6 +215,8 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
   j << "  \"broken_by_mode\": {\"tension\": " << r.broken_by_mode[0]
     << ", \"shear\": " << r.broken_by_mode[1] << ", \"mixed\": " << r.broken_by_mode[2] << "},\n";
   if (r.fragments >= 0) j << "  \"fragments\": " << r.fragments << ",\n";
+  j << "  \"gids\": {\"offset\": " << r.gid_offset << ", \"node_max\": " << r.node_gid_max
+    << ", \"tet_max\": " << r.tet_gid_max << ", \"joint_max\": " << r.joint_gid_max << "},\n";
   if (r.parallel)
     j << "  \"decomposition\": {\"start\": \"" << r.start
       << "\", \"imbalance\": " << JsonNumber{r.imbalance}

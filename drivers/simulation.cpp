@@ -1,5 +1,6 @@
 #include "drivers/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -176,8 +177,8 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   for (LocalIndex j = 0; j < model_.joints.size(); ++j)
     owned_joints += model_.tets.is_owned(model_.joints.tets[2 * j]);
   whole_joints_ = global_sum(owned_joints);
-  reference_hash_ =
-      distributed ? global_reference_hash(model_.nodes, *comm_) : reference_hash(model_.nodes);
+  reference_hash_ = distributed ? global_reference_hash(model_, *comm_)
+                                : reference_hash(model_.nodes, model_.gid_offset);
   next_checkpoint_time_ = scene_.output.checkpoint_every;
   if (distributed) {  // the stages were made on the local model: bind them to its halo
     distributed_start_ = true;
@@ -672,9 +673,18 @@ RunReport Simulation::report() const {
   std::vector<std::int64_t> memory = {startup_peak_rss_kib_, peak_rss_kib()};
   r.startup_peak_rss_kib_max = r.startup_peak_rss_kib_mean = memory[0];
   r.run_peak_rss_kib_max = r.run_peak_rss_kib_mean = memory[1];
+  // Largest gids held (every rank's are the model's, ghosts included).
+  const auto last = [](const std::vector<GlobalId>& gids) {
+    return gids.empty() ? GlobalId{-1} : *std::max_element(gids.begin(), gids.end());
+  };
+  std::vector<std::int64_t> gid_max = {last(model_.nodes.gid), last(model_.tets.gid),
+                                       last(model_.joints.gid)};
+  r.gid_offset = model_.gid_offset;
   if (distribution_) {
     std::vector<std::int64_t> largest = memory;
+    largest.insert(largest.end(), gid_max.begin(), gid_max.end());
     comm_->max_in_place(largest);
+    std::copy(largest.begin() + 2, largest.end(), gid_max.begin());
     comm_->sum_in_place(memory);
     r.startup_peak_rss_kib_max = largest[0];
     r.run_peak_rss_kib_max = largest[1];
@@ -682,7 +692,7 @@ RunReport Simulation::report() const {
     r.run_peak_rss_kib_mean = memory[1] / comm_->size();
     comm_->sum_in_place(counts);
     r.ranks = comm_->size();
-    r.state_hash = hash_to_hex(global_state_hash(model_.nodes, *comm_));
+    r.state_hash = hash_to_hex(global_state_hash(model_, *comm_));
     r.fragments = global_fragment_count(model_, *comm_);
     const DistributionReport& d = distribution_->report();
     r.parallel = true;
@@ -700,9 +710,12 @@ RunReport Simulation::report() const {
     r.communication_seconds =
         clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;
   } else {
-    r.state_hash = hash_to_hex(state_hash(model_.nodes));
+    r.state_hash = hash_to_hex(state_hash(model_.nodes, model_.gid_offset));
     r.fragments = count_fragments(model_);
   }
+  r.node_gid_max = gid_max[0];
+  r.tet_gid_max = gid_max[1];
+  r.joint_gid_max = gid_max[2];
   r.nodes = counts[0];
   r.elements = counts[1];
   r.joints = counts[2];

@@ -65,6 +65,9 @@ struct RunReport {
   long nodes = 0, elements = 0, pieces = 0, joints = 0, broken_joints = 0;
   long broken_by_mode[3] = {0, 0, 0};  // tension, shear, mixed
   long fragments = -1;                 // discrete elements now (−1: not counted)
+  // Model::gid_offset and the largest node, tet and joint gid held (−1: none): what the run's
+  // gids were (a run with parallel.gid_offset shows them above it).
+  std::int64_t gid_offset = 0, node_gid_max = -1, tet_gid_max = -1, joint_gid_max = -1;
   // Decomposition (N ranks): imbalance = max/mean owned cost, halo and migration sizes.
   bool parallel = false;
   std::string start;  // "distributed" (no rank held the whole model) or "whole_model"

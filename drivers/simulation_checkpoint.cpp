@@ -1,6 +1,7 @@
 // Checkpoint and restart of a Simulation (parallel/checkpoint.hpp holds the file format): rows
 // keyed by global id, so any rank count can continue any checkpoint; the run scalars make the
-// continuation bit-identical.
+// continuation bit-identical.  The file holds gid − gid_offset (the dense row index), so its rows
+// and hashes do not depend on the scene's parallel.gid_offset.
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -46,18 +47,20 @@ void Simulation::write_checkpoint() {
   for (const auto& [key, value] : restart_scene_values(scene_))  // compared on a restart
     header.doubles.emplace_back(restart_scene_prefix + key, value);
   // The state_hash of the state it holds (as summary.json would give it): verified on restart.
-  const std::uint64_t hash =
-      distribution_ ? global_state_hash(model_.nodes, *comm_) : state_hash(model_.nodes);
+  const std::uint64_t hash = distribution_ ? global_state_hash(model_, *comm_)
+                                           : state_hash(model_.nodes, model_.gid_offset);
   header.integers = {{"steps", steps_},
                      {"contact_detected", contact_ && contact_->detected() ? 1 : 0},
                      {"contact_detections", contact_ ? contact_->detections() : 0},
-                     {"state_hash", static_cast<std::int64_t>(hash)}};
+                     {"state_hash", static_cast<std::int64_t>(hash)},
+                     {"gid_offset", model_.gid_offset}};  // for the record: rows are gid − it
 
   CheckpointRows rows;
   const NodeArrays& nodes = model_.nodes;
+  const GlobalId offset = model_.gid_offset;
   const std::vector<double>& at_detection = contact_ ? contact_->x_at_detection() : nodes.x;
   for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    rows.node_gid.push_back(nodes.gid[n]);
+    rows.node_gid.push_back(nodes.gid[n] - offset);
     for (int k = 0; k < 3; ++k) {
       rows.node_x.push_back(nodes.x[3 * n + k]);
       rows.node_v.push_back(nodes.v[3 * n + k]);
@@ -69,7 +72,7 @@ void Simulation::write_checkpoint() {
   const JointArrays& joint_rows = model_.joints;
   for (LocalIndex j = 0; j < joint_rows.size(); ++j) {
     if (!model_.tets.is_owned(joint_rows.tets[2 * j])) continue;
-    rows.joint_gid.push_back(joint_rows.gid[j]);
+    rows.joint_gid.push_back(joint_rows.gid[j] - offset);
     rows.joint_broken.push_back(joint_rows.broken[j]);
     rows.joint_mode.push_back(joint_rows.mode[j]);
     rows.joint_failure_time.push_back(joint_rows.failure_time[j]);
@@ -82,8 +85,8 @@ void Simulation::write_checkpoint() {
       const LocalIndex a = model_.tets.find(e.a);
       if (a < 0 || !model_.tets.is_owned(a))
         continue;  // the owner of the pair's first tet writes it
-      rows.friction_a.push_back(e.a);
-      rows.friction_b.push_back(e.b);
+      rows.friction_a.push_back(e.a - offset);
+      rows.friction_b.push_back(e.b - offset);
       for (int k = 0; k < 3; ++k) rows.friction_spring.push_back(e.spring[k]);
       rows.friction_stiffness.push_back(e.stiffness);
     }
@@ -104,12 +107,18 @@ void Simulation::restore_checkpoint(const std::string& path) {
   if (!comm_) throw InputError(path + ": a restart needs the MPI environment of the fdem command");
   // Only the rows of what this rank holds (parallel/checkpoint.hpp): its owned and ghost nodes,
   // its joints, and the friction pairs of its tets.
+  // The file's rows are gid − gid_offset, whatever offset wrote it.
+  const GlobalId offset = model_.gid_offset;
+  const auto indices = [&](std::vector<GlobalId> gids) {
+    for (GlobalId& g : gids) g -= offset;
+    return gids;
+  };
   CheckpointWanted wanted;
   const NodeArrays& held = model_.nodes;
-  wanted.nodes = held.gid;
+  wanted.nodes = indices(held.gid);
   std::inplace_merge(wanted.nodes.begin(), wanted.nodes.begin() + held.n_owned, wanted.nodes.end());
-  wanted.joints = model_.joints.gid;
-  wanted.tets = model_.tets.gid;
+  wanted.joints = indices(model_.joints.gid);
+  wanted.tets = indices(model_.tets.gid);
   const auto same_scene = [&](const CheckpointHeader& header) {
     if (header.n_nodes != whole_nodes_ || header.n_tets != whole_tets_ ||
         header.n_joints != whole_joints_ || header.reference_hash != reference_hash_)
@@ -135,6 +144,16 @@ void Simulation::restore_checkpoint(const std::string& path) {
     if (is_root()) std::fprintf(stderr, "fdem: warning: restart: %s\n", warning.c_str());
   std::map<std::string, std::int64_t> integers;
   for (const auto& [name, value] : header.integers) integers[name] = value;
+  // Rows are indices, so another offset continues the same state; said so, since gids in the
+  // output change.  (Checkpoints from before the key have none: offset 0.)
+  const auto stored_offset = integers.find("gid_offset");
+  const GlobalId written_with = stored_offset == integers.end() ? 0 : stored_offset->second;
+  if (written_with != offset && is_root())
+    std::fprintf(stderr,
+                 "fdem: warning: restart: parallel.gid_offset: the checkpoint was written with "
+                 "%lld, this run uses %lld: rows are stored by gid − offset, so the state is the "
+                 "same and the gids of the output start from the new offset\n",
+                 static_cast<long long>(written_with), static_cast<long long>(offset));
   const auto number = [&](const std::string& name) {
     const auto it = doubles.find(name);
     if (it == doubles.end())
@@ -151,7 +170,7 @@ void Simulation::restore_checkpoint(const std::string& path) {
   NodeArrays& nodes = model_.nodes;
   std::vector<double> at_detection = nodes.x;
   for (std::size_t i = 0; i < rows.node_gid.size(); ++i) {
-    const LocalIndex local = nodes.find(rows.node_gid[i]);
+    const LocalIndex local = nodes.find(rows.node_gid[i] + offset);
     if (local < 0) continue;
     const auto n = static_cast<std::size_t>(local);
     for (int k = 0; k < 3; ++k) {
@@ -163,7 +182,7 @@ void Simulation::restore_checkpoint(const std::string& path) {
   }
   // Every node of the model is restored (on N ranks, by the ranks that own them).
   const std::uint64_t restored =
-      distribution_ ? global_state_hash(nodes, *comm_) : state_hash(nodes);
+      distribution_ ? global_state_hash(model_, *comm_) : state_hash(nodes, model_.gid_offset);
   if (static_cast<std::uint64_t>(integer("state_hash")) != restored)
     throw InputError("checkpoint corrupt: the restored state has state_hash " +
                      hash_to_hex(restored) + ", the checkpoint '" + path + "' holds " +
@@ -171,9 +190,9 @@ void Simulation::restore_checkpoint(const std::string& path) {
   JointArrays& joint_rows = model_.joints;
   std::vector<JointHistory> history(static_cast<std::size_t>(joint_rows.size()));
   for (std::size_t i = 0; i < rows.joint_gid.size(); ++i) {
-    const auto it =
-        std::lower_bound(joint_rows.gid.begin(), joint_rows.gid.end(), rows.joint_gid[i]);
-    if (it == joint_rows.gid.end() || *it != rows.joint_gid[i]) continue;
+    const GlobalId gid = rows.joint_gid[i] + offset;
+    const auto it = std::lower_bound(joint_rows.gid.begin(), joint_rows.gid.end(), gid);
+    if (it == joint_rows.gid.end() || *it != gid) continue;
     const auto j = static_cast<std::size_t>(it - joint_rows.gid.begin());
     joint_rows.broken[j] = rows.joint_broken[i];
     joint_rows.mode[j] = rows.joint_mode[i];
@@ -190,11 +209,10 @@ void Simulation::restore_checkpoint(const std::string& path) {
         for (int side = 0; side < 2; ++side) joint_state[joint_rows.tets[2 * j + side]] = 2;
     std::vector<FrictionEntry> friction;  // the pairs whose first tet is held here
     for (std::size_t i = 0; i < rows.friction_a.size(); ++i) {
-      if (!std::binary_search(model_.tets.gid.begin(), model_.tets.gid.end(), rows.friction_a[i]))
-        continue;
       FrictionEntry e;
-      e.a = rows.friction_a[i];
-      e.b = rows.friction_b[i];
+      e.a = rows.friction_a[i] + offset;
+      e.b = rows.friction_b[i] + offset;
+      if (!std::binary_search(model_.tets.gid.begin(), model_.tets.gid.end(), e.a)) continue;
       e.spring = Vec3(rows.friction_spring[3 * i], rows.friction_spring[3 * i + 1],
                       rows.friction_spring[3 * i + 2]);
       e.stiffness = rows.friction_stiffness[i];

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -146,6 +147,15 @@ class Reader {
     if (!node.IsScalar()) fail(node, path, "expected an integer");
     try {
       return node.as<int>();
+    } catch (const YAML::Exception&) {
+      fail(node, path, "expected an integer, got '" + node.Scalar() + "'");
+    }
+  }
+
+  std::int64_t integer64(const YAML::Node& node, const std::string& path) const {
+    if (!node.IsScalar()) fail(node, path, "expected an integer");
+    try {
+      return node.as<std::int64_t>();
     } catch (const YAML::Exception&) {
       fail(node, path, "expected an integer, got '" + node.Scalar() + "'");
     }
@@ -870,7 +880,8 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
 
   if (const YAML::Node parallel = root["parallel"]) {
     r.check_keys(parallel, "parallel",
-                 {"rebalance_threshold", "redistribute_every", "distributed_start", "partitioner"});
+                 {"rebalance_threshold", "redistribute_every", "distributed_start", "partitioner",
+                  "gid_offset"});
     if (parallel["partitioner"])
       scene.parallel.partitioner = r.choice(parallel["partitioner"], "parallel.partitioner",
                                             {"rib", "rcb", "hsfc", "random"});
@@ -887,6 +898,16 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
         r.fail(parallel["redistribute_every"], "parallel.redistribute_every",
                "expected a number of steps >= 0 (0: only at contact detections)");
       scene.parallel.redistribute_every = every;
+    }
+    if (parallel["gid_offset"]) {
+      // gid_offset + N must fit 63 bits, with room for the start-up's 4 × tet index.
+      const std::int64_t offset = r.integer64(parallel["gid_offset"], "parallel.gid_offset");
+      if (offset < 0 || offset >= (std::int64_t{1} << 62))
+        r.fail(parallel["gid_offset"], "parallel.gid_offset",
+               std::to_string(offset) +
+                   " is impossible: the gid offset (a testing aid) must be >= 0 and < 2^62 = " +
+                   std::to_string(std::int64_t{1} << 62));
+      scene.parallel.gid_offset = offset;
     }
   }
 

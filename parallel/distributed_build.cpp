@@ -58,7 +58,7 @@ int block_owner(const std::vector<GlobalId>& block, GlobalId g) {
 }
 
 // Sample sort of the records of all ranks, cut into the blocks: rank r ends with global positions
-// [block[r], block[r+1]) in order.
+// [block[r], block[r+1]) in order (positions count from block[0], the gid offset).
 std::vector<TetRecord> sort_into_blocks(std::vector<TetRecord> local,
                                         const std::vector<GlobalId>& block,
                                         const Communicator& comm) {
@@ -89,15 +89,15 @@ std::vector<TetRecord> sort_into_blocks(std::vector<TetRecord> local,
   // Buckets are in global order by rank: each record's position, and so its block, follows.
   const std::vector<std::int64_t> sizes = comm.allgather(static_cast<std::int64_t>(bucket.size()));
   const GlobalId first =
-      std::accumulate(sizes.begin(), sizes.begin() + comm.rank(), std::int64_t{0});
+      block.front() + std::accumulate(sizes.begin(), sizes.begin() + comm.rank(), std::int64_t{0});
   counts.assign(static_cast<std::size_t>(ranks), 0);
   for (std::size_t i = 0; i < bucket.size(); ++i)
     ++counts[static_cast<std::size_t>(block_owner(block, first + static_cast<GlobalId>(i)))];
   return comm.exchange_grouped(bucket, counts);  // from lower ranks first, each sorted: in order
 }
 
-// A use of a node (by its key, NodeKeys) by a tet corner: use = 4 × tet gid + corner (first
-// use = smallest).
+// A use of a node (by its key, NodeKeys) by a tet corner: use = 4 × tet index + corner, the tet
+// index being gid − gid_offset (first use = smallest; 4 × gid could overflow for large offsets).
 struct NodeUse {
   std::int64_t mesh_node, use;
   double x[3];
@@ -241,19 +241,23 @@ std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<Bo
 }
 
 // Step 4: node gids by first use.  Returns the numbers of the nodes of the local tets, by key.
-// Split nodes (one tet's own) are numbered here without a directory.
+// Split nodes (one tet's own) are numbered here without a directory.  Tet and node gids are
+// gid_offset + their index (block[0] = gid_offset).
 std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalId first_tet,
                                      const std::vector<GlobalId>& block, const NodeKeys& keys,
                                      const NodeDirectory& directory, const Communicator& comm,
                                      GlobalId* n_nodes) {
   const int ranks = comm.size();
+  const GlobalId gid_offset = block.front();
+  const std::int64_t first_index = first_tet - gid_offset;
+  const auto tet_of_use = [&](std::int64_t use) { return gid_offset + use / 4; };
   // This rank's first use of each node it uses (one message per node, not per corner).
   std::vector<std::pair<std::int64_t, std::int64_t>> corner;  // (node key, use)
   std::vector<NodeUse> split;  // uses of split nodes: their first and only
   corner.reserve(4 * tets.size());
   for (std::size_t t = 0; t < tets.size(); ++t)
     for (int c = 0; c < 4; ++c) {
-      const std::int64_t use = 4 * (first_tet + static_cast<GlobalId>(t)) + c;
+      const std::int64_t use = 4 * (first_index + static_cast<std::int64_t>(t)) + c;
       if (!keys.split(tets[t])) {
         corner.emplace_back(tets[t].node[c], use);
         continue;
@@ -267,7 +271,7 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
   for (std::size_t i = 0; i < corner.size(); ++i) {
     if (i > 0 && corner[i].first == corner[i - 1].first) continue;
     NodeUse u{corner[i].first, corner[i].second, {}};
-    const TetRecord& r = tets[static_cast<std::size_t>(corner[i].second / 4 - first_tet)];
+    const TetRecord& r = tets[static_cast<std::size_t>(corner[i].second / 4 - first_index)];
     std::copy_n(&r.x[3 * (corner[i].second % 4)], 3, u.x);
     uses[static_cast<std::size_t>(directory.rank_of(u.x))].push_back(u);
   }
@@ -286,8 +290,8 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
   std::vector<std::vector<NodeUse>> firsts(static_cast<std::size_t>(ranks));
   for (std::size_t i = 0; i < order.size(); ++i)
     if (i == 0 || seen[order[i]].mesh_node != seen[order[i - 1]].mesh_node)
-      firsts[static_cast<std::size_t>(block_owner(block, seen[order[i]].use / 4))].push_back(
-          seen[order[i]]);
+      firsts[static_cast<std::size_t>(block_owner(block, tet_of_use(seen[order[i]].use)))]
+          .push_back(seen[order[i]]);
   // First users' ranks number the nodes they own, in order of first use.
   std::vector<NodeUse> owned = comm.exchange(firsts);
   firsts.clear();
@@ -298,12 +302,13 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
             [](const NodeUse& a, const NodeUse& b) { return a.use < b.use; });
   const std::vector<std::int64_t> counts = comm.allgather(static_cast<std::int64_t>(owned.size()));
   const GlobalId base =
-      std::accumulate(counts.begin(), counts.begin() + comm.rank(), std::int64_t{0});
+      gid_offset + std::accumulate(counts.begin(), counts.begin() + comm.rank(), std::int64_t{0});
   *n_nodes = std::accumulate(counts.begin(), counts.end(), std::int64_t{0});
   std::vector<std::vector<NodeNumber>> numbers(static_cast<std::size_t>(ranks));
   std::vector<NodeNumber> split_numbers;
   for (std::size_t i = 0; i < owned.size(); ++i) {
-    const NodeNumber number{owned[i].mesh_node, base + static_cast<GlobalId>(i), owned[i].use / 4};
+    const NodeNumber number{owned[i].mesh_node, base + static_cast<GlobalId>(i),
+                            tet_of_use(owned[i].use)};
     if (number.mesh_node >= keys.split_start)
       split_numbers.push_back(number);
     else
@@ -400,7 +405,8 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   std::vector<TetRecord> records =
       generate_records(scene, chunks, node_base, piece_base, comm, &lo, &hi);
   out.tet_block.resize(static_cast<std::size_t>(ranks) + 1);
-  for (int r = 0; r <= ranks; ++r) out.tet_block[r] = mul_div(out.n_tets, r, ranks);
+  for (int r = 0; r <= ranks; ++r)
+    out.tet_block[r] = model.gid_offset + mul_div(out.n_tets, r, ranks);
   records = sort_into_blocks(std::move(records), out.tet_block, comm);
   const GlobalId first_tet = out.tet_block[me];
   FDEM_VERIFY(static_cast<GlobalId>(records.size()) == out.tet_block[me + 1] - first_tet,

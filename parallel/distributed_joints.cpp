@@ -534,7 +534,8 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
   });
   const std::vector<std::int64_t> per_rank =
       comm.allgather(static_cast<std::int64_t>(placed.size()));
-  const GlobalId base = std::accumulate(per_rank.begin(), per_rank.begin() + me, std::int64_t{0});
+  const GlobalId base =
+      block.gid_offset + std::accumulate(per_rank.begin(), per_rank.begin() + me, std::int64_t{0});
   out.n_joints = std::accumulate(per_rank.begin(), per_rank.end(), std::int64_t{0});
   out.joints.reserve(placed.size());
   for (std::size_t i = 0; i < placed.size(); ++i) {

@@ -179,7 +179,8 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   const TetArrays& tets = global.tets;
   const int ranks = comm_.size(), me = comm_.rank();
   // Node → its smallest tet gid: fixed for the whole run (fracture breaks joints, never tets).
-  // The whole model is in gid order here (local index = gid).
+  // The whole model is in gid order here (local index = gid − gid_offset).
+  gid_offset_ = global.gid_offset;
   node_first_tet_.assign(static_cast<std::size_t>(global.nodes.size()),
                          std::numeric_limits<GlobalId>::max());
   for (LocalIndex t = 0; t < tets.size(); ++t)
@@ -207,7 +208,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   }
   node_owner_.resize(node_first_tet_.size());
   for (std::size_t n = 0; n < node_owner_.size(); ++n)
-    node_owner_[n] = tet_owner_[static_cast<std::size_t>(node_first_tet_[n])];
+    node_owner_[n] = tet_owner_[static_cast<std::size_t>(node_first_tet_[n] - gid_offset_)];
 
   // This rank's tets: its own and every tet near them (destinations(), all tets known here).
   has_joint_state_ = !global_state.tet_joint_state.empty();
@@ -220,6 +221,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   local.body_fixed = global.body_fixed;
   local.gravity = global.gravity;
   local.joint_laws = global.joint_laws;
+  local.gid_offset = global.gid_offset;
   assemble({&rows}, local, local_state);
   build_exchange(local);
   report_.cycles = 1;
@@ -577,8 +579,8 @@ void Distribution::update_node_owners(const Model& model) {
     std::int32_t owner;
   };
   const int ranks = comm_.size();
-  const auto directory = [&](GlobalId tet) {
-    return static_cast<int>(mul_div(tet, ranks, std::max<GlobalId>(n_tets_, 1)));
+  const auto directory = [&](GlobalId tet) {  // equal blocks of tet indices (gid − offset)
+    return static_cast<int>(mul_div(tet - gid_offset_, ranks, std::max<GlobalId>(n_tets_, 1)));
   };
   const TetArrays& tets = model.tets;
   std::vector<std::vector<TetOwner>> posts(static_cast<std::size_t>(ranks));
@@ -713,12 +715,13 @@ void Distribution::update_report(const Model& model) {
   report_.neighbours_max = high[3];
 }
 
-std::uint64_t global_state_hash(const NodeArrays& nodes, const Communicator& comm) {
-  return comm.sum(state_hash(nodes));  // unsigned: the sum wraps modulo 2^64, like the local one
+std::uint64_t global_state_hash(const Model& model, const Communicator& comm) {
+  // Unsigned: the sum wraps modulo 2^64, like the local one.
+  return comm.sum(state_hash(model.nodes, model.gid_offset));
 }
 
-std::uint64_t global_reference_hash(const NodeArrays& nodes, const Communicator& comm) {
-  return comm.sum(reference_hash(nodes));
+std::uint64_t global_reference_hash(const Model& model, const Communicator& comm) {
+  return comm.sum(reference_hash(model.nodes, model.gid_offset));
 }
 
 std::int64_t global_fragment_count(const Model& model, const Communicator& comm) {

@@ -147,7 +147,8 @@ class Distribution {
   std::vector<std::int32_t> tet_owner_;
   std::vector<std::int32_t> node_owner_;
   std::vector<GlobalId> node_first_tet_;
-  GlobalId n_tets_ = 0;  // tets of the whole model
+  GlobalId n_tets_ = 0;      // tets of the whole model
+  GlobalId gid_offset_ = 0;  // Model::gid_offset: tet gids are gid_offset_ + 0..n_tets_−1
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
   DistributionReport report_;
@@ -156,9 +157,9 @@ class Distribution {
 
 // Collective: state_hash (core/state_hash.hpp) of the owned nodes of all ranks, the value one rank
 // holding every node computes (one integer sum-reduction).
-std::uint64_t global_state_hash(const NodeArrays& nodes, const Communicator& comm);
+std::uint64_t global_state_hash(const Model& model, const Communicator& comm);
 // Collective: reference_hash of the owned nodes of all ranks.
-std::uint64_t global_reference_hash(const NodeArrays& nodes, const Communicator& comm);
+std::uint64_t global_reference_hash(const Model& model, const Communicator& comm);
 
 // Collective: count_fragments (core/model.hpp) of the whole model — connected components of tets
 // linked by a shared node or an intact joint — from each rank's owned tets and joints.

@@ -41,6 +41,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
                            TravellingState& local_state)
     : comm_(comm), settings_(settings), buffer_(buffer) {
   n_tets_ = start.n_tets;
+  gid_offset_ = start.model.gid_offset;
   // The blocks are the initial partition: every local tet is owned here.
   tet_owner_.assign(static_cast<std::size_t>(start.model.tets.size()), comm_.rank());
   node_owner_ = std::move(start.node_owner);
@@ -63,6 +64,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     local.body_fixed = start.model.body_fixed;
     local.gravity = start.model.gravity;
     local.joint_laws = start.model.joint_laws;
+    local.gid_offset = start.model.gid_offset;
     migrate(start.model, state, local, local_state, &start.joints, &start.tet_reach);
   }
   report_.cycles = 1;

@@ -16,10 +16,13 @@ inline bool same_bits(double a, double b) {
   return std::memcmp(&a, &b, sizeof(double)) == 0;
 }
 
-// Collective (sums over the ranks).  `serial`: build_model's model (gid = index).
+// Collective (sums over the ranks).  `serial`: build_model's model of the same scene (gid =
+// gid_offset + index, the same offset).
 inline void check_block_is_serial_model(const DistributedModel& block, const Model& serial,
                                         const Communicator& comm) {
   const Model& local = block.model;
+  const GlobalId offset = serial.gid_offset;
+  CHECK(local.gid_offset == offset);
   CHECK(block.n_tets == serial.tets.size());
   CHECK(block.n_nodes == serial.nodes.size());
   CHECK(comm.sum(std::int64_t{local.tets.size()}) == serial.tets.size());
@@ -29,12 +32,13 @@ inline void check_block_is_serial_model(const DistributedModel& block, const Mod
 
   long tet_mismatches = 0, node_mismatches = 0;
   for (LocalIndex t = 0; t < local.tets.size(); ++t) {
-    const auto g = static_cast<std::size_t>(local.tets.gid[t]);
-    if (g >= static_cast<std::size_t>(serial.tets.size())) {
+    const auto g = static_cast<std::size_t>(local.tets.gid[t] - offset);
+    if (local.tets.gid[t] < offset || g >= static_cast<std::size_t>(serial.tets.size())) {
       ++tet_mismatches;
       continue;
     }
-    bool same = local.tets.material[t] == serial.tets.material[g] &&
+    bool same = local.tets.gid[t] == serial.tets.gid[g] &&
+                local.tets.material[t] == serial.tets.material[g] &&
                 local.tets.piece[t] == serial.tets.piece[g] &&
                 local.tets.group_of(static_cast<LocalIndex>(t)) ==
                     serial.tets.group_of(static_cast<LocalIndex>(g)) &&
@@ -43,16 +47,18 @@ inline void check_block_is_serial_model(const DistributedModel& block, const Mod
     for (int k = 0; k < 9; ++k)
       same = same && same_bits(local.tets.dm_inv[9 * t + k], serial.tets.dm_inv[9 * g + k]);
     for (int c = 0; c < 4; ++c)
-      same = same && local.nodes.gid[local.tets.nodes[4 * t + c]] == serial.tets.nodes[4 * g + c];
+      same = same && local.nodes.gid[local.tets.nodes[4 * t + c]] ==
+                         serial.nodes.gid[serial.tets.nodes[4 * g + c]];
     tet_mismatches += !same;
   }
   for (LocalIndex n = 0; n < local.nodes.size(); ++n) {
-    const auto g = static_cast<std::size_t>(local.nodes.gid[n]);
-    if (g >= static_cast<std::size_t>(serial.nodes.size())) {
+    const auto g = static_cast<std::size_t>(local.nodes.gid[n] - offset);
+    if (local.nodes.gid[n] < offset || g >= static_cast<std::size_t>(serial.nodes.size())) {
       ++node_mismatches;
       continue;
     }
-    bool same = local.nodes.piece[n] == serial.nodes.piece[g] &&
+    bool same = local.nodes.gid[n] == serial.nodes.gid[g] &&
+                local.nodes.piece[n] == serial.nodes.piece[g] &&
                 same_bits(local.nodes.mass[n], serial.nodes.mass[g]) &&
                 local.nodes.constrained[n] == serial.nodes.constrained[g];
     for (int k = 0; k < 3; ++k)
@@ -62,7 +68,8 @@ inline void check_block_is_serial_model(const DistributedModel& block, const Mod
              same_bits(local.nodes.prescribed_velocity[3 * n + k],
                        serial.nodes.prescribed_velocity[3 * g + k]);
     // Owned nodes: their first tet is in this block; the owner table says so.
-    same = same && (n < local.nodes.n_owned) == (block.node_owner[n] == comm.rank());
+    same = same && (n < local.nodes.n_owned) == (block.node_owner[n] == comm.rank()) &&
+           block.node_first_tet[n] >= offset;
     node_mismatches += !same;
   }
   CHECK(tet_mismatches == 0);
@@ -79,8 +86,8 @@ inline void check_block_is_serial_model(const DistributedModel& block, const Mod
   }
   CHECK(piece_mismatches == 0);
   // Every rank holds the same whole-model ranks of the blocks, and they cover all tets.
-  CHECK(block.tet_block.front() == 0);
-  CHECK(block.tet_block.back() == serial.tets.size());
+  CHECK(block.tet_block.front() == offset);
+  CHECK(block.tet_block.back() == offset + serial.tets.size());
 }
 
 }  // namespace fdem::testing

@@ -179,8 +179,11 @@ std::vector<BodyChunks> chunks_of(const Scene& scene, int ranks) {
 TEST_CASE("distributed start-up: each rank's block is the serial builder's model, bit for bit",
           "[mpi][distributed_build]") {
   const Communicator comm = Communicator::world();
-  const Scene scene = mixed_scene();
-  const Model serial = build_model(scene, load_body_meshes(scene));  // gid = index
+  Scene scene = mixed_scene();
+  // Gids from 0, and from above 2^32 (parallel.gid_offset) in both builders.
+  scene.parallel.gid_offset = GENERATE(GlobalId{0}, (GlobalId{1} << 32) + 12345);
+  INFO("gid offset " << scene.parallel.gid_offset);
+  const Model serial = build_model(scene, load_body_meshes(scene));  // gid = offset + index
   const DistributedModel block =
       build_distributed_model(scene, chunks_of(scene, comm.size()), comm);
   testing::check_block_is_serial_model(block, serial, comm);
@@ -234,11 +237,15 @@ TEST_CASE("distributed_nth_value is the exact k-th smallest over all ranks",
 TEST_CASE("distributed start-up: joints, contact groups and joint states are the serial builder's",
           "[mpi][distributed_build]") {
   const Communicator comm = Communicator::world();
-  const Scene scene = jointed_scene();
-  const Model serial = build_model(scene, load_body_meshes(scene));  // gid = index
+  Scene scene = jointed_scene();
+  scene.parallel.gid_offset = GENERATE(GlobalId{0}, (GlobalId{1} << 40) - 7);
+  INFO("gid offset " << scene.parallel.gid_offset);
+  const GlobalId offset = scene.parallel.gid_offset;
+  const Model serial = build_model(scene, load_body_meshes(scene));  // gid = offset + index
   const DistributedModel block =
       build_distributed_model(scene, chunks_of(scene, comm.size()), comm);
   const Model& local = block.model;
+  testing::check_block_is_serial_model(block, serial, comm);
   const LocalIndex n_serial = serial.joints.size();
   CHECK(n_serial > 500);
   CHECK(block.n_joints == n_serial);
@@ -255,8 +262,9 @@ TEST_CASE("distributed start-up: joints, contact groups and joint states are the
   long joint_mismatches = 0;
   GlobalId previous = -1;
   for (const StartJoint& j : block.joints) {
-    const auto g = static_cast<std::size_t>(j.gid);
-    bool same = j.gid > previous && j.gid < n_serial && j.tets[0] >= block.tet_block[comm.rank()] &&
+    const auto g = static_cast<std::size_t>(j.gid - offset);
+    bool same = j.gid > previous && j.gid >= offset && j.gid < offset + n_serial &&
+                j.tets[0] >= block.tet_block[comm.rank()] &&
                 j.tets[0] < block.tet_block[comm.rank() + 1];
     previous = j.gid;
     if (same) {
@@ -302,11 +310,13 @@ TEST_CASE("distributed start-up: joints, contact groups and joint states are the
   for (LocalIndex t = 0; t < local.tets.size() && block.tet_joint_state.size() ==
                                                       static_cast<std::size_t>(local.tets.size());
        ++t) {
-    const auto g = static_cast<std::size_t>(local.tets.gid[t]);
+    const auto g = static_cast<std::size_t>(local.tets.gid[t] - offset);
     bool same = local.tets.group_of(t) == serial.tets.group_of(static_cast<LocalIndex>(g)) &&
                 block.tet_joint_state[t] == bonded[g] && same_bits(block.tet_reach[t], reach[g]);
     for (int c = 0; c < 4; ++c)
-      same = same && local.nodes.gid[local.tets.nodes[4 * t + c]] == serial.tets.nodes[4 * g + c] &&
+      same = same &&
+             local.nodes.gid[local.tets.nodes[4 * t + c]] ==
+                 serial.nodes.gid[serial.tets.nodes[4 * g + c]] &&
              same_bits(local.nodes.mass[local.tets.nodes[4 * t + c]],
                        serial.nodes.mass[serial.tets.nodes[4 * g + c]]);
     tet_mismatches += !same;

@@ -63,8 +63,9 @@ class SharedDir {
 
 // Two bodies of two materials, moved and spun a little so that positions, velocities and stresses
 // differ from node to node and tet to tet (the same on every rank).
-Model test_model() {
+Model test_model(GlobalId gid_offset = 0) {
   Scene scene = builders::basic_scene(1.0);
+  scene.parallel.gid_offset = gid_offset;
   scene.materials = {
       builders::elastic_material(1000, 1e6, 0.3),
       builders::elastic_material(2000, 5e6, 0.25, ElasticModel::st_venant_kirchhoff)};
@@ -280,9 +281,13 @@ int check_data_items(vtkXMLDataElement* e, const fs::path& directory, long& wron
 
 TEST_CASE("xdmf frames: every node and tet of a distributed model, exactly, in one HDF5 file",
           "[mpi][xdmf]") {
+  // Gids from 0, and from above 2^32 (parallel.gid_offset): written as int64, not truncated.
+  const GlobalId offset = GENERATE(GlobalId{0}, (GlobalId{1} << 32) + 12345);
+  INFO("gid offset " << offset);
   const Communicator comm = Communicator::world();
   const SharedDir dir(comm);
-  Model global = test_model();
+  Model global = test_model(offset);
+  CHECK(global.nodes.gid.front() == offset);
 
   // This rank's part with its halo (ghost nodes of owned tets are owned by other ranks).
   TravellingState whole, local_state;

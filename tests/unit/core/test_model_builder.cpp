@@ -159,6 +159,34 @@ TEST_CASE("nodal forces are bit-identical whatever the local order of the tets",
   CHECK(a.nodes.f == b.nodes.f);  // bit for bit
 }
 
+TEST_CASE("build_model: a gid offset shifts every gid and changes nothing else", "[model]") {
+  // A jointed body (joints: all) so that node, tet and joint gids all move.
+  Scene scene = scene_for(1);
+  scene.materials[0].fracture = FractureSpec{1e6, 2e6, 30.0, 10.0, 50.0};
+  scene.bodies[0].joints = JointPlacement::all;
+  const Model plain = build_model(scene, {two_pieces()});
+  REQUIRE(plain.joints.size() == 1);  // the face shared by the second piece's two tets
+  for (GlobalId offset : {(GlobalId{1} << 32) + 12345, (GlobalId{1} << 62) - 1000}) {
+    scene.parallel.gid_offset = offset;
+    const Model shifted = build_model(scene, {two_pieces()});
+    CHECK(shifted.gid_offset == offset);
+    const auto plus = [&](std::vector<GlobalId> gids) {
+      for (GlobalId& g : gids) g += offset;
+      return gids;
+    };
+    CHECK(shifted.nodes.gid == plus(plain.nodes.gid));
+    CHECK(shifted.tets.gid == plus(plain.tets.gid));
+    CHECK(shifted.joints.gid == plus(plain.joints.gid));
+    CHECK(shifted.nodes.x0 == plain.nodes.x0);
+    CHECK(shifted.nodes.mass == plain.nodes.mass);
+    CHECK(shifted.tets.nodes == plain.tets.nodes);
+    CHECK(shifted.tets.contact_group == plain.tets.contact_group);
+    CHECK(shifted.joints.nodes == plain.joints.nodes);
+    CHECK(shifted.joints.tets == plain.joints.tets);
+    CHECK(shifted.tet_force_order == plain.tet_force_order);
+  }
+}
+
 TEST_CASE("local_count refuses more entries than one rank can index", "[model]") {
   CHECK(local_count(0, "nodes") == 0);
   CHECK(local_count(static_cast<std::size_t>(max_local_entries), "tetrahedra") ==

@@ -45,7 +45,7 @@ NodeArrays slice(const NodeArrays& all, LocalIndex first, LocalIndex last) {
 
 TEST_CASE("state_hash: independent of node order and of the split among ranks", "[core][hash]") {
   const NodeArrays nodes = random_nodes(1000, 1);
-  const std::uint64_t whole = state_hash(nodes);
+  const std::uint64_t whole = state_hash(nodes, 0);
   // Reversed order.
   NodeArrays reversed = slice(nodes, 0, nodes.size());
   for (LocalIndex i = 0; i < nodes.size(); ++i) {
@@ -56,31 +56,45 @@ TEST_CASE("state_hash: independent of node order and of the split among ranks", 
       reversed.v[3 * j + k] = nodes.v[3 * i + k];
     }
   }
-  CHECK(state_hash(reversed) == whole);
+  CHECK(state_hash(reversed, 0) == whole);
   // Three "ranks": their hashes add up (modulo 2^64) to the whole one.
-  const std::uint64_t parts = state_hash(slice(nodes, 0, 123)) +
-                              state_hash(slice(nodes, 123, 640)) +
-                              state_hash(slice(nodes, 640, 1000));
+  const std::uint64_t parts = state_hash(slice(nodes, 0, 123), 0) +
+                              state_hash(slice(nodes, 123, 640), 0) +
+                              state_hash(slice(nodes, 640, 1000), 0);
   CHECK(parts == whole);
   // Ghost entries (beyond n_owned) do not count.
   NodeArrays with_ghosts = nodes;
   with_ghosts.n_owned = 640;
-  CHECK(state_hash(with_ghosts) == state_hash(slice(nodes, 0, 640)));
+  CHECK(state_hash(with_ghosts, 0) == state_hash(slice(nodes, 0, 640), 0));
 }
 
 TEST_CASE("state_hash: one flipped bit of one node changes it", "[core][hash]") {
   const NodeArrays nodes = random_nodes(200, 2);
-  const std::uint64_t whole = state_hash(nodes);
+  const std::uint64_t whole = state_hash(nodes, 0);
   for (int bit : {0, 17, 52, 63}) {
     NodeArrays changed = nodes;
     std::uint64_t word;
     std::memcpy(&word, &changed.v[3 * 77 + 1], sizeof(word));
     word ^= std::uint64_t{1} << bit;
     std::memcpy(&changed.v[3 * 77 + 1], &word, sizeof(word));
-    CHECK(state_hash(changed) != whole);
+    CHECK(state_hash(changed, 0) != whole);
   }
   NodeArrays renumbered = nodes;
   std::swap(renumbered.gid[3], renumbered.gid[4]);  // same values on other nodes
-  CHECK(state_hash(renumbered) != whole);
-  CHECK(reference_hash(nodes) != whole);
+  CHECK(state_hash(renumbered, 0) != whole);
+  CHECK(reference_hash(nodes, 0) != whole);
+}
+
+TEST_CASE("state_hash: the same for any gid offset, hashing gid − offset", "[core][hash]") {
+  const NodeArrays nodes = random_nodes(300, 3);
+  const std::uint64_t whole = state_hash(nodes, 0), reference = reference_hash(nodes, 0);
+  // Offsets above 2^32 and near 2^62 (the scene key's limit): a truncated gid would change it.
+  for (GlobalId offset : {GlobalId{1} << 32, (GlobalId{1} << 32) + 12345, GlobalId{1} << 40,
+                          (GlobalId{1} << 62) - 1}) {
+    NodeArrays shifted = nodes;
+    for (GlobalId& g : shifted.gid) g += offset;
+    CHECK(state_hash(shifted, offset) == whole);
+    CHECK(reference_hash(shifted, offset) == reference);
+    CHECK(state_hash(shifted, 0) != whole);  // the gid counts, not only the values
+  }
 }

@@ -324,6 +324,24 @@ TEST_CASE("the parallel block reads its two keys and rejects others", "[io]") {
   CHECK_THAT(negative, Contains("parallel.redistribute_every") && Contains(">= 0"));
 }
 
+TEST_CASE("parallel.gid_offset: a 64-bit integer from 0 to below 2^62", "[io]") {
+  CHECK(fdem::parse_scene(minimal_plus(""), "scene.yaml").parallel.gid_offset == 0);
+  for (const std::string value : {"4294979641", "1099511627775", "4611686018427387903"})
+    CHECK(fdem::parse_scene(minimal_plus("parallel: {gid_offset: " + value + "}\n"), "scene.yaml")
+              .parallel.gid_offset == std::stoll(value));
+  // From the command line too (the way the tests run a scene with large gids).
+  CHECK(fdem::parse_scene(minimal_plus(""), "scene.yaml", {"parallel.gid_offset=4294979641"})
+            .parallel.gid_offset == 4294979641LL);
+  for (const std::string value : {"-1", "4611686018427387904", "9223372036854775807"}) {
+    const std::string msg = input_error(minimal_plus("parallel: {gid_offset: " + value + "}\n"));
+    CHECK_THAT(msg, Contains("parallel.gid_offset") && Contains(">= 0 and < 2^62"));
+  }
+  for (const std::string value : {"1.5", "1e12", "lots", "18446744073709551616"}) {
+    const std::string msg = input_error(minimal_plus("parallel: {gid_offset: " + value + "}\n"));
+    CHECK_THAT(msg, Contains("parallel.gid_offset") && Contains("expected an integer"));
+  }
+}
+
 TEST_CASE("impossible values are rejected with the valid range", "[io]") {
   SECTION("negative density") {
     const std::string msg = input_error(minimal_with(4, "    density: -2500"));

@@ -84,8 +84,8 @@ std::vector<std::string> pvd_files(const std::string& path) {
 
 // Two unit hexahedra side by side along x (3×2×2 = 12 nodes), each cut into the 6 Kuhn tets around
 // its main diagonal: 12 tets.  Hexahedron h is piece h of body h; the tets alternate between two
-// materials.  Gids are not local indices (tet gid 10 + 3t, node gid 500 + 7i) so that a writer
-// that mixes them up fails.  The nodes are moved by a non-affine map (non-uniform stress) and get
+// materials.  Gids are not local indices (tet gid 2^40 + 10 + 3t, node gid 2^32 + 500 + 7i) so that
+// a writer that mixes them up, or narrows them to 32 bits, fails.  The nodes are moved by a non-affine map (non-uniform stress) and get
 // distinct velocities.
 Model two_block_model() {
   Model m;
@@ -102,7 +102,7 @@ Model two_block_model() {
         const double X[3] = {1.0 * i, 1.0 * j, 1.0 * k};
         const double dx[3] = {1e-3 * X[0] + 2e-3 * X[1] * X[1], -5e-4 * X[1] + 1e-3 * X[2] * X[0],
                               3e-4 * X[0] * X[1] + 2e-4 * X[2]};
-        m.nodes.gid[n] = 500 + 7 * n;
+        m.nodes.gid[n] = (GlobalId{1} << 32) + 500 + 7 * n;
         for (int c = 0; c < 3; ++c) {
           m.nodes.x0[3 * n + c] = X[c];
           m.nodes.x[3 * n + c] = X[c] + dx[c];
@@ -125,7 +125,7 @@ Model two_block_model() {
       const fdem::Mat3 dm_inv = fdem::edge_matrix(X).inverse();
       std::copy(dm_inv.data(), dm_inv.data() + 9, m.tets.dm_inv.begin() + 9 * t);
       m.tets.volume0[t] = 1.0 / 6.0;
-      m.tets.gid[t] = 10 + 3 * t;
+      m.tets.gid[t] = (GlobalId{1} << 40) + 10 + 3 * t;
       m.tets.piece[t] = h;
       m.tets.material[t] = t % 2;
     }
