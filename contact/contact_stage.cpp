@@ -306,7 +306,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   const TetArrays& tets = model.tets;
   NodeArrays& nodes = model.nodes;
   records_.clear();
-  out.candidate_pairs = static_cast<LocalIndex>(pairs_.size());  // held here, not unique
+  out.candidate_pairs = static_cast<std::int64_t>(pairs_.size());  // held here, not unique
   out.friction_dissipated = released_spring_energy_;
   released_spring_energy_ = 0.0;
   overlapping_.assign(pairs_.size(), 0);

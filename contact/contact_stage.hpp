@@ -33,8 +33,8 @@ struct ContactForceSummary {
   double friction_dissipated = 0.0;     // slip work + released stick-spring energy this step (J)
   double friction_spring_energy = 0.0;  // J stored in stick springs (part of the contact energy)
   double damping_dissipated = 0.0;      // J dissipated by normal contact dashpots this step
-  LocalIndex candidate_pairs = 0;
-  LocalIndex active_pairs = 0;  // overlapping pairs
+  std::int64_t candidate_pairs = 0;     // may exceed the local tet count many times: 64-bit
+  std::int64_t active_pairs = 0;        // overlapping pairs
 };
 
 // One active contact for output: where it acts and the force on the contactor.

@@ -157,12 +157,36 @@ double memory_ceiling_per_rank(const LimitsSpec& limits, int ranks_on_node, std:
   return std::min(per_rank, process);
 }
 
+namespace {
+
+// A rank that would hold more nodes, tets or joints than max_local_entries (core/types.hpp:
+// 32-bit local indices) cannot run whatever its memory: its part with a distributed start, else
+// the whole model, which every rank builds.
+void check_local_counts(const Scene& scene, const ModelSize& size, int ranks,
+                        bool distributed_start, const std::string& what) {
+  const double local_share = ranks > 1 && distributed_start ? 2.5 / ranks : 1.0;
+  const double most = std::max({size.tets, size.nodes, size.joints}) * local_share;
+  if (most <= static_cast<double>(max_local_entries)) return;
+  std::ostringstream msg;
+  msg << scene.source_path << ": " << what << " would put about " << format_count(most)
+      << " nodes, tetrahedra or joints on one rank (" << format_count(size.tets) << " tetrahedra, "
+      << format_count(size.nodes) << " nodes in all), more than the " << max_local_entries
+      << " one rank can index (32-bit local indices). Run on more ranks"
+      << (distributed_start ? "." : " with parallel.distributed_start: true.");
+  throw InputError(msg.str());
+}
+
+}  // namespace
+
 void check_memory_limit(const Scene& scene, const ModelSize& size, int ranks, int ranks_on_node,
                         bool distributed_start, const std::string& what) {
   std::string source;
   const double ceiling = memory_ceiling_per_rank(scene.limits, ranks_on_node, &source);
   const double needed = estimated_bytes_per_rank(size, ranks, distributed_start);
-  if (needed <= ceiling) return;
+  if (needed <= ceiling) {
+    check_local_counts(scene, size, ranks, distributed_start, what);
+    return;
+  }
   std::ostringstream msg;
   msg << scene.source_path << ": " << what << " would need about " << format_bytes(needed)
       << " per rank (" << format_count(size.tets) << " tetrahedra, " << format_count(size.nodes)

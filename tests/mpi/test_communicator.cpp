@@ -297,7 +297,8 @@ TEST_CASE("64-bit counts: exchanges cut into pieces give what one message gives"
   }
   // Every element arrived once, in rank order, with what its sender meant for this rank.
   std::int64_t expected = 0;
-  for (int from = 0; from < n; ++from) expected += static_cast<std::int64_t>(rows_for(from, me).size());
+  for (int from = 0; from < n; ++from)
+    expected += static_cast<std::int64_t>(rows_for(from, me).size());
   CHECK(static_cast<std::int64_t>(whole.size()) == expected);
   CHECK(gathered.size() == static_cast<std::size_t>(7 * n * (n - 1) / 2 + 3 * n));
 }

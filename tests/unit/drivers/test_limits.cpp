@@ -67,6 +67,16 @@ TEST_CASE("a mesh too large for the memory per rank is refused before it is gene
     CHECK_THAT(o.err, Contains("162000048 tetrahedra"));
     CHECK_THAT(o.err, Contains("more than limits.max_memory_per_rank = 4 GB"));
   }
+  SECTION("more tets than one rank can index, with memory to spare") {
+    // 640^3 cells: 1.57e9 tets; a 1 PB ceiling lets the memory check pass.
+    const std::string cells = " --set bodies.0.mesh.box.cells=[640,640,640]";
+    const Outcome o =
+        run_with(two_blocks, "check scene.yaml --set limits.max_memory_per_rank=1e15" + cells);
+    INFO(o.err);
+    CHECK(o.exit_code == 2);
+    CHECK_THAT(o.err, Contains("more than the 238609294 one rank can index") &&
+                          Contains("Run on more ranks"));
+  }
   SECTION("a wall of 2147483647 courses") {
     const Outcome o =
         run_with(wall, "check scene.yaml --set bodies.0.mesh.wall.courses=2147483647");
