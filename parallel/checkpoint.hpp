@@ -7,14 +7,16 @@
 //                     counts and the /run values)
 //   /run/<name>       one scalar dataset per named value: float64 for header.doubles, int64 for
 //                     header.integers, in the order the driver gave them (creation order tracked)
-//   /nodes/gid        int64[n_nodes] = 0..n_nodes-1 (row i is the node of gid i)
+//   /nodes/gid        int64[n_nodes] = 0..n_nodes-1 (row i is the node of gid i; the driver
+//                     stores gid − Model::gid_offset, with /run/gid_offset for the record)
 //   /nodes/{x, v, x_at_detection, prescribed_velocity}   float64[n_nodes][3]
 //   /joints/gid       int64[n_joints] = 0..n_joints-1
 //   /joints/{broken, mode}            uint8[n_joints]
 //   /joints/{failure_time, damage}    float64[n_joints]
 //   /joints/history   uint8[n_joints][joint_history_bytes] (opaque per-joint history records)
-//   /friction/{a, b}  int64[m] (a < b), /friction/spring float64[m][3], /friction/stiffness
-//                     float64[m]; written in rank order, read back sorted by (a, b)
+//   /friction/{a, b}  int64[m] (tet gids a < b, less the offset too), /friction/spring
+//                     float64[m][3], /friction/stiffness float64[m]; written in rank order, read
+//                     back sorted by (a, b)
 //
 // Every dataset has a uint64 attribute `checksum` (parallel/checkpoint_checksum.hpp: a sum over
 // its rows, so each rank adds its block); reading verifies each one and the header's, and a
