@@ -85,8 +85,8 @@ std::vector<std::string> pvd_files(const std::string& path) {
 // Two unit hexahedra side by side along x (3×2×2 = 12 nodes), each cut into the 6 Kuhn tets around
 // its main diagonal: 12 tets.  Hexahedron h is piece h of body h; the tets alternate between two
 // materials.  Gids are not local indices (tet gid 2^40 + 10 + 3t, node gid 2^32 + 500 + 7i) so that
-// a writer that mixes them up, or narrows them to 32 bits, fails.  The nodes are moved by a non-affine map (non-uniform stress) and get
-// distinct velocities.
+// a writer that mixes them up, or narrows them to 32 bits, fails.  The nodes are moved by a
+// non-affine map (non-uniform stress) and get distinct velocities.
 Model two_block_model() {
   Model m;
   const int nx = 3, ny = 2, nz = 2;
