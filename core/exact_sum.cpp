@@ -1,0 +1,174 @@
+#include "core/exact_sum.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "core/error.hpp"
+
+namespace fdem {
+
+namespace {
+constexpr std::int64_t digit_base = std::int64_t{1} << 32;
+// Carries are propagated before a limb could hold 2^30 additions of up to 2^32 each (< 2^62).
+constexpr std::int32_t additions_before_normalising = std::int32_t{1} << 29;
+constexpr std::uint8_t plus_infinity = 1, minus_infinity = 2, not_a_number = 4;
+
+std::int64_t floor_div_base(std::int64_t v) {
+  return v >= 0 ? v / digit_base : -((-(v + 1)) / digit_base) - 1;
+}
+}  // namespace
+
+void ExactSum::reach(std::int32_t digit) {
+  if (limbs_.empty()) {
+    first_digit_ = digit;
+    limbs_.assign(1, 0);
+  } else if (digit < first_digit_) {
+    limbs_.insert(limbs_.begin(), static_cast<std::size_t>(first_digit_ - digit), 0);
+    first_digit_ = digit;
+  } else if (digit >= first_digit_ + static_cast<std::int32_t>(limbs_.size())) {
+    limbs_.resize(static_cast<std::size_t>(digit - first_digit_ + 1), 0);
+  }
+}
+
+void ExactSum::add(double x) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &x, sizeof bits);
+  const bool negative = (bits >> 63) != 0;
+  const int exponent = static_cast<int>((bits >> 52) & 0x7ff);
+  std::uint64_t mantissa = bits & ((std::uint64_t{1} << 52) - 1);
+  if (exponent == 0x7ff) {
+    non_finite_ |= mantissa != 0 ? not_a_number : negative ? minus_infinity : plus_infinity;
+    return;
+  }
+  if (exponent == 0 && mantissa == 0) return;
+  // x = mantissa · 2^(position − 1074): subnormals at position 0, normals at exponent − 1.
+  int position = 0;
+  if (exponent != 0) {
+    mantissa |= std::uint64_t{1} << 52;
+    position = exponent - 1;
+  }
+  __extension__ typedef unsigned __int128 wide;
+  const wide shifted = static_cast<wide>(mantissa) << (position % 32);  // < 2^85: three digits
+  const std::int32_t digit = position / 32;
+  const std::int64_t chunk[3] = {static_cast<std::int64_t>(shifted & 0xffffffffu),
+                                 static_cast<std::int64_t>((shifted >> 32) & 0xffffffffu),
+                                 static_cast<std::int64_t>(shifted >> 64)};
+  int low = 0, high = 2;
+  while (chunk[low] == 0) ++low;
+  while (chunk[high] == 0) --high;
+  reach(digit + low);
+  reach(digit + high);
+  for (int k = low; k <= high; ++k) {
+    std::int64_t& limb = limbs_[static_cast<std::size_t>(digit + k - first_digit_)];
+    limb += negative ? -chunk[k] : chunk[k];
+  }
+  if (++unnormalised_ >= additions_before_normalising) normalise();
+}
+
+void ExactSum::add(const ExactSum& other) {
+  non_finite_ |= other.non_finite_;
+  if (other.limbs_.empty()) return;
+  reach(other.first_digit_);
+  reach(other.first_digit_ + static_cast<std::int32_t>(other.limbs_.size()) - 1);
+  const std::size_t offset = static_cast<std::size_t>(other.first_digit_ - first_digit_);
+  for (std::size_t i = 0; i < other.limbs_.size(); ++i) limbs_[offset + i] += other.limbs_[i];
+  unnormalised_ += other.unnormalised_ + 1;
+  if (unnormalised_ >= additions_before_normalising) normalise();
+}
+
+void ExactSum::normalise() {
+  unnormalised_ = 0;
+  std::int64_t carry = 0;
+  for (std::int64_t& limb : limbs_) {
+    const std::int64_t v = limb + carry;
+    carry = floor_div_base(v);
+    limb = v - carry * digit_base;
+  }
+  // The carry out of the top becomes further digits; the last one keeps the sign.
+  while (carry <= -digit_base || carry >= digit_base) {
+    const std::int64_t v = carry;
+    carry = floor_div_base(v);
+    limbs_.push_back(v - carry * digit_base);
+  }
+  if (carry != 0) limbs_.push_back(carry);
+  while (!limbs_.empty() && limbs_.back() == 0) limbs_.pop_back();
+  std::size_t zeros = 0;
+  while (zeros < limbs_.size() && limbs_[zeros] == 0) ++zeros;
+  limbs_.erase(limbs_.begin(), limbs_.begin() + static_cast<std::ptrdiff_t>(zeros));
+  first_digit_ = limbs_.empty() ? 0 : first_digit_ + static_cast<std::int32_t>(zeros);
+}
+
+double ExactSum::value() const {
+  if (non_finite_ != 0) {
+    const bool nan =
+        (non_finite_ & not_a_number) != 0 ||
+        (non_finite_ & (plus_infinity | minus_infinity)) == (plus_infinity | minus_infinity);
+    if (nan) return std::numeric_limits<double>::quiet_NaN();
+    return (non_finite_ & plus_infinity) ? std::numeric_limits<double>::infinity()
+                                         : -std::numeric_limits<double>::infinity();
+  }
+  ExactSum m = *this;
+  m.normalise();
+  if (m.limbs_.empty()) return 0.0;
+  // The top limb carries the sign (the others are digits in [0, 2^32)): work on the magnitude.
+  const bool negative = m.limbs_.back() < 0;
+  if (negative) {
+    for (std::int64_t& limb : m.limbs_) limb = -limb;
+    m.normalise();
+  }
+  const auto digit = [&](std::int64_t d) -> std::uint64_t {
+    const std::int64_t i = d - m.first_digit_;
+    return i < 0 || i >= static_cast<std::int64_t>(m.limbs_.size())
+               ? 0
+               : static_cast<std::uint64_t>(m.limbs_[static_cast<std::size_t>(i)]);
+  };
+  const auto bit = [&](std::int64_t k) -> std::uint64_t { return (digit(k >> 5) >> (k & 31)) & 1; };
+  const std::int64_t top_digit = m.first_digit_ + static_cast<std::int64_t>(m.limbs_.size()) - 1;
+  const std::int64_t length =
+      32 * top_digit + 64 - __builtin_clzll(static_cast<std::uint64_t>(m.limbs_.back()));
+  double magnitude = 0.0;
+  if (length <= 53) {  // exact: below 2^53 units of 2^-1074
+    std::uint64_t v = 0;
+    for (std::int64_t k = 0; k < length; ++k) v |= bit(k) << k;
+    magnitude = std::ldexp(static_cast<double>(v), -1074);
+  } else {  // the top 53 bits, rounded to nearest, ties to even
+    const std::int64_t shift = length - 53;
+    std::uint64_t top = 0;
+    for (std::int64_t k = 0; k < 53; ++k) top |= bit(shift + k) << k;
+    const bool half = bit(shift - 1) != 0;
+    bool below_half = false;  // any bit under the half bit
+    const std::int64_t half_position = shift - 1;
+    for (std::int64_t d = m.first_digit_; d <= (half_position >> 5) && !below_half; ++d) {
+      std::uint64_t bits = digit(d);
+      if (d == (half_position >> 5)) bits &= (std::uint64_t{1} << (half_position & 31)) - 1;
+      below_half = bits != 0;
+    }
+    if (half && (below_half || (top & 1))) ++top;
+    magnitude = std::ldexp(static_cast<double>(top), static_cast<int>(shift - 1074));
+  }
+  return negative ? -magnitude : magnitude;
+}
+
+void ExactSum::append_words(std::vector<std::int64_t>& out) const {
+  ExactSum m = *this;
+  m.normalise();
+  out.push_back(m.first_digit_);
+  out.push_back(static_cast<std::int64_t>(m.limbs_.size()));
+  out.push_back(m.non_finite_);
+  out.insert(out.end(), m.limbs_.begin(), m.limbs_.end());
+}
+
+ExactSum ExactSum::from_words(const std::int64_t*& words) {
+  ExactSum s;
+  s.first_digit_ = static_cast<std::int32_t>(words[0]);
+  const std::int64_t count = words[1];
+  FDEM_VERIFY(count >= 0 && count <= 80 && words[2] >= 0 && words[2] <= 7,
+              "an exact sum read from words has a sane digit count and flags");
+  s.non_finite_ = static_cast<std::uint8_t>(words[2]);
+  s.limbs_.assign(words + 3, words + 3 + count);
+  words += 3 + count;
+  return s;
+}
+
+}  // namespace fdem
