@@ -1,7 +1,8 @@
 # Runs the fdem command on a scene with each rank count of RANKS and passes when every run
-# completes and summary.json's state_hash is the same in all of them.  With RESTART_RANKS, also
-# continues the first run's earliest checkpoint on each of those rank counts and requires the
-# same hash again (checkpoint-and-restart vs. uninterrupted).  With START, every run on more than
+# completes, summary.json's state_hash is the same in all of them and bodies.csv is the same file,
+# byte for byte.  With RESTART_RANKS, also continues the first run's earliest checkpoint on each
+# of those rank counts and requires the same hash again (checkpoint-and-restart vs.
+# uninterrupted), and the same bodies.csv in every restarted run.  With START, every run on more than
 # one rank must report that start-up in summary.json (decomposition.start: "distributed" when no
 # rank held the whole model, "whole_model").
 # -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list), RESTART_RANKS (list, optional),
@@ -42,6 +43,15 @@ function(read_hash out variable ranks)
   set(${variable} ${hash} PARENT_SCOPE)
 endfunction()
 
+# bodies.csv of `out` must be the bytes of `reference_out`'s.
+function(compare_bodies out reference_out)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${out}/bodies.csv
+                          ${reference_out}/bodies.csv RESULT_VARIABLE different)
+  if(different)
+    message(FATAL_ERROR "${out}/bodies.csv differs from ${reference_out}/bodies.csv")
+  endif()
+endfunction()
+
 set(reference "")
 foreach(ranks ${RANKS})
   run_fdem(${ranks} ${WORK}/ranks${ranks})
@@ -51,6 +61,8 @@ foreach(ranks ${RANKS})
     set(first_run ${WORK}/ranks${ranks})
   elseif(NOT hash STREQUAL reference)
     message(FATAL_ERROR "state_hash on ${ranks} ranks is ${hash}, expected ${reference}")
+  else()
+    compare_bodies(${WORK}/ranks${ranks} ${first_run})
   endif()
 endforeach()
 
@@ -69,6 +81,11 @@ if(RESTART_RANKS)
       message(FATAL_ERROR "restart from ${earliest} on ${ranks} ranks: state_hash ${hash}, "
                           "uninterrupted ${reference}")
     endif()
+    if(NOT first_restart)
+      set(first_restart ${WORK}/restart${ranks})
+    else()
+      compare_bodies(${WORK}/restart${ranks} ${first_restart})
+    endif()
   endforeach()
 endif()
-message("all runs: state_hash ${reference}")
+message("all runs: state_hash ${reference}, bodies.csv the same")
