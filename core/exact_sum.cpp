@@ -108,15 +108,9 @@ double ExactSum::value() const {
     return (non_finite_ & plus_infinity) ? std::numeric_limits<double>::infinity()
                                          : -std::numeric_limits<double>::infinity();
   }
-  ExactSum m = *this;
-  m.normalise();
+  bool negative = false;
+  const ExactSum m = magnitude(&negative);
   if (m.limbs_.empty()) return 0.0;
-  // The top limb carries the sign (the others are digits in [0, 2^32)): work on the magnitude.
-  const bool negative = m.limbs_.back() < 0;
-  if (negative) {
-    for (std::int64_t& limb : m.limbs_) limb = -limb;
-    m.normalise();
-  }
   const auto digit = [&](std::int64_t d) -> std::uint64_t {
     const std::int64_t i = d - m.first_digit_;
     return i < 0 || i >= static_cast<std::int64_t>(m.limbs_.size())
@@ -150,24 +144,47 @@ double ExactSum::value() const {
   return negative ? -magnitude : magnitude;
 }
 
-void ExactSum::append_words(std::vector<std::int64_t>& out) const {
+ExactSum ExactSum::magnitude(bool* negative) const {
   ExactSum m = *this;
   m.normalise();
-  out.push_back(m.first_digit_);
-  out.push_back(static_cast<std::int64_t>(m.limbs_.size()));
-  out.push_back(m.non_finite_);
-  out.insert(out.end(), m.limbs_.begin(), m.limbs_.end());
+  // The top limb carries the sign (the others are digits in [0, 2^32)).
+  *negative = !m.limbs_.empty() && m.limbs_.back() < 0;
+  if (*negative) {
+    for (std::int64_t& limb : m.limbs_) limb = -limb;
+    m.normalise();
+  }
+  return m;
+}
+
+// Header word: first digit (bits 0–15), digit count (16–31), sign (32), non-finite flags (33–35).
+void ExactSum::append_words(std::vector<std::int64_t>& out) const {
+  bool negative = false;
+  const ExactSum m = magnitude(&negative);
+  const std::uint64_t count = m.limbs_.size();
+  out.push_back(static_cast<std::int64_t>(static_cast<std::uint64_t>(m.first_digit_) | count << 16 |
+                                          std::uint64_t{negative} << 32 |
+                                          std::uint64_t{non_finite_} << 33));
+  for (std::size_t i = 0; i < count; i += 2) {
+    const std::uint64_t high = i + 1 < count ? static_cast<std::uint64_t>(m.limbs_[i + 1]) : 0;
+    out.push_back(static_cast<std::int64_t>(static_cast<std::uint64_t>(m.limbs_[i]) | high << 32));
+  }
 }
 
 ExactSum ExactSum::from_words(const std::int64_t*& words) {
+  const std::uint64_t header = static_cast<std::uint64_t>(*words++);
   ExactSum s;
-  s.first_digit_ = static_cast<std::int32_t>(words[0]);
-  const std::int64_t count = words[1];
-  FDEM_VERIFY(count >= 0 && count <= 80 && words[2] >= 0 && words[2] <= 7,
-              "an exact sum read from words has a sane digit count and flags");
-  s.non_finite_ = static_cast<std::uint8_t>(words[2]);
-  s.limbs_.assign(words + 3, words + 3 + count);
-  words += 3 + count;
+  s.first_digit_ = static_cast<std::int32_t>(header & 0xffff);
+  const std::size_t count = (header >> 16) & 0xffff;
+  FDEM_VERIFY(count <= 80 && header >> 36 == 0, "an exact sum read from words is well formed");
+  const bool negative = (header >> 32) & 1;
+  s.non_finite_ = static_cast<std::uint8_t>((header >> 33) & 7);
+  s.limbs_.resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint64_t word = static_cast<std::uint64_t>(words[i / 2]);
+    const std::int64_t digit = static_cast<std::int64_t>(i % 2 ? word >> 32 : word & 0xffffffffu);
+    s.limbs_[i] = negative ? -digit : digit;
+  }
+  words += (count + 1) / 2;
   return s;
 }
 

@@ -22,14 +22,16 @@ class ExactSum {
   // added (those combine the same in any order).
   double value() const;
 
-  // As 64-bit words, for messages: [first digit, digit count, non-finite flags, digits...].
+  // As 64-bit words, for messages: a header (first digit, digit count, sign, non-finite flags),
+  // then the digits of the magnitude, two to a word.
   void append_words(std::vector<std::int64_t>& out) const;
   // Reads what append_words wrote at `words` and moves `words` past it.
   static ExactSum from_words(const std::int64_t*& words);
 
  private:
   void normalise();  // every limb but the top in [0, 2^32), no zero limb at either end
-  void reach(std::int32_t digit);  // widen the limbs to hold `digit`
+  ExactSum magnitude(bool* negative) const;  // normalised, every limb a digit in [0, 2^32)
+  void reach(std::int32_t digit);            // widen the limbs to hold `digit`
 
   std::int32_t first_digit_ = 0;     // digit index of limbs_[0]
   std::vector<std::int64_t> limbs_;  // limbs_[i]: the count of 2^(32·(first_digit_ + i) − 1074)
