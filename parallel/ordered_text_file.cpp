@@ -1,8 +1,12 @@
 #include "parallel/ordered_text_file.hpp"
 
+#include <fcntl.h>
 #include <mpi.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <utility>
 
 #include "core/error.hpp"
@@ -12,6 +16,19 @@ namespace fdem {
 namespace {
 // Bytes per MPI write call (counts are ints).
 constexpr std::int64_t write_chunk = std::int64_t{1} << 30;
+
+// Allocates bytes [begin, begin + count) of the file (file systems without fallocate: no check).
+LocalError claim_space(const std::string& path, std::int64_t begin, std::int64_t count) {
+  LocalError error;
+  const int fd = ::open(path.c_str(), O_WRONLY);
+  if (fd < 0) return {ErrorKind::io, "cannot open " + path + ": " + std::strerror(errno)};
+  const int failure =
+      ::fallocate(fd, 0, static_cast<off_t>(begin), static_cast<off_t>(count)) == 0 ? 0 : errno;
+  ::close(fd);
+  if (failure != 0 && failure != EOPNOTSUPP && failure != ENOSYS)
+    error = {ErrorKind::io, "cannot write " + path + " (disk full?): " + std::strerror(failure)};
+  return error;
+}
 }  // namespace
 
 OrderedTextFile::OrderedTextFile(std::string path, std::int64_t end, const Communicator& comm)
@@ -24,6 +41,11 @@ void OrderedTextFile::append(const std::string& text) {
   if (total == 0) return;
   // Every rank writes as many chunks as the rank with the longest text (collective calls).
   const std::int64_t rounds = comm_.max((bytes + write_chunk - 1) / write_chunk);
+  // Rank 0 claims the bytes first: a full disk (or file size limit) is then reported by every
+  // rank together; MPI-IO may lose a failed write of an aggregating rank.
+  LocalError claim;
+  if (comm_.rank() == 0) claim = claim_space(path_, end_, total);
+  comm_.check_errors(claim);
   MPI_File file;
   const bool opened = MPI_File_open(comm_.handle(), path_.c_str(), MPI_MODE_WRONLY, MPI_INFO_NULL,
                                     &file) == MPI_SUCCESS;
@@ -36,10 +58,13 @@ void OrderedTextFile::append(const std::string& text) {
     const std::int64_t begin = std::min(bytes, r * write_chunk);
     const std::int64_t count = std::min(bytes - begin, write_chunk);
     MPI_Status status;
-    written =
+    const bool call_ok =
         MPI_File_write_at_all(file, static_cast<MPI_Offset>(offset + begin), text.data() + begin,
-                              static_cast<int>(count), MPI_CHAR, &status) == MPI_SUCCESS &&
-        written;
+                              static_cast<int>(count), MPI_CHAR, &status) == MPI_SUCCESS;
+    // A full disk (or a file size limit) may end a write early without an error code.
+    int done = 0;
+    written = written && call_ok && MPI_Get_count(&status, MPI_CHAR, &done) == MPI_SUCCESS &&
+              done == count;
   }
   written = MPI_File_close(&file) == MPI_SUCCESS && written;
   LocalError error;

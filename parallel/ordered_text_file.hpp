@@ -16,7 +16,8 @@ class OrderedTextFile {
   // `path` exists already (rank 0 wrote its header); appends start at byte `end`.
   OrderedTextFile(std::string path, std::int64_t end, const Communicator& comm);
 
-  // Collective.  Throws IoError on every rank when opening or writing fails on every rank; ends
+  // Collective.  Rank 0 first claims the bytes (fallocate), so a full disk stops every rank
+  // together with an IoError before anything is written; so does a failed open or write.  Ends
   // every rank (MPI_Abort, exit code 4) when the file opened on some ranks only.
   void append(const std::string& text);
 
