@@ -180,16 +180,13 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
 
 std::vector<PieceMotion> piece_motions(const Model& model) {
   const OwnedPieces owned = owned_pieces(model.nodes);
-  const std::vector<PieceMoments> moments = piece_moments(model.nodes, owned);
-  std::vector<PieceCentres> centres;
-  for (const PieceMoments& m : moments) centres.push_back(centres_of(m));
-  const std::vector<PieceSpread> spreads = piece_spreads(model.nodes, owned, centres);
   std::vector<PieceMotion> motion(model.pieces.size());
   for (std::size_t i = 0; i < owned.ids.size(); ++i) {
+    const PieceCentres c = centres_of(piece_moments(model.nodes, owned, i));
     PieceMotion& m = motion[static_cast<std::size_t>(owned.ids[i])];
-    m.centroid = centres[i].centroid;
-    m.velocity = centres[i].velocity;
-    m.rotation = rotation_of(spreads[i]);
+    m.centroid = c.centroid;
+    m.velocity = c.velocity;
+    m.rotation = rotation_of(piece_spread(model.nodes, owned, i, c));
   }
   return motion;
 }

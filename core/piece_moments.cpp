@@ -75,39 +75,47 @@ OwnedPieces owned_pieces(const NodeArrays& nodes) {
   owned.ids.assign(nodes.piece.begin(), nodes.piece.begin() + nodes.n_owned);
   std::sort(owned.ids.begin(), owned.ids.end());
   owned.ids.erase(std::unique(owned.ids.begin(), owned.ids.end()), owned.ids.end());
-  owned.slot_of_node.resize(static_cast<std::size_t>(nodes.n_owned));
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n)
-    owned.slot_of_node[static_cast<std::size_t>(n)] = static_cast<std::int32_t>(
+  // Counting sort of the owned nodes by their piece's slot.
+  std::vector<std::int32_t> slot(static_cast<std::size_t>(nodes.n_owned));
+  owned.first.assign(owned.ids.size() + 1, 0);
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
+    slot[static_cast<std::size_t>(n)] = static_cast<std::int32_t>(
         std::lower_bound(owned.ids.begin(), owned.ids.end(), nodes.piece[n]) - owned.ids.begin());
+    ++owned.first[static_cast<std::size_t>(slot[static_cast<std::size_t>(n)]) + 1];
+  }
+  for (std::size_t i = 0; i < owned.ids.size(); ++i) owned.first[i + 1] += owned.first[i];
+  std::vector<std::int32_t> next(owned.first.begin(), owned.first.end() - 1);
+  owned.nodes.resize(static_cast<std::size_t>(nodes.n_owned));
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n)
+    owned.nodes[static_cast<std::size_t>(next[static_cast<std::size_t>(slot[n])]++)] = n;
   return owned;
 }
 
-std::vector<PieceMoments> piece_moments(const NodeArrays& nodes, const OwnedPieces& owned) {
-  std::vector<PieceMoments> moments(owned.ids.size());
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    PieceMoments& s = moments[static_cast<std::size_t>(owned.slot_of_node[n])];
+PieceMoments piece_moments(const NodeArrays& nodes, const OwnedPieces& owned, std::size_t i) {
+  PieceMoments s;
+  for (std::int32_t k = owned.first[i]; k < owned.first[i + 1]; ++k) {
+    const LocalIndex n = owned.nodes[static_cast<std::size_t>(k)];
     const double m = nodes.mass[n];
     s.mass.add(m);
-    for (int k = 0; k < 3; ++k) {
-      s.position[k].add(m * nodes.x[3 * n + k]);
-      s.momentum[k].add(m * nodes.v[3 * n + k]);
-      s.reference[k].add(m * nodes.x0[3 * n + k]);
+    for (int d = 0; d < 3; ++d) {
+      s.position[d].add(m * nodes.x[3 * n + d]);
+      s.momentum[d].add(m * nodes.v[3 * n + d]);
+      s.reference[d].add(m * nodes.x0[3 * n + d]);
     }
   }
-  return moments;
+  return s;
 }
 
-std::vector<PieceSpread> piece_spreads(const NodeArrays& nodes, const OwnedPieces& owned,
-                                       const std::vector<PieceCentres>& centres) {
-  std::vector<PieceSpread> spreads(owned.ids.size());
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    const std::size_t slot = static_cast<std::size_t>(owned.slot_of_node[n]);
-    const PieceCentres& c = centres[slot];
+PieceSpread piece_spread(const NodeArrays& nodes, const OwnedPieces& owned, std::size_t i,
+                         const PieceCentres& c) {
+  PieceSpread s;
+  for (std::int32_t k = owned.first[i]; k < owned.first[i + 1]; ++k) {
+    const LocalIndex n = owned.nodes[static_cast<std::size_t>(k)];
     const Mat3 outer = nodes.mass[n] * (vec3_at(nodes.x.data(), n) - c.centroid) *
                        (vec3_at(nodes.x0.data(), n) - c.reference).transpose();
-    for (int i = 0; i < 9; ++i) spreads[slot].covariance[i].add(outer.data()[i]);
+    for (int j = 0; j < 9; ++j) s.covariance[j].add(outer.data()[j]);
   }
-  return spreads;
+  return s;
 }
 
 }  // namespace fdem

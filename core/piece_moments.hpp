@@ -48,17 +48,20 @@ struct PieceSpread {
 // Best-fit rotation (Kabsch) as a rotation vector.
 Vec3 rotation_of(const PieceSpread& spread);
 
-// The pieces of the owned nodes, ascending, and each owned node's index in that list.
+// The owned nodes grouped by piece: ids ascending, piece ids[i] has the owned nodes
+// nodes[first[i]] .. nodes[first[i + 1] − 1] (ascending local index).  Sums are made one piece at a
+// time from it, so only one piece's exact sums exist at once.
 struct OwnedPieces {
   std::vector<std::int32_t> ids;
-  std::vector<std::int32_t> slot_of_node;
+  std::vector<std::int32_t> first;
+  std::vector<LocalIndex> nodes;
 };
 OwnedPieces owned_pieces(const NodeArrays& nodes);
 
-// Per entry of `owned.ids`: the moments of this process's owned nodes of that piece.
-std::vector<PieceMoments> piece_moments(const NodeArrays& nodes, const OwnedPieces& owned);
-// Per entry of `owned.ids`: the spread of those nodes about `centres` (one per entry).
-std::vector<PieceSpread> piece_spreads(const NodeArrays& nodes, const OwnedPieces& owned,
-                                       const std::vector<PieceCentres>& centres);
+// The moments of the owned nodes of piece owned.ids[i].
+PieceMoments piece_moments(const NodeArrays& nodes, const OwnedPieces& owned, std::size_t i);
+// Their spread about `centres`.
+PieceSpread piece_spread(const NodeArrays& nodes, const OwnedPieces& owned, std::size_t i,
+                         const PieceCentres& centres);
 
 }  // namespace fdem

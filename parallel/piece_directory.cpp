@@ -96,39 +96,55 @@ std::vector<PieceInfo> chain_piece_sums(const Model& model, const std::vector<st
   return running;
 }
 
-// Records of `words` as [piece, sums...] from the ranks in `source` (one per word), merged into
-// `block` (one per piece of the directory block starting at `first`).  Returns (piece, sender).
-template <class Sums>
-std::vector<std::pair<std::int32_t, int>> merge_at_directory(const std::vector<std::int64_t>& words,
-                                                             const std::vector<int>& source,
-                                                             std::int32_t first,
-                                                             std::vector<Sums>& block) {
-  std::vector<std::pair<std::int32_t, int>> senders;
+// Per owned piece, [piece, sums...] to its directory rank; make(i) gives the sums of
+// owned.ids[i], made one piece at a time.
+template <class MakeSums>
+std::vector<std::vector<std::int64_t>> pack_for_directory(const OwnedPieces& owned,
+                                                          const GidBlocks& blocks,
+                                                          const MakeSums& make) {
+  std::vector<std::vector<std::int64_t>> outbox(static_cast<std::size_t>(blocks.ranks));
+  for (std::size_t i = 0; i < owned.ids.size(); ++i) {
+    std::vector<std::int64_t>& box = outbox[static_cast<std::size_t>(blocks.owner(owned.ids[i]))];
+    box.push_back(owned.ids[i]);
+    make(i).append_words(box);
+  }
+  return outbox;
+}
+
+// The records [piece, sums...] of `words` (sent by the ranks in `source`, one per word), merged
+// piece by piece: use(piece, merged sums, ranks that sent them) in ascending piece.  Only one
+// piece's merged sums exist at a time.
+template <class Sums, class Use>
+void merge_by_piece(const std::vector<std::int64_t>& words, const std::vector<int>& source,
+                    const Use& use) {
+  struct Record {
+    std::int64_t piece;
+    std::size_t at;  // word of its sums
+    int from;
+  };
+  std::vector<Record> records;
   const std::int64_t* w = words.data();
   const std::int64_t* const end = w + words.size();
   while (w < end) {
-    const int from = source[static_cast<std::size_t>(w - words.data())];
+    const std::size_t at = static_cast<std::size_t>(w - words.data());
     const std::int64_t piece = *w++;
-    FDEM_VERIFY(piece >= first && piece < first + static_cast<std::int64_t>(block.size()),
-                "a piece of the directory block");
-    block[static_cast<std::size_t>(piece - first)].add(Sums::from_words(w));
-    senders.emplace_back(static_cast<std::int32_t>(piece), from);
+    records.push_back({piece, at + 1, source[at]});
+    Sums::from_words(w);  // moves past them
   }
-  return senders;
-}
-
-// Per owned piece, [piece, sums...] to its directory rank.
-template <class Sums>
-std::vector<std::vector<std::int64_t>> pack_for_directory(const std::vector<std::int32_t>& ids,
-                                                          const std::vector<Sums>& sums,
-                                                          const GidBlocks& blocks) {
-  std::vector<std::vector<std::int64_t>> outbox(static_cast<std::size_t>(blocks.ranks));
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    std::vector<std::int64_t>& box = outbox[static_cast<std::size_t>(blocks.owner(ids[i]))];
-    box.push_back(ids[i]);
-    sums[i].append_words(box);
+  std::stable_sort(records.begin(), records.end(),
+                   [](const Record& a, const Record& b) { return a.piece < b.piece; });
+  std::vector<int> senders;
+  for (std::size_t i = 0; i < records.size();) {
+    Sums merged;
+    senders.clear();
+    const std::int64_t piece = records[i].piece;
+    for (; i < records.size() && records[i].piece == piece; ++i) {
+      const std::int64_t* sums = words.data() + records[i].at;
+      merged.add(Sums::from_words(sums));
+      senders.push_back(records[i].from);
+    }
+    use(static_cast<std::int32_t>(piece), merged, senders);
   }
-  return outbox;
 }
 
 // A piece's centres as the directory sends them back to the ranks holding its nodes.
@@ -220,31 +236,42 @@ void sum_pieces_by_directory(Model& model, const Communicator& comm) {
 BlockMotions directory_piece_motions(const Model& model, const Communicator& comm) {
   const GidBlocks blocks = piece_blocks(model.pieces, comm);
   const PieceBlock block = piece_directory_block(model.pieces, comm);
-  const std::size_t n_block = static_cast<std::size_t>(block.end - block.begin);
-  const OwnedPieces owned = owned_pieces(model.nodes);
+  const NodeArrays& nodes = model.nodes;
+  const OwnedPieces owned = owned_pieces(nodes);
+  BlockMotions out;
+  out.first = block.begin;
+  out.motion.resize(static_cast<std::size_t>(block.end - block.begin));
+  const auto in_block = [&](std::int32_t piece) -> PieceMotion& {
+    FDEM_VERIFY(piece >= block.begin && piece < block.end, "a piece of the directory block");
+    return out.motion[static_cast<std::size_t>(piece - block.begin)];
+  };
 
-  // The moments of the owned nodes to the directory, which merges them into the centres.
+  // The moments of the owned nodes to the directory, which merges them into the centres and
+  // sends those back to the ranks that sent moments.
   std::vector<int> source;
   std::vector<std::int64_t> words = comm.exchange(
-      pack_for_directory(owned.ids, piece_moments(model.nodes, owned), blocks), &source);
-  std::vector<PieceMoments> block_moments(n_block);
-  const std::vector<std::pair<std::int32_t, int>> senders =
-      merge_at_directory(words, source, block.begin, block_moments);
-  std::vector<PieceCentres> block_centres;
-  block_centres.reserve(n_block);
-  for (const PieceMoments& m : block_moments) block_centres.push_back(centres_of(m));
-
-  // The centres back to the ranks that sent moments; their spreads about them to the directory.
+      pack_for_directory(owned, blocks,
+                         [&](std::size_t i) { return piece_moments(nodes, owned, i); }),
+      &source);
   std::vector<std::vector<CentreRow>> answers(static_cast<std::size_t>(comm.size()));
-  for (const auto& [piece, rank] : senders) {
-    const PieceCentres& c = block_centres[static_cast<std::size_t>(piece - block.begin)];
-    answers[static_cast<std::size_t>(rank)].push_back(
-        {piece,
-         0,
-         {c.centroid.x(), c.centroid.y(), c.centroid.z()},
-         {c.reference.x(), c.reference.y(), c.reference.z()}});
-  }
+  std::int64_t merged_pieces = 0;
+  merge_by_piece<PieceMoments>(
+      words, source,
+      [&](std::int32_t piece, const PieceMoments& moments, const std::vector<int>& senders) {
+        const PieceCentres c = centres_of(moments);
+        in_block(piece).centroid = c.centroid;
+        in_block(piece).velocity = c.velocity;
+        for (const int rank : senders)
+          answers[static_cast<std::size_t>(rank)].push_back(
+              {piece,
+               0,
+               {c.centroid.x(), c.centroid.y(), c.centroid.z()},
+               {c.reference.x(), c.reference.y(), c.reference.z()}});
+        ++merged_pieces;
+      });
+  FDEM_VERIFY(merged_pieces == block.end - block.begin, "every piece of the block has nodes");
   const std::vector<CentreRow> rows = comm.exchange(answers);
+  answers = {};
   FDEM_VERIFY(rows.size() == owned.ids.size(), "the centres of every owned piece come back");
   std::vector<PieceCentres> centres(owned.ids.size());
   for (const CentreRow& r : rows) {
@@ -252,17 +279,16 @@ BlockMotions directory_piece_motions(const Model& model, const Communicator& com
     c.centroid = Vec3(r.centroid[0], r.centroid[1], r.centroid[2]);
     c.reference = Vec3(r.reference[0], r.reference[1], r.reference[2]);
   }
-  words = comm.exchange(
-      pack_for_directory(owned.ids, piece_spreads(model.nodes, owned, centres), blocks), &source);
-  std::vector<PieceSpread> block_spreads(n_block);
-  merge_at_directory(words, source, block.begin, block_spreads);
 
-  BlockMotions out;
-  out.first = block.begin;
-  out.motion.resize(n_block);
-  for (std::size_t i = 0; i < n_block; ++i)
-    out.motion[i] = {block_centres[i].centroid, block_centres[i].velocity,
-                     rotation_of(block_spreads[i])};
+  // The spreads about the centres to the directory: the rotations.
+  words = comm.exchange(
+      pack_for_directory(owned, blocks,
+                         [&](std::size_t i) { return piece_spread(nodes, owned, i, centres[i]); }),
+      &source);
+  merge_by_piece<PieceSpread>(
+      words, source, [&](std::int32_t piece, const PieceSpread& spread, const std::vector<int>&) {
+        in_block(piece).rotation = rotation_of(spread);
+      });
   return out;
 }
 
