@@ -2,7 +2,7 @@
 # completes, summary.json's state_hash is the same in all of them and bodies.csv is the same file,
 # byte for byte.  With RESTART_RANKS, also continues the first run's earliest checkpoint on each
 # of those rank counts and requires the same hash again (checkpoint-and-restart vs.
-# uninterrupted), and the same bodies.csv in every restarted run.  With START, every run on more than
+# uninterrupted), and the uninterrupted run's bodies.csv rows at the times both runs wrote.  With START, every run on more than
 # one rank must report that start-up in summary.json (decomposition.start: "distributed" when no
 # rank held the whole model, "whole_model").
 # -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list), RESTART_RANKS (list, optional),
@@ -52,6 +52,30 @@ function(compare_bodies out reference_out)
   endif()
 endfunction()
 
+# Every row of a restarted run's bodies.csv at a time the uninterrupted run wrote must be that
+# run's row, byte for byte (the restart also writes a frame at the checkpoint's time).
+function(compare_restarted_bodies out reference_out)
+  file(READ ${reference_out}/bodies.csv reference_text)
+  file(STRINGS ${out}/bodies.csv rows)
+  list(REMOVE_AT rows 0)  # the header
+  set(compared 0)
+  foreach(row ${rows})
+    string(REGEX MATCH "^[^,]*," time "${row}")
+    string(FIND "${reference_text}" "\n${time}" at_time)
+    if(at_time EQUAL -1)
+      continue()
+    endif()
+    string(FIND "${reference_text}" "\n${row}\n" found)
+    if(found EQUAL -1)
+      message(FATAL_ERROR "${out}/bodies.csv: row '${row}' is not in ${reference_out}/bodies.csv")
+    endif()
+    math(EXPR compared "${compared} + 1")
+  endforeach()
+  if(compared EQUAL 0)
+    message(FATAL_ERROR "${out}/bodies.csv has no row at a time of ${reference_out}/bodies.csv")
+  endif()
+endfunction()
+
 set(reference "")
 foreach(ranks ${RANKS})
   run_fdem(${ranks} ${WORK}/ranks${ranks})
@@ -81,11 +105,7 @@ if(RESTART_RANKS)
       message(FATAL_ERROR "restart from ${earliest} on ${ranks} ranks: state_hash ${hash}, "
                           "uninterrupted ${reference}")
     endif()
-    if(NOT first_restart)
-      set(first_restart ${WORK}/restart${ranks})
-    else()
-      compare_bodies(${WORK}/restart${ranks} ${first_restart})
-    endif()
+    compare_restarted_bodies(${WORK}/restart${ranks} ${first_run})
   endforeach()
 endif()
 message("all runs: state_hash ${reference}, bodies.csv the same")
