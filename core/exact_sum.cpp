@@ -1,5 +1,6 @@
 #include "core/exact_sum.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -19,15 +20,43 @@ std::int64_t floor_div_base(std::int64_t v) {
 }
 }  // namespace
 
+void ExactSum::Limbs::resize(std::size_t n) {
+  if (heap_.empty() && n > in_place_count) {
+    heap_.assign(n, 0);
+    std::copy(in_place_, in_place_ + size_, heap_.begin());
+  } else if (!heap_.empty() && heap_.size() < n) {
+    heap_.resize(n, 0);
+  }
+  std::fill(begin() + std::min(size_, n), begin() + n, 0);
+  size_ = n;
+}
+
+void ExactSum::Limbs::push_back(std::int64_t limb) {
+  resize(size_ + 1);
+  begin()[size_ - 1] = limb;
+}
+
+void ExactSum::Limbs::grow_front(std::size_t n) {
+  const std::size_t old = size_;
+  resize(size_ + n);
+  std::move_backward(begin(), begin() + old, begin() + old + n);
+  std::fill(begin(), begin() + n, 0);
+}
+
+void ExactSum::Limbs::drop_front(std::size_t n) {
+  std::move(begin() + n, end(), begin());
+  size_ -= n;
+}
+
 void ExactSum::reach(std::int32_t digit) {
   if (limbs_.empty()) {
     first_digit_ = digit;
-    limbs_.assign(1, 0);
+    limbs_.resize(1);
   } else if (digit < first_digit_) {
-    limbs_.insert(limbs_.begin(), static_cast<std::size_t>(first_digit_ - digit), 0);
+    limbs_.grow_front(static_cast<std::size_t>(first_digit_ - digit));
     first_digit_ = digit;
   } else if (digit >= first_digit_ + static_cast<std::int32_t>(limbs_.size())) {
-    limbs_.resize(static_cast<std::size_t>(digit - first_digit_ + 1), 0);
+    limbs_.resize(static_cast<std::size_t>(digit - first_digit_ + 1));
   }
 }
 
@@ -95,7 +124,7 @@ void ExactSum::normalise() {
   while (!limbs_.empty() && limbs_.back() == 0) limbs_.pop_back();
   std::size_t zeros = 0;
   while (zeros < limbs_.size() && limbs_[zeros] == 0) ++zeros;
-  limbs_.erase(limbs_.begin(), limbs_.begin() + static_cast<std::ptrdiff_t>(zeros));
+  limbs_.drop_front(zeros);
   first_digit_ = limbs_.empty() ? 0 : first_digit_ + static_cast<std::int32_t>(zeros);
 }
 
