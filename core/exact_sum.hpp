@@ -5,7 +5,7 @@
 //
 // The sum is held as an integer multiple of 2^-1074 (the smallest subnormal) in base-2^32 digits
 // stored in 64-bit limbs, only over the span of digits the added values reach: a few limbs for
-// values of similar magnitude.  A limb absorbs 2^30 additions before carries are propagated.
+// values of similar magnitude.  Carries are propagated every 2^29 additions (limbs stay < 2^62).
 #pragma once
 
 #include <cstdint>
