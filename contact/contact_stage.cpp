@@ -16,6 +16,11 @@ namespace {
 // Auto penalty: 10 E keeps the kinetic energy recovered in an impact above 99 % (docs/references.md
 // 2) and the penetration under 10 % of the element size at the material's strength scale.
 constexpr double auto_penalty_factor = 10.0;
+
+// From the piece's body: no table per piece (a rank may not know every piece of the model).
+bool piece_fixed(const Model& model, std::int32_t piece) {
+  return model.body_fixed[model.pieces.body_of(piece)];
+}
 }  // namespace
 
 ContactStage::ContactStage(const Model& model, ContactSettings settings) {
@@ -24,9 +29,6 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
     friction_coefficient_.push_back(m.contact.friction);
     damping_ratio_.push_back(m.contact.damping);
   }
-  piece_fixed_.resize(model.pieces.size());
-  for (std::size_t p = 0; p < model.pieces.size(); ++p)
-    piece_fixed_[p] = model.body_fixed[model.pieces[p].body];
   x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
@@ -58,8 +60,9 @@ std::vector<double> ContactStage::tet_sizes(const Model& model) {
 }
 
 bool ContactStage::needed(const Model& model) {
-  int free_pieces = 0;
-  for (const PieceInfo& p : model.pieces) free_pieces += model.body_fixed[p.body] ? 0 : 1;
+  std::int64_t free_pieces = 0;
+  for (std::int32_t b = 0; b < model.pieces.bodies(); ++b)
+    free_pieces += model.body_fixed[b] ? 0 : model.pieces.pieces_in_body(b);
   // A jointed body is one piece of many contact groups: its tets meet once joints break.
   const bool grouped =
       model.tets.contact_group.size() > 0 &&
@@ -187,8 +190,8 @@ void ContactStage::run_detection(const Model& model, const double* x) {
   const auto keep = [&](LocalIndex a, LocalIndex b) {
     // A pair between two tets this rank does not compute is left to the ranks that do.
     if (!all_active && !tets.active[a] && !tets.active[b]) return false;
-    const std::int32_t pa = tets.piece[a], pb = tets.piece[b];
-    if (tets.group_of(a) == tets.group_of(b) || (piece_fixed_[pa] && piece_fixed_[pb]))
+    if (tets.group_of(a) == tets.group_of(b) ||
+        (piece_fixed(model, tets.piece[a]) && piece_fixed(model, tets.piece[b])))
       return false;
     if (bonds_.empty()) return true;
     const LocalIndex* bonded = bonds_.data() + 4 * static_cast<std::size_t>(a);
@@ -362,8 +365,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       const double k = r.normal_force * r.normal_force / (2.0 * r.energy);
       const double m_a = model.materials[ma].density * std::abs(tets.volume0[pair.a]);
       const double m_b = model.materials[mb].density * std::abs(tets.volume0[pair.b]);
-      const bool a_fixed = piece_fixed_[tets.piece[pair.a]],
-                 b_fixed = piece_fixed_[tets.piece[pair.b]];
+      const bool a_fixed = piece_fixed(model, tets.piece[pair.a]),
+                 b_fixed = piece_fixed(model, tets.piece[pair.b]);
       const double m = a_fixed ? m_b : b_fixed ? m_a : m_a * m_b / (m_a + m_b);
       const double v_n = relative_velocity_at_centroid(r, va, vb).dot(r.normal);
       const double f_n = std::max(-2.0 * xi * std::sqrt(k * m) * v_n,

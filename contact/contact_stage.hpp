@@ -108,7 +108,6 @@ class ContactStage {
 
   double buffer_ = 0.0;
   std::vector<double> penalty_;
-  std::vector<char> piece_fixed_;
   NbsDetector detector_;
   std::vector<double> lo_, hi_, x_at_detection_;
   std::vector<CandidatePair> pairs_;

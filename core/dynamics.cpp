@@ -1,6 +1,5 @@
 #include "core/dynamics.hpp"
 
-#include <Eigen/SVD>
 #include <cmath>
 
 #include "core/tet_kernels.hpp"
@@ -179,49 +178,15 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
   return out;
 }
 
-std::vector<PieceMotion> piece_motions(
-    const Model& model, const std::function<void(std::vector<double>&)>& sum_over_ranks) {
-  const NodeArrays& nodes = model.nodes;
-  const std::size_t n_pieces = model.pieces.size();
-  std::vector<PieceMotion> motion(n_pieces);
-  // Per piece: mass, Σm·x, Σm·v, Σm·x0 (10 values), then the covariance (9).
-  std::vector<double> sums(10 * n_pieces, 0.0);
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    double* s = &sums[10 * static_cast<std::size_t>(nodes.piece[n])];
-    const double m = nodes.mass[n];
-    s[0] += m;
-    for (int k = 0; k < 3; ++k) {
-      s[1 + k] += m * nodes.x[3 * n + k];
-      s[4 + k] += m * nodes.v[3 * n + k];
-      s[7 + k] += m * nodes.x0[3 * n + k];
-    }
-  }
-  if (sum_over_ranks) sum_over_ranks(sums);
-  std::vector<Vec3> reference_centroid(n_pieces, Vec3::Zero());
-  for (std::size_t p = 0; p < n_pieces; ++p) {
-    const double* s = &sums[10 * p];
-    if (!(s[0] > 0.0)) continue;
-    motion[p].centroid = Vec3(s[1], s[2], s[3]) / s[0];
-    motion[p].velocity = Vec3(s[4], s[5], s[6]) / s[0];
-    reference_centroid[p] = Vec3(s[7], s[8], s[9]) / s[0];
-  }
-  std::vector<double> covariance(9 * n_pieces, 0.0);
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    const std::int32_t p = nodes.piece[n];
-    const Mat3 c = nodes.mass[n] * (vec3_at(nodes.x.data(), n) - motion[p].centroid) *
-                   (vec3_at(nodes.x0.data(), n) - reference_centroid[p]).transpose();
-    for (int i = 0; i < 9; ++i) covariance[9 * static_cast<std::size_t>(p) + i] += c.data()[i];
-  }
-  if (sum_over_ranks) sum_over_ranks(covariance);
-  // Best-fit rotation (Kabsch): R = U·diag(1,1,det)·Vᵀ from the mass-weighted covariance.
-  for (std::size_t p = 0; p < n_pieces; ++p) {
-    const Eigen::Map<const Mat3> cov(&covariance[9 * p]);
-    Eigen::JacobiSVD<Mat3> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Mat3 d = Mat3::Identity();
-    d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
-    const Mat3 R = svd.matrixU() * d * svd.matrixV().transpose();
-    const Eigen::AngleAxisd aa(R);
-    motion[p].rotation = aa.angle() * aa.axis();
+std::vector<PieceMotion> piece_motions(const Model& model) {
+  const OwnedPieces owned = owned_pieces(model.nodes);
+  std::vector<PieceMotion> motion(model.pieces.size());
+  for (std::size_t i = 0; i < owned.ids.size(); ++i) {
+    const PieceCentres c = centres_of(piece_moments(model.nodes, owned, i));
+    PieceMotion& m = motion[static_cast<std::size_t>(owned.ids[i])];
+    m.centroid = c.centroid;
+    m.velocity = c.velocity;
+    m.rotation = rotation_of(piece_spread(model.nodes, owned, i, c));
   }
   return motion;
 }

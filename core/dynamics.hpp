@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/model.hpp"
+#include "core/piece_moments.hpp"
 
 namespace fdem {
 
@@ -56,16 +57,10 @@ struct IntegrationSummary {
 // Central difference: v⁺ = v⁻ + dt·f/m (prescribed components set), x += dt·v⁺, on owned nodes.
 IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes);
 
-// Mass-weighted position, velocity and rotation of each piece (for bodies.csv and tests).
-struct PieceMotion {
-  Vec3 centroid = Vec3::Zero();
-  Vec3 velocity = Vec3::Zero();
-  Vec3 rotation = Vec3::Zero();  // rotation vector (axis × angle, rad) of the best-fit rotation
-};
-// `sum_over_ranks` (parallel runs): adds a vector element-wise over all ranks in place, so each
-// rank's owned nodes contribute to the pieces they belong to.
-std::vector<PieceMotion> piece_motions(
-    const Model& model, const std::function<void(std::vector<double>&)>& sum_over_ranks = {});
+// Mass-weighted position, velocity and rotation of every piece of a model held whole by one
+// process, indexed by piece id (exact sums: core/piece_moments; on N ranks
+// parallel/piece_directory gives the same values).
+std::vector<PieceMotion> piece_motions(const Model& model);
 
 // Total linear and angular momentum (about the origin) of the owned nodes.
 Vec3 linear_momentum(const NodeArrays& nodes);

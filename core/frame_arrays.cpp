@@ -80,7 +80,7 @@ std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<L
     const LocalIndex t = cells[c];
     tet_gid.integer[c] = tets.gid[t];
     piece.integer[c] = tets.piece[t];
-    body.integer[c] = model.pieces[tets.piece[t]].body;
+    body.integer[c] = model.pieces.body_of(tets.piece[t]);
     material.integer[c] = tets.material[t];
   }
   for (FrameArray* a : {&tet_gid, &piece, &body, &material}) arrays.push_back(std::move(*a));

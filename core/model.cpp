@@ -1,8 +1,11 @@
 #include "core/model.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <string>
+
+#include "core/error.hpp"
 
 #include "core/error.hpp"
 
@@ -60,6 +63,88 @@ void JointArrays::resize(LocalIndex n) {
   mode.resize(n, 0);
   failure_time.resize(n, -1.0);
   damage.resize(n, 0.0);
+}
+
+void PieceTable::add_body(std::int32_t pieces) {
+  FDEM_VERIFY(pieces >= 0 && first_.back() <= std::numeric_limits<std::int32_t>::max() - pieces,
+              "piece ids fit 32 bits");
+  first_.push_back(first_.back() + pieces);
+}
+
+std::int32_t PieceTable::body_of(std::int32_t piece) const {
+  FDEM_VERIFY(piece >= 0 && piece < first_.back(), "a piece id of the model");
+  return static_cast<std::int32_t>(std::upper_bound(first_.begin(), first_.end(), piece) -
+                                   first_.begin()) -
+         1;
+}
+
+std::int32_t PieceTable::slot(std::int32_t piece) const {
+  if (kept_id_.empty()) return -1;
+  // Kept ids are often one dense range (one process, a directory block): no search then.
+  const std::int64_t offset = std::int64_t{piece} - kept_id_.front();
+  if (kept_id_.back() - kept_id_.front() + 1 == static_cast<std::int64_t>(kept_id_.size()))
+    return offset >= 0 && offset < static_cast<std::int64_t>(kept_id_.size())
+               ? static_cast<std::int32_t>(offset)
+               : -1;
+  const auto it = std::lower_bound(kept_id_.begin(), kept_id_.end(), piece);
+  return it != kept_id_.end() && *it == piece ? static_cast<std::int32_t>(it - kept_id_.begin())
+                                              : -1;
+}
+
+void PieceTable::keep_range(std::int32_t begin, std::int32_t end) {
+  std::vector<std::int32_t> ids(static_cast<std::size_t>(std::max(0, end - begin)));
+  std::iota(ids.begin(), ids.end(), begin);
+  keep(ids);
+}
+
+void PieceTable::keep(const std::vector<std::int32_t>& sorted_ids) {
+  std::vector<std::int32_t> ids;
+  std::vector<PieceInfo> infos;
+  ids.reserve(kept_id_.size() + sorted_ids.size());
+  infos.reserve(ids.capacity());
+  std::size_t i = 0, j = 0;
+  while (i < kept_id_.size() || j < sorted_ids.size()) {
+    if (j == sorted_ids.size() || (i < kept_id_.size() && kept_id_[i] <= sorted_ids[j])) {
+      if (j < sorted_ids.size() && kept_id_[i] == sorted_ids[j]) ++j;
+      ids.push_back(kept_id_[i]);
+      infos.push_back(kept_[i++]);
+      continue;
+    }
+    const std::int32_t id = sorted_ids[j++];
+    if (!ids.empty() && ids.back() == id) continue;
+    PieceInfo info;
+    info.body = body_of(id);
+    info.index_in_body = id - first_[info.body];
+    ids.push_back(id);
+    infos.push_back(info);
+  }
+  kept_id_ = std::move(ids);
+  kept_ = std::move(infos);
+}
+
+void PieceTable::keep_only_range(std::int32_t begin, std::int32_t end) {
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < kept_id_.size(); ++i)
+    if (kept_id_[i] >= begin && kept_id_[i] < end) {
+      kept_id_[out] = kept_id_[i];
+      kept_[out++] = kept_[i];
+    }
+  kept_id_.resize(out);
+  kept_.resize(out);
+  kept_id_.shrink_to_fit();
+  kept_.shrink_to_fit();
+}
+
+PieceInfo& PieceTable::operator[](std::int32_t piece) {
+  const std::int32_t s = slot(piece);
+  FDEM_VERIFY(s >= 0, "the piece is kept here");
+  return kept_[static_cast<std::size_t>(s)];
+}
+
+const PieceInfo& PieceTable::operator[](std::int32_t piece) const {
+  const std::int32_t s = slot(piece);
+  FDEM_VERIFY(s >= 0, "the piece is kept here");
+  return kept_[static_cast<std::size_t>(s)];
 }
 
 std::int32_t count_fragments(const Model& model) {

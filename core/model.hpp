@@ -111,11 +111,44 @@ struct PieceInfo {
   Vec3 centroid0 = Vec3::Zero();  // mass-weighted reference centroid (m)
 };
 
+// The discrete elements, numbered body by body: a piece's id is its body's first id plus its index
+// in the body, so its body and index follow from one number per body.  Mass and reference
+// centroid are *kept* for some pieces only: every piece in one process; on N ranks those of the
+// rank's directory block of ids (parallel/piece_directory), so no rank holds a table of every
+// piece of a wall of 10^6 blocks.
+class PieceTable {
+ public:
+  void add_body(std::int32_t pieces);  // the pieces of the next body
+  std::size_t size() const { return static_cast<std::size_t>(first_.back()); }  // whole model
+  std::int32_t bodies() const { return static_cast<std::int32_t>(first_.size()) - 1; }
+  std::int32_t first_of_body(std::int32_t body) const { return first_[body]; }
+  std::int32_t pieces_in_body(std::int32_t body) const { return first_[body + 1] - first_[body]; }
+  std::int32_t body_of(std::int32_t piece) const;
+  std::int32_t index_in_body(std::int32_t piece) const { return piece - first_[body_of(piece)]; }
+
+  // Kept pieces, in ascending id; added ones start with mass 0.
+  const std::vector<std::int32_t>& kept() const { return kept_id_; }
+  bool keeps(std::int32_t piece) const { return slot(piece) >= 0; }
+  void keep_all() { keep_range(0, static_cast<std::int32_t>(size())); }
+  void keep_range(std::int32_t begin, std::int32_t end);
+  void keep(const std::vector<std::int32_t>& sorted_ids);
+  void keep_only_range(std::int32_t begin, std::int32_t end);  // drops the others
+  PieceInfo& operator[](std::int32_t piece);
+  const PieceInfo& operator[](std::int32_t piece) const;
+
+ private:
+  std::int32_t slot(std::int32_t piece) const;  // index into kept_, or −1
+
+  std::vector<std::int32_t> first_{0};  // per body its first id, then the total
+  std::vector<std::int32_t> kept_id_;
+  std::vector<PieceInfo> kept_;
+};
+
 struct Model {
   NodeArrays nodes;
   TetArrays tets;
   std::vector<MaterialProperties> materials;
-  std::vector<PieceInfo> pieces;
+  PieceTable pieces;
   std::vector<std::string> body_names;
   std::vector<bool> body_fixed;
   // Local active tets in ascending global id: the order in which element forces are added to

@@ -178,8 +178,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     std::int32_t n_pieces = 0;
     const auto piece = connected_pieces(mesh.tets, n_nodes, &n_pieces);
     const std::int32_t piece_base = static_cast<std::int32_t>(model.pieces.size());
-    for (std::int32_t p = 0; p < n_pieces; ++p)
-      model.pieces.push_back({static_cast<std::int32_t>(b), p});
+    model.pieces.add_body(n_pieces);
     const LocalIndex n_tets = static_cast<LocalIndex>(mesh.tets.size() / 4);
     for (LocalIndex t = 0; t < n_tets; ++t) {
       Vec3 X[4];
@@ -190,6 +189,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     }
   }
   if (records.empty()) throw InputError(scene.source_path + ": the scene has no tetrahedra");
+  model.pieces.keep_all();
 
   // Element order: Morton keys of centroids give spatial locality in memory.
   if (order == ElementOrder::space_filling_curve) {
@@ -274,7 +274,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     for (int c = 0; c < 4; ++c) nodes.mass[tets.nodes[4 * t + c]] += 0.25 * setup.mass;
     add_to_piece(model.pieces[r.piece], setup.mass, X);
   }
-  for (auto& piece : model.pieces) finish_piece(piece);
+  for (const std::int32_t piece : model.pieces.kept()) finish_piece(model.pieces[piece]);
 
   // Contact groups: a piece, or a single tet of a jointed body.
   tets.contact_group.resize(n_tets);
@@ -299,7 +299,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
 void apply_constraints(const Scene& scene, Model& model) {
   NodeArrays& nodes = model.nodes;
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    const std::int32_t body = model.pieces[nodes.piece[n]].body;
+    const std::int32_t body = model.pieces.body_of(nodes.piece[n]);
     if (scene.bodies[body].fixed) {
       nodes.constrained[n] = 7;
       vec3_at(nodes.prescribed_velocity.data(), n).setZero();
@@ -314,7 +314,7 @@ void apply_constraints(const Scene& scene, Model& model) {
         applies = (X.array() >= load.region->min.array()).all() &&
                   (X.array() <= load.region->max.array()).all();
       } else {
-        const std::int32_t body = model.pieces[nodes.piece[n]].body;
+        const std::int32_t body = model.pieces.body_of(nodes.piece[n]);
         applies = std::find(load.bodies.begin(), load.bodies.end(), body) != load.bodies.end();
       }
       if (!applies) continue;

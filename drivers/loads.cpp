@@ -136,7 +136,7 @@ void LoadSchedule::rebind(const Model& model) {
   for (Base& base : bases_) {
     base.nodes.clear();
     for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
-      const std::int32_t body = model.pieces[model.nodes.piece[n]].body;
+      const std::int32_t body = model.pieces.body_of(model.nodes.piece[n]);
       if (std::find(base.bodies.begin(), base.bodies.end(), body) != base.bodies.end())
         base.nodes.push_back(n);
     }

@@ -43,12 +43,11 @@ int check(const fdem::Scene& scene) {
         m.elastic.young, m.elastic.poisson,
         m.elastic.model == fdem::ElasticModel::neo_hookean ? "neo-hookean" : "st-venant-kirchhoff",
         m.damping > 0 ? (", damping ratio " + std::to_string(m.damping)).c_str() : "");
-  std::vector<int> pieces_per_body(scene.bodies.size(), 0);
-  for (const auto& p : model.pieces) ++pieces_per_body[p.body];
   std::printf("  bodies: %zu\n", scene.bodies.size());
   for (std::size_t b = 0; b < scene.bodies.size(); ++b)
     std::printf("    %-16s %d discrete element(s), material %s%s\n", scene.bodies[b].name.c_str(),
-                pieces_per_body[b], scene.materials[scene.bodies[b].material].name.c_str(),
+                model.pieces.pieces_in_body(static_cast<std::int32_t>(b)),
+                scene.materials[scene.bodies[b].material].name.c_str(),
                 scene.bodies[b].fixed ? ", fixed" : "");
   std::printf("  mesh: %d nodes, %d tetrahedra, %zu discrete elements\n", model.nodes.size(),
               model.tets.size(), model.pieces.size());

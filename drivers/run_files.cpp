@@ -39,6 +39,8 @@ const std::string& create_output_directory(const std::string& directory) {
   return directory;
 }
 
+constexpr const char* bodies_header = "time,body,piece,mass,x,y,z,vx,vy,vz,rx,ry,rz\n";
+
 // JSON has no NaN or infinity: a run that blew up reports those values as null.
 struct JsonNumber {
   double value;
@@ -62,9 +64,9 @@ RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>&
   energy_ << "time,kinetic,strain,gravity,contact,joint,dissipated_fracture,dissipated_friction,"
              "dissipated_damping,external_work,total,balance_error\n";
   bodies_.open(std::filesystem::path(directory) / "bodies.csv");
-  bodies_ << "time,body,piece,mass,x,y,z,vx,vy,vz,rx,ry,rz\n";
+  bodies_ << bodies_header;
   energy_ << std::setprecision(12);
-  bodies_ << std::setprecision(12);
+  if (ranks_ > 1) bodies_.close();  // the rows are appended collectively (OrderedTextFile)
   if (!energy_ || !bodies_)
     throw InputError("cannot write into the output directory '" + directory + "' (-o)");
 }
@@ -79,19 +81,37 @@ void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balanc
   if (!energy_) throw IoError("cannot write " + directory_ + "/energy.csv (disk full?)");
 }
 
+std::string bodies_rows(double time, const Model& model, std::int32_t first_piece,
+                        const std::vector<PieceMotion>& motion) {
+  std::ostringstream rows;
+  rows << std::setprecision(12);
+  for (std::size_t i = 0; i < motion.size(); ++i) {
+    const std::int32_t id = first_piece + static_cast<std::int32_t>(i);
+    const PieceMotion& m = motion[i];
+    rows << time << ',' << model.body_names[model.pieces.body_of(id)] << ','
+         << model.pieces.index_in_body(id) << ',' << model.pieces[id].mass << ',' << m.centroid.x()
+         << ',' << m.centroid.y() << ',' << m.centroid.z() << ',' << m.velocity.x() << ','
+         << m.velocity.y() << ',' << m.velocity.z() << ',' << m.rotation.x() << ','
+         << m.rotation.y() << ',' << m.rotation.z() << '\n';
+  }
+  return rows.str();
+}
+
 void RunFiles::write_bodies_rows(double time, const Model& model,
                                  const std::vector<PieceMotion>& motion) {
   if (rank_ != 0) return;
-  for (std::size_t p = 0; p < model.pieces.size(); ++p) {
-    const PieceInfo& piece = model.pieces[p];
-    const PieceMotion& m = motion[p];
-    bodies_ << time << ',' << model.body_names[piece.body] << ',' << piece.index_in_body << ','
-            << piece.mass << ',' << m.centroid.x() << ',' << m.centroid.y() << ',' << m.centroid.z()
-            << ',' << m.velocity.x() << ',' << m.velocity.y() << ',' << m.velocity.z() << ','
-            << m.rotation.x() << ',' << m.rotation.y() << ',' << m.rotation.z() << '\n';
-  }
+  bodies_ << bodies_rows(time, model, 0, motion);
   bodies_.flush();
   if (!bodies_) throw IoError("cannot write " + directory_ + "/bodies.csv (disk full?)");
+}
+
+void RunFiles::write_bodies_rows(double time, const Model& model, std::int32_t first_piece,
+                                 const std::vector<PieceMotion>& motion, const Communicator& comm) {
+  if (!shared_bodies_)
+    shared_bodies_ = std::make_unique<OrderedTextFile>(
+        (std::filesystem::path(directory_) / "bodies.csv").string(),
+        static_cast<std::int64_t>(std::string(bodies_header).size()), comm);
+  shared_bodies_->append(bodies_rows(time, model, first_piece, motion));
 }
 
 std::vector<double> tet_damage(const Model& model) {

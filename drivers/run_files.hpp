@@ -15,6 +15,7 @@
 #include "core/model.hpp"
 #include "io/vtk_output.hpp"
 #include "io/xdmf_series.hpp"
+#include "parallel/ordered_text_file.hpp"
 #include "parallel/xdmf_output.hpp"
 
 namespace fdem {
@@ -38,7 +39,12 @@ class RunFiles {
   RunFiles(const std::string& directory, const std::vector<std::string>& fields, int rank = 0,
            int ranks = 1, std::optional<XdmfFrames> xdmf = std::nullopt);
   void write_energy_row(double time, const EnergyTerms& e, double balance_error);
+  // One process: the bodies.csv rows of every piece (motion indexed by piece id).
   void write_bodies_rows(double time, const Model& model, const std::vector<PieceMotion>& motion);
+  // N ranks, collective: every rank's rows of the pieces first_piece, first_piece + 1, ... (its
+  // directory block, parallel/piece_directory) go into bodies.csv in piece order (MPI-IO).
+  void write_bodies_rows(double time, const Model& model, std::int32_t first_piece,
+                         const std::vector<PieceMotion>& motion, const Communicator& comm);
   // A frame of the tets; with `damage` in the fields, the per-tet damage; in a model with joints
   // also a frame of the "cracks" series (broken joint faces).
   // `cracks`: the scene has joints (the same answer on every rank: each writes a piece).
@@ -60,12 +66,18 @@ class RunFiles {
   std::string directory_;
   std::vector<std::string> fields_;
   int rank_ = 0, ranks_ = 1;
-  std::ofstream energy_, bodies_;
+  std::ofstream energy_, bodies_;                   // bodies_: one process only
+  std::unique_ptr<OrderedTextFile> shared_bodies_;  // N ranks
   SeriesWriter frames_;
   std::optional<XdmfFrames> xdmf_;
   std::unique_ptr<XdmfSeries> xdmf_series_;
   std::unique_ptr<SeriesWriter> contacts_, cracks_;
 };
+
+// The bodies.csv rows of pieces first_piece, first_piece + 1, ... at `time` (the same text on any
+// number of ranks).
+std::string bodies_rows(double time, const Model& model, std::int32_t first_piece,
+                        const std::vector<PieceMotion>& motion);
 
 // Per-tet damage: the largest damage of the tet's joints (0 for a tet without joints).
 std::vector<double> tet_damage(const Model& model);

@@ -243,10 +243,10 @@ std::string describe_tet(const Model& model, LocalIndex tet) {
     largest_area = std::max(largest_area, 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm());
   }
   const double height = largest_area > 0 ? 3.0 * volume / largest_area : 0.0;
-  const PieceInfo& piece = model.pieces[model.tets.piece[tet]];
+  const std::int32_t body = model.pieces.body_of(model.tets.piece[tet]);
   std::ostringstream out;
   out.precision(3);
-  out << "tetrahedron " << model.tets.gid[tet] << " of body '" << model.body_names[piece.body]
+  out << "tetrahedron " << model.tets.gid[tet] << " of body '" << model.body_names[body]
       << "' (smallest height " << height << " m)";
   return out.str();
 }

@@ -80,7 +80,7 @@ inline LoadSpec load_on_region(const Vec3& lo, const Vec3& hi, const Vec3& v, un
 inline Vec3 reaction_on_body(const Model& model, int body) {
   Vec3 r = Vec3::Zero();
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces[model.nodes.piece[n]].body == body && model.nodes.constrained[n])
+    if (model.pieces.body_of(model.nodes.piece[n]) == body && model.nodes.constrained[n])
       r -= vec3_at(model.nodes.f.data(), n);
   return r;
 }
@@ -89,7 +89,7 @@ inline Vec3 reaction_on_body(const Model& model, int body) {
 // the kinetic energy change as the reactions' work (that step's reaction holds the impulse).
 inline void set_body_velocity(Model& model, int body, const Vec3& v) {
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces[model.nodes.piece[n]].body == body)
+    if (model.pieces.body_of(model.nodes.piece[n]) == body)
       vec3_at(model.nodes.prescribed_velocity.data(), n) = v;
 }
 

@@ -32,6 +32,7 @@
 #include "parallel/communicator.hpp"
 #include "parallel/distribution.hpp"
 #include "parallel/file_mesh_chunks.hpp"
+#include "parallel/piece_directory.hpp"
 
 namespace fdem {
 
@@ -591,11 +592,11 @@ void Simulation::check_state(const InternalForceSummary& forces, bool velocities
   const std::string advice = step_advice();
   if (!(forces.min_jacobian > 0.0)) {
     const LocalIndex t = forces.min_jacobian_tet;
-    const PieceInfo& piece = model_.pieces[model_.tets.piece[t]];
+    const std::int32_t piece = model_.tets.piece[t];
     std::ostringstream msg;
     msg << "numerical failure at step " << steps_ << " (t = " << time_ << " s): tetrahedron "
-        << model_.tets.gid[t] << " of body '" << model_.body_names[piece.body] << "' (piece "
-        << piece.index_in_body << ") "
+        << model_.tets.gid[t] << " of body '" << model_.body_names[model_.pieces.body_of(piece)]
+        << "' (piece " << model_.pieces.index_in_body(piece) << ") "
         << (std::isnan(forces.min_jacobian) ? "has NaN coordinates" : "inverted")
         << " (det F = " << forces.min_jacobian << ")." << advice;
     throw NumericalFailure(msg.str());
@@ -760,17 +761,18 @@ void Simulation::write_outputs(bool force) {
 
 // The energy row and/or the frame (with contacts, cracks and bodies.csv rows) of this step.
 void Simulation::write_files(bool frame, bool energy_row, double energy_time) {
-  std::vector<PieceMotion> motion;
+  // Piece motions: of every piece on one rank; on N ranks of this rank's directory block.
+  BlockMotions motion;
   if (frame) {
-    std::function<void(std::vector<double>&)> sum_over_ranks;
     if (distribution_) {
       if (halo_in_flight_) {  // frames show ghost nodes of owned tets: complete the exchange
         distribution_->finish_halo_exchange(model_.nodes);
         halo_in_flight_ = false;
       }
-      sum_over_ranks = [this](std::vector<double>& v) { comm_->sum_in_place(v); };
+      motion = directory_piece_motions(model_, *comm_);
+    } else {
+      motion.motion = piece_motions(model_);
     }
-    motion = piece_motions(model_, sum_over_ranks);
   }
   // The frame first: with output.format xdmf it is written collectively, so no rank may leave
   // this lambda before it (rank 0 alone failing on energy.csv would leave the others waiting in
@@ -784,13 +786,13 @@ void Simulation::write_files(bool frame, bool energy_row, double energy_time) {
       files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());
     if (!frame) return;
     if (contact_) files_->write_contacts(time_, contact_->records());
-    files_->write_bodies_rows(time_, model_, motion);
+    if (!distribution_) files_->write_bodies_rows(time_, model_, motion.motion);
   };
   // A full disk is seen by the ranks that write: every rank stops together (IoError).
-  if (distribution_)
-    comm_->run_collectively(write);
-  else
-    write();
+  if (!distribution_) return write();
+  comm_->run_collectively(write);
+  // Collective (MPI-IO), so outside the lambda: every rank reaches it.
+  if (frame) files_->write_bodies_rows(time_, model_, motion.first, motion.motion, *comm_);
 }
 
 // After a signal: the frame and energy row of the step reached, a checkpoint to continue from.

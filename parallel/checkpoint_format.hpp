@@ -1,6 +1,6 @@
 // What the checkpoint writer (parallel/checkpoint.cpp) and reader (parallel/checkpoint_read.cpp)
 // share: the format name, the header text that its checksum covers, and the contiguous gid blocks
-// that rank r writes and reads.  Internal to parallel/.
+// that rank r writes and reads (parallel/gid_blocks).  Internal to parallel/.
 #pragma once
 
 #include <algorithm>
@@ -12,6 +12,7 @@
 #include "core/types.hpp"
 #include "parallel/checkpoint.hpp"
 #include "parallel/checkpoint_checksum.hpp"
+#include "parallel/gid_blocks.hpp"
 
 namespace fdem::checkpoint_format {
 
@@ -38,21 +39,7 @@ inline std::uint64_t header_checksum(const std::string& serialized_header,
   return text_checksum(serialized_header + " h:" + std::to_string(history_bytes));
 }
 
-// n rows cut into `ranks` contiguous blocks, the first n % ranks of them one row longer: rank r
-// writes (and reads) rows [begin(r), begin(r + 1)).
-struct GidBlocks {
-  std::int64_t n = 0;
-  int ranks = 1;
-
-  std::int64_t begin(std::int64_t r) const {
-    return r * (n / ranks) + std::min<std::int64_t>(r, n % ranks);
-  }
-  std::int64_t count(int r) const { return begin(r + 1) - begin(r); }
-  // The rank whose block holds row g (0 <= g < n).
-  int owner(GlobalId g) const {
-    const std::int64_t base = n / ranks, extra = n % ranks, long_end = extra * (base + 1);
-    return static_cast<int>(g < long_end ? g / (base + 1) : extra + (g - long_end) / base);
-  }
-};
+// Rank r writes (and reads) rows [begin(r), begin(r + 1)).
+using fdem::GidBlocks;
 
 }  // namespace fdem::checkpoint_format

@@ -199,6 +199,10 @@ class Communicator {
     reduce_in_place(values, MPI_MIN);
   }
 
+  // The sum of `value` over the lower ranks (0 on rank 0): where a rank's part of something laid
+  // out in rank order begins.
+  std::int64_t exclusive_sum(std::int64_t value) const;
+
   // One value per rank, in rank order, on every rank.
   template <class T>
   std::vector<T> allgather(const T& value) const;

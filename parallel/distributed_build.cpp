@@ -9,6 +9,7 @@
 #include "core/joint_placement.hpp"
 #include "core/tet_kernels.hpp"
 #include "parallel/distributed_joints.hpp"
+#include "parallel/piece_directory.hpp"
 
 namespace fdem {
 
@@ -335,42 +336,6 @@ std::vector<NodeNumber> number_nodes(const std::vector<TetRecord>& tets, GlobalI
   return mine;
 }
 
-// Step 5b: piece masses and centroids summed tet by tet in gid order along the ranks (rank r
-// continues the sums rank r − 1 reached), as one process summing all tets in order does.
-void sum_pieces(std::vector<PieceInfo>& pieces, const Model& model, const Communicator& comm) {
-  const int me = comm.rank(), ranks = comm.size();
-  std::vector<double> running(4 * pieces.size(), 0.0);
-  constexpr int tag = 51;
-  if (me > 0)
-    MPI_Recv(running.data(), detail::checked_count(running.size(), 1), MPI_DOUBLE, me - 1, tag,
-             comm.handle(), MPI_STATUS_IGNORE);
-  for (std::size_t p = 0; p < pieces.size(); ++p) {
-    pieces[p].mass = running[4 * p];
-    pieces[p].centroid0 = Vec3(running[4 * p + 1], running[4 * p + 2], running[4 * p + 3]);
-  }
-  const TetArrays& tets = model.tets;
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
-    Vec3 X[4];
-    for (int c = 0; c < 4; ++c) X[c] = vec3_at(model.nodes.x0.data(), tets.nodes[4 * t + c]);
-    add_to_piece(pieces[static_cast<std::size_t>(tets.piece[t])],
-                 model.materials[tets.material[t]].density * tets.volume0[t], X);
-  }
-  for (std::size_t p = 0; p < pieces.size(); ++p) {
-    running[4 * p] = pieces[p].mass;
-    for (int k = 0; k < 3; ++k) running[4 * p + 1 + k] = pieces[p].centroid0[k];
-  }
-  if (me + 1 < ranks)
-    MPI_Send(running.data(), detail::checked_count(running.size(), 1), MPI_DOUBLE, me + 1, tag,
-             comm.handle());
-  MPI_Bcast(running.data(), detail::checked_count(running.size(), 1), MPI_DOUBLE, ranks - 1,
-            comm.handle());
-  for (std::size_t p = 0; p < pieces.size(); ++p) {
-    pieces[p].mass = running[4 * p];
-    pieces[p].centroid0 = Vec3(running[4 * p + 1], running[4 * p + 2], running[4 * p + 3]);
-    finish_piece(pieces[p]);
-  }
-}
-
 }  // namespace
 
 DistributedModel build_distributed_model(const Scene& scene, const std::vector<BodyChunks>& chunks,
@@ -386,8 +351,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   for (std::size_t b = 0; b < chunks.size(); ++b) {
     node_base[b + 1] = node_base[b] + chunks[b].n_nodes;
     piece_base[b + 1] = piece_base[b] + chunks[b].n_pieces;
-    for (std::int32_t p = 0; p < chunks[b].n_pieces; ++p)
-      model.pieces.push_back({static_cast<std::int32_t>(b), p});
+    model.pieces.add_body(chunks[b].n_pieces);
     for (std::int64_t n : chunks[b].chunk_tets) body_tets[b] += n;
     out.n_tets += body_tets[b];
   }
@@ -602,9 +566,10 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
       reach = std::max(reach, node_extent[static_cast<std::size_t>(tets.nodes[4 * t + c])]);
   }
 
-  // Pieces, velocities, constraints, force order.
-  sum_pieces(model.pieces, model, comm);
+  // Pieces (kept at their directory ranks), velocities, constraints, force order.
+  sum_pieces_by_directory(model, comm);
   set_initial_velocities(scene, model);
+  keep_directory_block(model.pieces, comm);
   build_tet_force_order(tets, model.tet_force_order);
   apply_constraints(scene, model);
   return out;

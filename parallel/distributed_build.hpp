@@ -5,8 +5,9 @@
 // The result is the model build_model (core/model_builder) makes, cut into blocks, bit for bit:
 // the same tet gids (Morton order of the centroids in the box of all nodes, ties by body and mesh
 // tet), the same node gids (order of first use by the ordered tets), the same lumped masses
-// (each node's tets summed in gid order), the same piece masses and centroids (summed along the
-// ranks in gid order), velocities, constraints, reference shapes and viscosities.
+// (each node's tets summed in gid order), the same piece masses and centroids (summed in gid
+// order along the ranks holding each piece's tets), velocities, constraints, reference shapes and
+// viscosities.
 //
 // The steps, each a bounded all-to-all (data per rank ∝ its part, plus O(P) tables):
 //   1 chunks are dealt to ranks by tet count; each rank generates its chunks and checks shapes;
@@ -15,7 +16,9 @@
 //   4 nodes meet at a directory rank (by mesh node number) that learns each node's first use,
 //     hands it to the rank of that tet, which numbers the nodes it owns; the numbers go back to
 //     every rank that uses the node;
-//   5 lumped masses are summed at the node's owner in tet-gid order; pieces in a chain of ranks.
+//   5 lumped masses are summed at the node's owner in tet-gid order; each piece's mass and centroid
+//     along the chain of ranks holding its tets, kept at its directory rank
+//     (parallel/piece_directory).
 #pragma once
 
 #include <cstdint>
@@ -44,7 +47,8 @@ struct DistributedModel {
   // Owned tets (tets.owned and tets.active all 1) and every node they use: the nodes this rank
   // owns (their first user is here) first, then the others, each range in ascending gid.  Every
   // node has its mass, velocity and constraints.  model.joint_laws is the whole model's; the
-  // joints are in `joints` (model.joints stays empty).
+  // joints are in `joints` (model.joints stays empty); model.pieces keeps the rank's directory
+  // block of pieces (parallel/piece_directory).
   Model model;
   std::vector<GlobalId> node_first_tet;  // per local node: gid of the first tet that uses it
   std::vector<std::int32_t> node_owner;  // per local node: the rank that owns it

@@ -16,6 +16,7 @@
 #include "core/state_hash.hpp"
 #include "parallel/distribution_rows.hpp"
 #include "parallel/partition.hpp"
+#include "parallel/piece_directory.hpp"
 #include "parallel/zoltan_partition.hpp"
 
 namespace fdem {
@@ -217,6 +218,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
       .pack(destinations(global, true)[me], rows);
   local.materials = global.materials;
   local.pieces = global.pieces;
+  keep_directory_block(local.pieces, comm_);  // each piece's data at its directory rank only
   local.body_names = global.body_names;
   local.body_fixed = global.body_fixed;
   local.gravity = global.gravity;

@@ -1,7 +1,8 @@
 # Runs the fdem command on a scene with each rank count of RANKS and passes when every run
-# completes and summary.json's state_hash is the same in all of them.  With RESTART_RANKS, also
-# continues the first run's earliest checkpoint on each of those rank counts and requires the
-# same hash again (checkpoint-and-restart vs. uninterrupted).  With START, every run on more than
+# completes, summary.json's state_hash is the same in all of them and bodies.csv is the same file,
+# byte for byte.  With RESTART_RANKS, also continues the first run's earliest checkpoint on each
+# of those rank counts and requires the same hash again (checkpoint-and-restart vs.
+# uninterrupted), and the uninterrupted run's bodies.csv rows at the times both runs wrote.  With START, every run on more than
 # one rank must report that start-up in summary.json (decomposition.start: "distributed" when no
 # rank held the whole model, "whole_model").
 # -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list), RESTART_RANKS (list, optional),
@@ -42,6 +43,39 @@ function(read_hash out variable ranks)
   set(${variable} ${hash} PARENT_SCOPE)
 endfunction()
 
+# bodies.csv of `out` must be the bytes of `reference_out`'s.
+function(compare_bodies out reference_out)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${out}/bodies.csv
+                          ${reference_out}/bodies.csv RESULT_VARIABLE different)
+  if(different)
+    message(FATAL_ERROR "${out}/bodies.csv differs from ${reference_out}/bodies.csv")
+  endif()
+endfunction()
+
+# Every row of a restarted run's bodies.csv at a time the uninterrupted run wrote must be that
+# run's row, byte for byte (the restart also writes a frame at the checkpoint's time).
+function(compare_restarted_bodies out reference_out)
+  file(READ ${reference_out}/bodies.csv reference_text)
+  file(STRINGS ${out}/bodies.csv rows)
+  list(REMOVE_AT rows 0)  # the header
+  set(compared 0)
+  foreach(row ${rows})
+    string(REGEX MATCH "^[^,]*," time "${row}")
+    string(FIND "${reference_text}" "\n${time}" at_time)
+    if(at_time EQUAL -1)
+      continue()
+    endif()
+    string(FIND "${reference_text}" "\n${row}\n" found)
+    if(found EQUAL -1)
+      message(FATAL_ERROR "${out}/bodies.csv: row '${row}' is not in ${reference_out}/bodies.csv")
+    endif()
+    math(EXPR compared "${compared} + 1")
+  endforeach()
+  if(compared EQUAL 0)
+    message(FATAL_ERROR "${out}/bodies.csv has no row at a time of ${reference_out}/bodies.csv")
+  endif()
+endfunction()
+
 set(reference "")
 foreach(ranks ${RANKS})
   run_fdem(${ranks} ${WORK}/ranks${ranks})
@@ -51,6 +85,8 @@ foreach(ranks ${RANKS})
     set(first_run ${WORK}/ranks${ranks})
   elseif(NOT hash STREQUAL reference)
     message(FATAL_ERROR "state_hash on ${ranks} ranks is ${hash}, expected ${reference}")
+  else()
+    compare_bodies(${WORK}/ranks${ranks} ${first_run})
   endif()
 endforeach()
 
@@ -69,6 +105,7 @@ if(RESTART_RANKS)
       message(FATAL_ERROR "restart from ${earliest} on ${ranks} ranks: state_hash ${hash}, "
                           "uninterrupted ${reference}")
     endif()
+    compare_restarted_bodies(${WORK}/restart${ranks} ${first_run})
   endforeach()
 endif()
-message("all runs: state_hash ${reference}")
+message("all runs: state_hash ${reference}, bodies.csv the same")

@@ -72,7 +72,7 @@ fdem::Model model_with_counts(int nodes, int tets, int pieces) {
   fdem::Model m;
   m.nodes.gid.resize(nodes);
   m.tets.gid.resize(tets);
-  m.pieces.resize(pieces);
+  m.pieces.add_body(pieces);
   return m;
 }
 

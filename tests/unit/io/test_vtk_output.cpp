@@ -140,11 +140,8 @@ Model two_block_model() {
     props.lame = fdem::LameParameters::from_young_poisson(props.young, props.poisson);
     m.materials.push_back(props);
   }
-  m.pieces.resize(2);
-  for (int h = 0; h < 2; ++h) {
-    m.pieces[h].body = h;
-    m.pieces[h].index_in_body = 0;
-  }
+  m.pieces.add_body(1);  // one piece in each of the two bodies
+  m.pieces.add_body(1);
   m.body_names = {"left", "right"};
   m.body_fixed = {false, false};
   return m;
