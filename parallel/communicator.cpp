@@ -154,7 +154,7 @@ int Communicator::ranks_on_this_node() const {
   return ranks;
 }
 
-std::int64_t Communicator::exclusive_sum(std::int64_t value) const {
+std::int64_t Communicator::sum_over_lower_ranks(std::int64_t value) const {
   std::int64_t below = 0;
   MPI_Exscan(&value, &below, 1, MPI_INT64_T, MPI_SUM, comm_);
   return rank_ == 0 ? 0 : below;  // MPI leaves rank 0's result undefined

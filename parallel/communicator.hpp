@@ -201,7 +201,7 @@ class Communicator {
 
   // The sum of `value` over the lower ranks (0 on rank 0): where a rank's part of something laid
   // out in rank order begins.
-  std::int64_t exclusive_sum(std::int64_t value) const;
+  std::int64_t sum_over_lower_ranks(std::int64_t value) const;
 
   // One value per rank, in rank order, on every rank.
   template <class T>

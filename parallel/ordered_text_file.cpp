@@ -36,7 +36,7 @@ OrderedTextFile::OrderedTextFile(std::string path, std::int64_t end, const Commu
 
 void OrderedTextFile::append(const std::string& text) {
   const std::int64_t bytes = static_cast<std::int64_t>(text.size());
-  const std::int64_t offset = end_ + comm_.exclusive_sum(bytes);
+  const std::int64_t offset = end_ + comm_.sum_over_lower_ranks(bytes);
   const std::int64_t total = comm_.sum(bytes);
   if (total == 0) return;
   // Every rank writes as many chunks as the rank with the longest text (collective calls).
