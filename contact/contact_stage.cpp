@@ -187,7 +187,7 @@ void ContactStage::run_detection(const Model& model, const double* x) {
   compute_boxes(model, x);
   const TetArrays& tets = model.tets;
   const bool all_active = tets.active.empty();
-  const auto keep = [&](LocalIndex a, LocalIndex b) {
+  const auto eligible = [&](LocalIndex a, LocalIndex b) {
     // A pair between two tets this rank does not compute is left to the ranks that do.
     if (!all_active && !tets.active[a] && !tets.active[b]) return false;
     if (tets.group_of(a) == tets.group_of(b) ||
@@ -203,15 +203,15 @@ void ContactStage::run_detection(const Model& model, const double* x) {
       return !share_reference_node(model, a, b);
     return true;
   };
+  // Narrowed as the boxes are tested, so that only kept pairs are ever stored (box overlaps of
+  // sliver tets across a joint between blocks outnumber the kept pairs several times): every
+  // point of a tet stays within buffer/2 of where it was at detection (a convex combination of
+  // node moves ≤ buffer/2), so a pair whose tets are now more than `buffer` apart cannot touch
+  // before the next detection.
+  const auto keep = [&](LocalIndex a, LocalIndex b) {
+    return eligible(a, b) && !tets_farther_than(model, x, a, b, buffer_);
+  };
   detector_.detect(lo_.data(), hi_.data(), tets.size(), buffer_, pairs_, keep);
-  // Narrow the list once per cycle: every point of a tet stays within buffer/2 of where it was at
-  // detection (a convex combination of node moves ≤ buffer/2), so a pair whose tets are now more
-  // than `buffer` apart cannot touch before the next detection.
-  pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
-                              [&](const CandidatePair& p) {
-                                return tets_farther_than(model, x, p.a, p.b, buffer_);
-                              }),
-               pairs_.end());
 }
 
 void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection,
@@ -245,6 +245,17 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
   detected_ = detected;
   pairs_.clear();
   if (detected_) run_detection(model, x_at_detection_.data());
+}
+
+void ContactStage::release_until_rebind() {
+  pairs_ = {};
+  overlapping_ = {};
+  records_ = {};
+  lo_ = {};
+  hi_ = {};
+  x_at_detection_ = {};
+  friction_ = {};
+  detector_.release_workspace();
 }
 
 std::vector<FrictionEntry> ContactStage::friction_entries() const {

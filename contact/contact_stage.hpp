@@ -74,6 +74,10 @@ class ContactStage {
               std::vector<std::uint8_t> tet_joint_state, const std::vector<FrictionEntry>& friction,
               bool detected);
   std::vector<FrictionEntry> friction_entries() const;
+  // Parallel runs, once the travelling state was taken: frees what rebind() rebuilds (candidate
+  // pairs, their records and friction map, the detector's grids) so that it does not add to
+  // the migration's buffers at the peak of the step loop.
+  void release_until_rebind();
   const std::vector<double>& x_at_detection() const { return x_at_detection_; }
   std::vector<std::uint8_t> tet_joint_states() const;
   bool detected() const { return detected_; }

@@ -60,6 +60,18 @@ std::size_t NbsDetector::workspace_bytes() const {
   return total;
 }
 
+void NbsDetector::release_workspace() {
+  levels_ = {};  // head arrays are built afresh (all −1) for new levels
+  boxes_ = {};
+  extent_ = {};
+  extent_scratch_ = {};
+  remaining_ = {};
+  large_ = {};
+  scratch_ = {};
+  counts_ = {};
+  heads_clean_ = true;
+}
+
 void NbsDetector::detect(const double* lo, const double* hi, LocalIndex n, double buffer,
                          std::vector<CandidatePair>& out, PairFilter keep) {
   inflate_boxes(lo, hi, n, buffer, boxes_);

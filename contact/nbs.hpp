@@ -72,6 +72,8 @@ class NbsDetector {
 
   const NbsStats& stats() const { return stats_; }
   std::size_t workspace_bytes() const;
+  // Gives the grids and scratch arrays back (the next detect() rebuilds them).
+  void release_workspace();
 
  private:
   struct Level {

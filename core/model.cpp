@@ -7,8 +7,6 @@
 
 #include "core/error.hpp"
 
-#include "core/error.hpp"
-
 namespace fdem {
 
 LocalIndex local_count(std::size_t n, const char* what) {
@@ -20,15 +18,15 @@ LocalIndex local_count(std::size_t n, const char* what) {
 }
 
 void NodeArrays::resize(LocalIndex n) {
-  gid.resize(n);
-  x.resize(3 * n);
-  x0.resize(3 * n);
-  v.resize(3 * n);
-  f.resize(3 * n);
-  mass.resize(n);
-  piece.resize(n);
-  constrained.resize(n);
-  prescribed_velocity.resize(3 * n);
+  resize_exact(gid, static_cast<std::size_t>(n));
+  resize_exact(x, static_cast<std::size_t>(3 * n));
+  resize_exact(x0, static_cast<std::size_t>(3 * n));
+  resize_exact(v, static_cast<std::size_t>(3 * n));
+  resize_exact(f, static_cast<std::size_t>(3 * n));
+  resize_exact(mass, static_cast<std::size_t>(n));
+  resize_exact(piece, static_cast<std::size_t>(n));
+  resize_exact(constrained, static_cast<std::size_t>(n));
+  resize_exact(prescribed_velocity, static_cast<std::size_t>(3 * n));
 }
 
 LocalIndex NodeArrays::find(GlobalId id) const {
@@ -44,25 +42,25 @@ LocalIndex TetArrays::find(GlobalId id) const {
 }
 
 void TetArrays::resize(LocalIndex n) {
-  gid.resize(n);
-  nodes.resize(4 * n);
-  dm_inv.resize(9 * n);
-  volume0.resize(n);
-  material.resize(n);
-  piece.resize(n);
-  viscosity.resize(n);
+  resize_exact(gid, static_cast<std::size_t>(n));
+  resize_exact(nodes, static_cast<std::size_t>(4 * n));
+  resize_exact(dm_inv, static_cast<std::size_t>(9 * n));
+  resize_exact(volume0, static_cast<std::size_t>(n));
+  resize_exact(material, static_cast<std::size_t>(n));
+  resize_exact(piece, static_cast<std::size_t>(n));
+  resize_exact(viscosity, static_cast<std::size_t>(n));
 }
 
 void JointArrays::resize(LocalIndex n) {
-  gid.resize(n);
-  nodes.resize(6 * n);
-  tets.resize(2 * n);
-  area0.resize(n);
-  law.resize(n);
-  broken.resize(n, 0);
-  mode.resize(n, 0);
-  failure_time.resize(n, -1.0);
-  damage.resize(n, 0.0);
+  resize_exact(gid, static_cast<std::size_t>(n));
+  resize_exact(nodes, static_cast<std::size_t>(6 * n));
+  resize_exact(tets, static_cast<std::size_t>(2 * n));
+  resize_exact(area0, static_cast<std::size_t>(n));
+  resize_exact(law, static_cast<std::size_t>(n));
+  resize_exact(broken, static_cast<std::size_t>(n), 0);
+  resize_exact(mode, static_cast<std::size_t>(n), 0);
+  resize_exact(failure_time, static_cast<std::size_t>(n), -1.0);
+  resize_exact(damage, static_cast<std::size_t>(n), 0.0);
 }
 
 void PieceTable::add_body(std::int32_t pieces) {

@@ -11,6 +11,15 @@
 
 namespace fdem {
 
+// Resizes to exactly n entries: growing a std::vector by resize() may double its capacity (the
+// model's arrays are the largest allocations of a rank; a halo appended to a block would keep
+// twice the block's memory reserved).
+template <class T, class... Fill>
+void resize_exact(std::vector<T>& values, std::size_t n, const Fill&... fill) {
+  if (n > values.capacity()) values.reserve(n);
+  values.resize(n, fill...);
+}
+
 // Nodes.  Vector quantities are stored xyz-interleaved (3 doubles per node) in separate arrays.
 struct NodeArrays {
   LocalIndex n_owned = 0;  // entries [0, n_owned) are integrated here; the rest are halo copies

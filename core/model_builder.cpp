@@ -73,12 +73,22 @@ std::vector<std::int32_t> connected_pieces(const std::vector<LocalIndex>& tets, 
 }
 
 std::uint64_t morton_key(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  // Each axis spans its own extent, but an axis m times (rounded in log2) shorter than the
+  // longest gets m bits fewer, so the curve first cuts the longest axis alone until the cells
+  // are about cubes. Equal stretches of the curve (the ranks' blocks at start-up) are then
+  // compact: a 0.4 m thick wall is cut across its length, not through its thickness, where every
+  // block would border the next over the whole wall.
+  const Vec3 extent = hi - lo;
+  const double longest = extent.maxCoeff();
   std::uint64_t key = 0;
   for (int k = 0; k < 3; ++k) {
-    const double extent = hi[k] - lo[k];
-    double s = extent > 0.0 ? (p[k] - lo[k]) / extent : 0.0;
+    int fewer_bits = 0;
+    if (extent[k] > 0.0)
+      fewer_bits = std::clamp(static_cast<int>(std::lround(std::log2(longest / extent[k]))), 0, 20);
+    const double cells = static_cast<double>((std::uint64_t{1} << (21 - fewer_bits)) - 1);
+    double s = extent[k] > 0.0 ? (p[k] - lo[k]) / extent[k] : 0.0;
     s = std::clamp(s, 0.0, 1.0);
-    key |= spread_bits(static_cast<std::uint64_t>(s * 2097151.0)) << k;
+    key |= spread_bits(static_cast<std::uint64_t>(s * cells)) << k;
   }
   return key;
 }

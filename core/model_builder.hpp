@@ -54,7 +54,8 @@ struct BodyChunks {
 std::vector<std::int32_t> connected_pieces(const std::vector<LocalIndex>& tets, LocalIndex n_nodes,
                                            std::int32_t* n_pieces);
 
-// 63-bit Morton key of a point inside the box [lo, hi] (21 bits per axis).
+// 63-bit Morton key of a point inside the box [lo, hi]: 21 bits on the longest axis, one bit fewer
+// on another axis per halving of its extent against the longest (cells about cubes).
 std::uint64_t morton_key(const Vec3& p, const Vec3& lo, const Vec3& hi);
 
 // Throws InputError naming the body, its source and the tet's number (`tag`) if the tet with

@@ -309,6 +309,7 @@ void Simulation::redistribute() {
     for (std::size_t i = 0; i < pairs.size(); ++i)
       contact_cost[pairs[i].a] +=
           candidate_cost + (i < overlapping.size() && overlapping[i] ? overlap_cost : 0.0);
+    contact_->release_until_rebind();  // `state` holds what rebind needs; pairs are re-detected
   }
   mark_phase(CommPhase::redistribution);
   distribution_->redistribute(model_, state, contact_cost);

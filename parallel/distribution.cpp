@@ -14,6 +14,7 @@
 #include "core/checked_cast.hpp"
 #include "core/error.hpp"
 #include "core/state_hash.hpp"
+#include "parallel/distributed_pieces.hpp"
 #include "parallel/distribution_rows.hpp"
 #include "parallel/partition.hpp"
 #include "parallel/piece_directory.hpp"
@@ -727,59 +728,33 @@ std::uint64_t global_reference_hash(const Model& model, const Communicator& comm
 }
 
 std::int64_t global_fragment_count(const Model& model, const Communicator& comm) {
-  // Links between node gids: the corners of each owned tet, and across each intact joint owned by
-  // its tet A (a node of A to a node of B).
-  struct Link {
-    GlobalId a, b;
-  };
-  std::vector<Link> links;
-  std::vector<GlobalId> tet_nodes;  // one node gid per owned tet, to count its component
   const TetArrays& tets = model.tets;
-  for (LocalIndex t = 0; t < tets.size(); ++t) {
-    if (!tets.is_owned(t)) continue;
-    const GlobalId first = model.nodes.gid[tets.nodes[4 * t]];
-    tet_nodes.push_back(first);
-    for (int c = 1; c < 4; ++c) links.push_back({first, model.nodes.gid[tets.nodes[4 * t + c]]});
-  }
   const JointArrays& joints = model.joints;
   std::int64_t joint_count = 0;
-  for (LocalIndex j = 0; j < joints.size(); ++j) {
-    if (!tets.is_owned(joints.tets[2 * j])) continue;
-    ++joint_count;
-    if (!joints.broken[j])
-      links.push_back(
-          {model.nodes.gid[joints.nodes[6 * j]], model.nodes.gid[joints.nodes[6 * j + 3]]});
-  }
+  for (LocalIndex j = 0; j < joints.size(); ++j) joint_count += tets.is_owned(joints.tets[2 * j]);
   // Without joints the pieces at t = 0 are the components, as on one rank.
   if (comm.sum(joint_count) == 0) return static_cast<std::int64_t>(model.pieces.size());
-  const std::vector<Link> all_links = comm.allgatherv(links);
-  const std::vector<GlobalId> all_tet_nodes = comm.allgatherv(tet_nodes);
-  // Union-find over the node gids that occur, numbered densely (gids may be sparse or large).
-  std::vector<GlobalId> ids(all_tet_nodes);
-  for (const Link& l : all_links) {
-    ids.push_back(l.a);
-    ids.push_back(l.b);
+  // Components of a distributed union-find (the one that finds the pieces of a model file) over
+  // node rows (gid − offset): each owned tet joins its corners, and each intact joint owned by its
+  // tet A joins a node of A to a node of B, given as the degenerate element (a, b, b, b).
+  std::vector<std::int64_t> elements;
+  elements.reserve(4 * static_cast<std::size_t>(tets.n_owned + joint_count));
+  const auto row = [&](LocalIndex node) { return model.nodes.gid[node] - model.gid_offset; };
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    if (!tets.is_owned(t)) continue;
+    for (int c = 0; c < 4; ++c) elements.push_back(row(tets.nodes[4 * t + c]));
   }
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  const auto dense = [&](GlobalId gid) {
-    return static_cast<std::size_t>(std::lower_bound(ids.begin(), ids.end(), gid) - ids.begin());
-  };
-  std::vector<std::size_t> parent(ids.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  for (const Link& l : all_links) {
-    const std::size_t a = find(dense(l.a)), b = find(dense(l.b));
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  for (LocalIndex j = 0; j < joints.size(); ++j) {
+    if (!tets.is_owned(joints.tets[2 * j]) || joints.broken[j]) continue;
+    const std::int64_t a = row(joints.nodes[6 * j]), b = row(joints.nodes[6 * j + 3]);
+    elements.insert(elements.end(), {a, b, b, b});
   }
-  std::vector<std::size_t> roots;
-  roots.reserve(all_tet_nodes.size());
-  for (GlobalId n : all_tet_nodes) roots.push_back(find(dense(n)));
-  std::sort(roots.begin(), roots.end());
-  return static_cast<std::int64_t>(std::unique(roots.begin(), roots.end()) - roots.begin());
+  const std::int64_t n_nodes = comm.sum(static_cast<std::int64_t>(model.nodes.n_owned));
+  const std::int64_t first =
+      comm.sum_over_lower_ranks(static_cast<std::int64_t>(elements.size() / 4));
+  std::int32_t fragments = 0;
+  distributed_pieces(elements, n_nodes, first, comm, &fragments);
+  return fragments;
 }
 
 }  // namespace fdem

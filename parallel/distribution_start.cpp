@@ -29,7 +29,7 @@ void permute_tail(std::vector<T>& values, std::size_t width, std::size_t first,
 template <class T>
 void open_rows(std::vector<T>& values, std::size_t width, std::size_t old_rows, std::size_t rows,
                std::size_t shift) {
-  values.resize(rows * width);
+  resize_exact(values, rows * width);
   std::move_backward(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(old_rows * width),
                      values.begin() + static_cast<std::ptrdiff_t>((old_rows + shift) * width));
 }
@@ -96,9 +96,9 @@ void Distribution::append_halo(Model& model, TravellingState& state,
   const std::size_t n_all = n_old + rows.nodes.size();
   const auto n_owned = static_cast<std::size_t>(nodes.n_owned);
   nodes.resize(local_count(n_all, "nodes"));
-  node_owner_.resize(n_all);
-  node_first_tet_.resize(n_all);
-  state.x_at_detection.resize(3 * n_all);
+  resize_exact(node_owner_, n_all);
+  resize_exact(node_first_tet_, n_all);
+  resize_exact(state.x_at_detection, 3 * n_all);
   for (std::size_t k = 0; k < rows.nodes.size(); ++k) {
     const NodeRow& r = rows.nodes[k];
     const std::size_t n = n_old + k;

@@ -2,7 +2,9 @@
 
 #include <zoltan.h>
 
+#include <algorithm>
 #include <cstring>
+#include <map>
 #include <string>
 
 #include "core/error.hpp"
@@ -50,6 +52,49 @@ void check(int status, const char* call) {
               std::string("Zoltan ") + call + " failed");
 }
 
+// Overlap of one rank's points with one new part (weight), gathered to every rank.
+struct PartOverlap {
+  std::int32_t rank;
+  std::int32_t part;
+  double weight;
+};
+
+// Renames the parts so that each stays, as far as a greedy matching finds, on the rank that
+// already holds most of its weight. Zoltan's bisections number parts by their recursion, not by
+// who holds what, so without this a cut that barely moved can swap two ranks' whole contents (and
+// the checkpoint's gid blocks, which follow the start-up order, with them). Each rank
+// contributes a few overlaps (the parts its points go to): O(P) numbers in all, never O(N).
+void keep_parts_on_their_ranks(std::vector<std::int32_t>& parts,
+                               const std::vector<PartitionPoint>& points,
+                               const Communicator& comm) {
+  std::map<std::int32_t, double> local;
+  for (std::size_t i = 0; i < parts.size(); ++i) local[parts[i]] += points[i].weight + 1e-30;
+  std::vector<PartOverlap> mine;
+  for (const auto& [part, weight] : local) mine.push_back({comm.rank(), part, weight});
+  std::vector<PartOverlap> all = comm.allgatherv(mine);
+  // Heaviest overlaps first; ties broken by (rank, part) so that every rank decides alike.
+  std::sort(all.begin(), all.end(), [](const PartOverlap& a, const PartOverlap& b) {
+    if (a.weight != b.weight) return a.weight > b.weight;
+    return a.rank != b.rank ? a.rank < b.rank : a.part < b.part;
+  });
+  const int ranks = comm.size();
+  std::vector<std::int32_t> rank_of_part(static_cast<std::size_t>(ranks), -1);
+  std::vector<char> rank_taken(static_cast<std::size_t>(ranks), 0);
+  for (const PartOverlap& o : all) {
+    if (rank_of_part[o.part] >= 0 || rank_taken[o.rank]) continue;
+    rank_of_part[o.part] = o.rank;
+    rank_taken[o.rank] = 1;
+  }
+  int next_free = 0;  // parts that no rank holds any of go to the ranks left, in order
+  for (std::int32_t& r : rank_of_part) {
+    if (r >= 0) continue;
+    while (rank_taken[next_free]) ++next_free;
+    r = next_free;
+    rank_taken[next_free] = 1;
+  }
+  for (std::int32_t& part : parts) part = rank_of_part[part];
+}
+
 }  // namespace
 
 std::vector<std::int32_t> partition_geometric(const std::vector<PartitionPoint>& points,
@@ -94,6 +139,7 @@ std::vector<std::int32_t> partition_geometric(const std::vector<PartitionPoint>&
   Zoltan_LB_Free_Part(&import_gids, &import_lids, &import_procs, &import_parts);
   Zoltan_LB_Free_Part(&export_gids, &export_lids, &export_procs, &export_parts);
   Zoltan_Destroy(&zz);
+  keep_parts_on_their_ranks(parts, points, comm);
   return parts;
 }
 

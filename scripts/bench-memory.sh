@@ -7,7 +7,8 @@
 #   block  elastic box, no contact: BLOCK_CELLS cells of 6 tets (default 80,80,40 = 1,536,000)
 #   wall   dry running-bond wall on a footing under gravity (contact): WALL_UNITS units per course,
 #          WALL_COURSES courses, WALL_UNIT_CELLS cells per unit (default 50, 62, 4,2,2 = 298,206)
-#   tiny   TINY_CELLS block (default 3,3,2 = 108 tets) on 1 rank: the fixed overhead per rank
+#   tiny   TINY_CELLS block (default 3,3,2 = 108 tets) on each rank count: the fixed overhead per
+#          rank F (MPI, VTK, HDF5, the binary), which grows a little with the rank count
 # Each run takes STEPS steps (default 5); frames: first and last only (output.every 0).
 # Writes OUT/memory-scaling.{csv,txt} (OUT default docs/data), the runs under RUNS (default
 # out/memory), prints the table and the issue's criterion at the largest rank count
@@ -81,7 +82,10 @@ for scene in tiny $scenes; do
   end="$(python3 -c "print(repr(($steps - 0.5) * $dt))")"
   # shellcheck disable=SC2046
   python3 "$here/make_scene.py" $(scene_args "$scene") --end "$end" -o "$runs/scenes/$scene.yaml" >/dev/null
-  if [[ "$scene" == tiny ]]; then run tiny 1 serial; continue; fi
+  if [[ "$scene" == tiny ]]; then  # the fixed overhead of a rank, at each rank count
+    for n in $ranks_list; do if ((n == 1)); then run tiny 1 serial; else run tiny "$n" distributed; fi; done
+    continue
+  fi
   for n in $ranks_list; do
     if ((n == 1)); then run "$scene" 1 serial; else run "$scene" "$n" distributed; run "$scene" "$n" whole; fi
   done

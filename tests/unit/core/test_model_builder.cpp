@@ -112,6 +112,24 @@ TEST_CASE("morton keys preserve locality along each axis", "[model]") {
   CHECK(morton_key(Vec3(1, 1, 1), lo, hi) == 0x7fffffffffffffffULL);
 }
 
+TEST_CASE("morton keys of a long thin wall cut its length before its thickness", "[model]") {
+  // A wall 8 m long (x), 0.5 m thick (y), 2 m high (z): y has 4 bits fewer, z 2 fewer.
+  const Vec3 lo(0, 0, 0), hi(8, 0.5, 2);
+  // The whole thickness at one end comes before the far half of the length...
+  CHECK(morton_key(Vec3(3.9, 0.5, 1.9), lo, hi) < morton_key(Vec3(4.1, 0, 0), lo, hi));
+  // ...and so does the whole height of the first quarter before the second quarter.
+  CHECK(morton_key(Vec3(1.9, 0.5, 2), lo, hi) < morton_key(Vec3(2.1, 0, 0), lo, hi));
+  // Cells about cubes below that: a step through the thickness is a low-order change.
+  CHECK(morton_key(Vec3(0, 0.5, 0), lo, hi) < morton_key(Vec3(0.6, 0, 0), lo, hi));
+  // The far corner has every kept bit set: 21 on x, 17 on y, 19 on z.
+  const std::uint64_t corner = morton_key(Vec3(8, 0.5, 2), lo, hi);
+  for (int level = 0; level < 21; ++level) {
+    CHECK(((corner >> (3 * level)) & 1u) == 1u);
+    CHECK(((corner >> (3 * level + 1)) & 1u) == (level < 17 ? 1u : 0u));
+    CHECK(((corner >> (3 * level + 2)) & 1u) == (level < 19 ? 1u : 0u));
+  }
+}
+
 TEST_CASE("nodal forces are bit-identical whatever the local order of the tets", "[model]") {
   // The same tets (same gids) stored in reversed local order give the same bits: forces are added
   // in ascending gid, not in storage order (the basis of rank-invariant results).
