@@ -9,6 +9,7 @@
 #include "contact/contact_stage.hpp"
 #include "core/error.hpp"
 #include "drivers/interrupt.hpp"
+#include "drivers/process_memory.hpp"
 #include "drivers/run_limits.hpp"
 #include "drivers/simulation.hpp"
 #include "fracture/joint_stage.hpp"
@@ -82,6 +83,7 @@ int run_command(int argc, char** argv, const fdem::Communicator& world);
 int prepare_command(const std::vector<std::string>& args, const fdem::Communicator& world);
 
 int main(int argc, char** argv) {
+  fdem::give_large_blocks_back_when_freed();
   // Under mpirun every rank runs the same command; one rank alone is a serial run.
   fdem::MpiEnvironment environment(&argc, &argv);
   const fdem::Communicator world = fdem::Communicator::world();

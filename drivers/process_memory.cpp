@@ -32,6 +32,17 @@ long current_rss_kib() {
   return status_field_kib("VmRSS:");
 }
 
+void give_large_blocks_back_when_freed() {
+#if defined(__GLIBC__)
+  // Fixed thresholds turn off glibc's sliding ones, which after the first large free keep
+  // blocks of up to 32 MiB on the heap and up to 64 MiB of freed heap top untrimmed: start-up
+  // frees arrays of tens of MiB while others are made, and every such hole would count in the
+  // peak RSS. Blocks of 1 MiB or more are mapped on their own and returned on free.
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  mallopt(M_TRIM_THRESHOLD, 8 << 20);
+#endif
+}
+
 void release_free_memory() {
 #if defined(__GLIBC__)
   malloc_trim(0);

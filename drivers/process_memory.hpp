@@ -9,6 +9,9 @@ namespace fdem {
 long peak_rss_kib();
 // Current resident set size (VmRSS, KiB); 0 where unknown.
 long current_rss_kib();
+// Call first in main: blocks of 1 MiB or more go back to the kernel as soon as they are freed
+// (glibc mallopt; nothing elsewhere).
+void give_large_blocks_back_when_freed();
 // Returns freed heap pages to the kernel (glibc malloc_trim): start-up buffers that were freed
 // stop counting against the node's memory.
 void release_free_memory();

@@ -226,6 +226,13 @@ class Communicator {
   std::vector<T> exchange_grouped(const std::vector<T>& grouped,
                                   const std::vector<std::size_t>& counts,
                                   std::vector<int>* sources = nullptr) const;
+  // exchange_grouped without a second copy of the data: this rank's own group never leaves
+  // `grouped`, only the others travel, and the result (what every rank sent here, in rank order,
+  // the own group in its place) is built in grouped's storage when its capacity allows.  For the
+  // start-up's sorts, where most rows stay where they are.
+  template <class T>
+  void exchange_grouped_in_place(std::vector<T>& grouped,
+                                 const std::vector<std::size_t>& counts) const;
   // The all-to-all underneath, for rows of a width known at run time: counts first (one
   // MPI_Alltoall of 64-bit counts: what rank r sends here), then the rows.  `send` holds
   // send_rows[r] rows for each rank r in rank order; `receive` gets receive_rows[r] rows from
@@ -334,6 +341,57 @@ std::vector<T> Communicator::exchange_grouped(const std::vector<T>& grouped,
       sources->insert(sources->end(), static_cast<std::size_t>(receive_rows[r]), r);
   }
   return received;
+}
+
+template <class T>
+void Communicator::exchange_grouped_in_place(std::vector<T>& grouped,
+                                             const std::vector<std::size_t>& counts) const {
+  static_assert(std::is_trivially_copyable_v<T>, "exchange moves plain values only");
+  FDEM_VERIFY(static_cast<int>(counts.size()) == size_, "one count per rank");
+  std::size_t own_begin = 0, total = 0;
+  for (int r = 0; r < size_; ++r) {
+    if (r < rank_) own_begin += counts[r];
+    total += counts[r];
+  }
+  FDEM_VERIFY(total == grouped.size(), "the counts cover the grouped array");
+  const std::size_t own = counts[rank_], own_end = own_begin + own;
+  std::vector<std::int64_t> send_rows(counts.begin(), counts.end());
+  send_rows[rank_] = 0;
+  std::vector<T> moving;
+  moving.reserve(grouped.size() - own);
+  moving.insert(moving.end(), grouped.begin(), grouped.begin() + own_begin);
+  moving.insert(moving.end(), grouped.begin() + own_end, grouped.end());
+  std::vector<std::size_t> moving_counts(counts);
+  moving_counts[rank_] = 0;
+  const std::vector<std::int64_t> receive_rows = exchange_counts(moving_counts);
+  std::size_t lower = 0, received_total = 0;
+  for (int r = 0; r < size_; ++r) {
+    if (r < rank_) lower += static_cast<std::size_t>(receive_rows[r]);
+    received_total += static_cast<std::size_t>(receive_rows[r]);
+  }
+  std::vector<T> received(received_total);
+  exchange_rows(moving.data(), send_rows, received.data(), receive_rows, sizeof(T));
+  moving = std::vector<T>{};
+  const std::size_t size = received_total + own;
+  if (size > grouped.capacity()) {  // no room: one new array after all
+    std::vector<T> out;
+    out.reserve(size);
+    out.insert(out.end(), received.begin(), received.begin() + lower);
+    out.insert(out.end(), grouped.begin() + own_begin, grouped.begin() + own_end);
+    out.insert(out.end(), received.begin() + lower, received.end());
+    grouped.swap(out);
+    return;
+  }
+  if (lower > own_begin) {  // the own group moves up
+    if (size > grouped.size()) grouped.resize(size);
+    std::move_backward(grouped.begin() + own_begin, grouped.begin() + own_end,
+                       grouped.begin() + lower + own);
+  } else {
+    std::move(grouped.begin() + own_begin, grouped.begin() + own_end, grouped.begin() + lower);
+  }
+  grouped.resize(size);
+  std::copy(received.begin(), received.begin() + lower, grouped.begin());
+  std::copy(received.begin() + lower, received.end(), grouped.begin() + lower + own);
 }
 
 template <class T>

@@ -25,6 +25,13 @@ struct TetRecord {
   double x[12];  // m
 };
 
+// A record without its positions (48 of 152 bytes), once the nodes hold them.
+struct TetLinks {
+  std::int32_t body, piece;
+  std::int64_t mesh_tet;
+  std::int64_t node[4];
+};
+
 // build_model's order: Morton key, ties by input order (body, then mesh tet).
 struct SortKey {
   std::uint64_t key;
@@ -46,11 +53,15 @@ SortKey sort_key(const TetRecord& r) {
 struct NodeKeys {
   std::vector<std::int64_t> split_base;  // per body; −1: the body's nodes are not split
   std::int64_t split_start = 0;          // the first split key
-  std::int64_t key(const TetRecord& r, int c) const {
+  template <class Record>                // TetRecord or TetLinks
+  std::int64_t key(const Record& r, int c) const {
     const std::int64_t base = split_base[static_cast<std::size_t>(r.body)];
     return base < 0 ? r.node[c] : base + 4 * r.mesh_tet + c;
   }
-  bool split(const TetRecord& r) const { return split_base[static_cast<std::size_t>(r.body)] >= 0; }
+  template <class Record>
+  bool split(const Record& r) const {
+    return split_base[static_cast<std::size_t>(r.body)] >= 0;
+  }
 };
 
 // Rank holding global position g when [block[r], block[r+1]) is rank r's.
@@ -84,8 +95,8 @@ std::vector<TetRecord> sort_into_blocks(std::vector<TetRecord> local,
   for (const TetRecord& r : local)
     ++counts[static_cast<std::size_t>(
         std::upper_bound(splitters.begin(), splitters.end(), sort_key(r)) - splitters.begin())];
-  std::vector<TetRecord> bucket = comm.exchange_grouped(local, counts);
-  local = std::vector<TetRecord>{};
+  std::vector<TetRecord>& bucket = local;  // most records stay: sorted in place
+  comm.exchange_grouped_in_place(bucket, counts);
   std::sort(bucket.begin(), bucket.end(), less);
   // Buckets are in global order by rank: each record's position, and so its block, follows.
   const std::vector<std::int64_t> sizes = comm.allgather(static_cast<std::int64_t>(bucket.size()));
@@ -94,7 +105,8 @@ std::vector<TetRecord> sort_into_blocks(std::vector<TetRecord> local,
   counts.assign(static_cast<std::size_t>(ranks), 0);
   for (std::size_t i = 0; i < bucket.size(); ++i)
     ++counts[static_cast<std::size_t>(block_owner(block, first + static_cast<GlobalId>(i)))];
-  return comm.exchange_grouped(bucket, counts);  // from lower ranks first, each sorted: in order
+  comm.exchange_grouped_in_place(bucket, counts);  // from lower ranks first, each sorted: in order
+  return std::move(bucket);
 }
 
 // A use of a node (by its key, NodeKeys) by a tet corner: use = 4 × tet index + corner, the tet
@@ -152,7 +164,8 @@ class NodeDirectory {
 std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<BodyChunks>& chunks,
                                         const std::vector<std::int64_t>& node_base,
                                         const std::vector<std::int32_t>& piece_base,
-                                        const Communicator& comm, Vec3* node_lo, Vec3* node_hi) {
+                                        std::int64_t block_tets, const Communicator& comm,
+                                        Vec3* node_lo, Vec3* node_hi) {
   std::int64_t total = 0, dealt = 0;
   for (const BodyChunks& body : chunks)
     for (std::int64_t n : body.chunk_tets) {
@@ -214,17 +227,25 @@ std::vector<TetRecord> generate_records(const Scene& scene, const std::vector<Bo
       records.push_back(r);
     }
   };
+  const auto tets_of = [&](const ChunkRef& ref) {
+    return chunks[static_cast<std::size_t>(ref.body)]
+        .chunk_tets[static_cast<std::size_t>(ref.chunk)];
+  };
+  std::vector<ChunkRef> mine = placed;
+  std::int64_t before = 0;  // tets of the chunks dealt before this one
+  for (const ChunkRef& ref : deal) {
+    // Each chunk goes to the rank whose share of the tets it starts in.
+    if (static_cast<int>(mul_div(before, comm.size(), dealt)) == comm.rank()) mine.push_back(ref);
+    before += tets_of(ref);
+  }
+  // The records are the largest array of the start-up: reserved once (growing by push_back would
+  // hold up to twice their size, and both copies while it reallocates), with room for the
+  // rank's block and the sample sort's uneven buckets, so that they are sorted in place.
+  std::int64_t my_tets = 0;
+  for (const ChunkRef& ref : mine) my_tets += tets_of(ref);
+  records.reserve(static_cast<std::size_t>(std::max(my_tets, block_tets) + block_tets / 16));
   comm.run_collectively([&] {
-    for (const ChunkRef& ref : placed) add_chunk(ref);
-    std::int64_t before = 0;  // tets of the chunks dealt before this one
-    for (const ChunkRef& ref : deal) {
-      const std::int64_t tets = chunks[static_cast<std::size_t>(ref.body)]
-                                    .chunk_tets[static_cast<std::size_t>(ref.chunk)];
-      // Each chunk goes to the rank whose share of the tets it starts in.
-      const int rank = static_cast<int>(mul_div(before, comm.size(), dealt));
-      before += tets;
-      if (rank == comm.rank()) add_chunk(ref);
-    }
+    for (const ChunkRef& ref : mine) add_chunk(ref);
   });
   std::vector<double> low(lo.data(), lo.data() + 3), high(hi.data(), hi.data() + 3);
   comm.min_in_place(low);
@@ -366,8 +387,9 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
 
   // Steps 1–3: records generated here, sorted into equal blocks of gids.
   Vec3 lo, hi;  // box of all nodes (m)
-  std::vector<TetRecord> records =
-      generate_records(scene, chunks, node_base, piece_base, comm, &lo, &hi);
+  std::vector<TetRecord> records = generate_records(
+      scene, chunks, node_base, piece_base,
+      mul_div(out.n_tets, me + 1, ranks) - mul_div(out.n_tets, me, ranks), comm, &lo, &hi);
   out.tet_block.resize(static_cast<std::size_t>(ranks) + 1);
   for (int r = 0; r <= ranks; ++r)
     out.tet_block[r] = model.gid_offset + mul_div(out.n_tets, r, ranks);
@@ -436,10 +458,20 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     return n;
   };
 
+  // The nodes hold the positions now: the records shrink to their links before the tet arrays
+  // are made (the start-up's peak would otherwise hold both).
+  std::vector<TetLinks> links(records.size());
+  for (std::size_t t = 0; t < records.size(); ++t) {
+    const TetRecord& r = records[t];
+    links[t] = {r.body, r.piece, r.mesh_tet, {r.node[0], r.node[1], r.node[2], r.node[3]}};
+  }
+  records = std::vector<TetRecord>{};
+  local_nodes = std::vector<LocalNode>{};  // pointed into the records
+
   // Tets: reference shapes, viscosities; node masses summed at the owners in tet-gid order, with
   // the largest extent among each node's tets (the reach of the first halo).
   TetArrays& tets = model.tets;
-  const LocalIndex n_tets = local_count(records.size(), "tetrahedra");
+  const LocalIndex n_tets = local_count(links.size(), "tetrahedra");
   tets.resize(n_tets);
   tets.n_owned = n_tets;
   tets.contact_group.resize(n_tets);
@@ -456,7 +488,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   std::vector<double> node_extent(static_cast<std::size_t>(n_local), 0.0);
   std::vector<std::vector<MassPart>> parts(static_cast<std::size_t>(ranks));
   for (LocalIndex t = 0; t < n_tets; ++t) {
-    const TetRecord& r = records[t];
+    const TetLinks& r = links[t];
     const std::int32_t material = scene.bodies[r.body].material;
     tets.gid[t] = first_tet + t;
     tets.material[t] = material;
@@ -499,7 +531,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   // pieces in gid order (as build_model numbers them).
   {
     std::int64_t split = 0;
-    for (const TetRecord& r : records) split += keys.split(r);
+    for (const TetLinks& r : links) split += keys.split(r);
     const std::vector<std::int64_t> counts = comm.allgather(split);
     std::int64_t next = static_cast<std::int64_t>(model.pieces.size()) +
                         std::accumulate(counts.begin(), counts.begin() + me, std::int64_t{0});
@@ -508,10 +540,9 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
                     std::numeric_limits<std::int32_t>::max(),
                 "contact groups fit 32 bits");
     for (LocalIndex t = 0; t < n_tets; ++t)
-      if (keys.split(records[t])) tets.contact_group[t] = static_cast<std::int32_t>(next++);
+      if (keys.split(links[t])) tets.contact_group[t] = static_cast<std::int32_t>(next++);
   }
-  records.clear();
-  records.shrink_to_fit();
+  links = std::vector<TetLinks>{};
   std::vector<MassPart> arrived = comm.exchange(parts);
   parts.clear();
   std::sort(arrived.begin(), arrived.end(), [](const MassPart& a, const MassPart& b) {

@@ -334,3 +334,37 @@ TEST_CASE("64-bit counts: rows of any width, own rows included, exchanged in pie
   }
   CHECK(wrong == 0);
 }
+
+TEST_CASE("exchange_grouped_in_place gives what exchange_grouped gives, with or without room",
+          "[mpi]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const int n = comm.size(), me = comm.rank();
+  std::vector<Row> grouped;
+  std::vector<std::size_t> counts;
+  for (int to = 0; to < n; ++to) {
+    // Most rows to self (as in the start-up sorts), some pairs none: lengths from rows_for.
+    std::vector<Row> rows = rows_for(me, to);
+    if (to == me)
+      for (int k = 0; k < 20 + 3 * me; ++k) rows.push_back({me, me, 100 + k, 0.25 * k});
+    counts.push_back(rows.size());
+    grouped.insert(grouped.end(), rows.begin(), rows.end());
+  }
+  const std::vector<Row> expected = comm.exchange_grouped(grouped, counts);
+  const auto same = [&](const std::vector<Row>& got) {
+    bool ok = got.size() == expected.size();
+    for (std::size_t i = 0; ok && i < got.size(); ++i)
+      ok = got[i].from == expected[i].from && got[i].to == me && got[i].k == expected[i].k &&
+           got[i].x == expected[i].x;
+    return ok;
+  };
+  for (std::size_t room : {std::size_t{0}, std::size_t{64}}) {
+    INFO("spare capacity " << room);
+    std::vector<Row> data;
+    data.reserve(grouped.size() + room);  // 0: exactly full (a new array when more arrives)
+    data = grouped;
+    if (room) data.reserve(grouped.size() + room);
+    comm.exchange_grouped_in_place(data, counts);
+    CHECK(same(data));
+  }
+}
