@@ -23,6 +23,7 @@
 #include "drivers/mesh_files.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/process_memory.hpp"
+#include "drivers/progress.hpp"
 #include "drivers/restart_check.hpp"
 #include "drivers/run_files.hpp"
 #include "drivers/run_limits.hpp"
@@ -857,43 +858,33 @@ RunReport Simulation::run() {
   }
   const long total_steps = checked_step_count(0.0, scene_.time.end, dt_);
   RunReport result;
-  auto last_progress = wall_start_;
+  ProgressReport progress(options_.quiet || !is_root(), ProgressReport::stderr_is_terminal());
   try {
     write_outputs(true);
     while (steps_ < total_steps && interrupt_ == 0) {
       step();
       write_outputs(steps_ == total_steps);
-      const auto now = std::chrono::steady_clock::now();
-      if (!options_.quiet && is_root() &&
-          (std::chrono::duration<double>(now - last_progress).count() > 0.5 ||
-           steps_ == total_steps)) {
-        last_progress = now;
-        const double wall = std::chrono::duration<double>(now - wall_start_).count();
-        const double rate = steps_ / std::max(wall, 1e-9);
-        std::fprintf(
-            stderr,
-            "\rstep %ld/%ld  t = %.4g s  %5.1f %%  %.3g steps/s  ETA %.1f s  energy error %.2e   ",
-            steps_, total_steps, time_, 100.0 * steps_ / total_steps, rate,
-            (total_steps - steps_) / std::max(rate, 1e-9), ledger_.balance_error());
-        if (steps_ == total_steps) std::fprintf(stderr, "\n");
-      }
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+      progress.after_step({steps_, total_steps, time_, dt_, ledger_.balance_error(), wall},
+                          steps_ == total_steps);
     }
     mark_phase(CommPhase::finish);
     if (steps_ < total_steps) {
-      if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+      progress.end_line();
       finish_interrupted(result);
     } else {
       result = report();
       result.status = "completed";
     }
   } catch (const NumericalFailure& failure) {
-    if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+    progress.end_line();
     mark_phase(CommPhase::finish);
     result = report();
     result.status = "failed";
     result.reason = failure.what();
   } catch (const IoError& failure) {
-    if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+    progress.end_line();
     result = report();
     result.status = "failed";
     result.io_failure = true;
