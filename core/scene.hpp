@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,16 @@ struct ContactSpec {
   double damping = 0.0;   // normal viscous damping ratio of a contact pair (fraction of critical)
 };
 
+// Spread of joint strength: each joint's tensile strength and cohesion are the block's values
+// times a factor drawn from this distribution by a hash of (seed, joint gid), so the draw does
+// not depend on ranks or on the order joints are found in (core/joint_strength).
+struct StrengthDistributionSpec {
+  enum class Type { none, weibull, normal } type = Type::none;
+  double modulus = 0.0;    // Weibull modulus m (> 0): scatter falls as m grows
+  double cov = 0.0;        // normal: coefficient of variation (standard deviation / mean)
+  std::uint64_t seed = 0;  // any integer; another seed gives another realisation
+};
+
 struct FractureSpec {
   double tensile_strength = 0.0;    // Pa
   double cohesion = 0.0;            // Pa
@@ -39,6 +50,12 @@ struct FractureSpec {
   double energy_I = 0.0;            // J/m^2
   double energy_II = 0.0;           // J/m^2
   double softening_a = 0.63, softening_b = 1.8, softening_c = 6.0;
+  // Joint penalties p_n, p_t (Pa): the joint layer's stiffness is p/h.  0: auto (50 E).
+  double normal_penalty = 0.0, tangential_penalty = 0.0;
+  StrengthDistributionSpec strength_distribution;
+  // Where the block is, for messages raised after reading: its key path
+  // ("materials.rock.fracture") and "file:line" (or the file).
+  std::string key, location;
 };
 
 struct MaterialSpec {

@@ -39,6 +39,20 @@ void add_material(std::vector<std::pair<std::string, double>>& values, const Mat
     values.emplace_back(key + ".fracture.friction_angle", m.fracture->friction_angle_deg);
     values.emplace_back(key + ".fracture.energy_I", m.fracture->energy_I);
     values.emplace_back(key + ".fracture.energy_II", m.fracture->energy_II);
+    // Listed only when set, so that a checkpoint of a scene without them restarts without a
+    // warning about keys it never had.
+    if (m.fracture->normal_penalty > 0.0)
+      values.emplace_back(key + ".fracture.penalty.normal", m.fracture->normal_penalty);
+    if (m.fracture->tangential_penalty > 0.0)
+      values.emplace_back(key + ".fracture.penalty.tangential", m.fracture->tangential_penalty);
+    const StrengthDistributionSpec& d = m.fracture->strength_distribution;
+    if (d.type != StrengthDistributionSpec::Type::none) {
+      const std::string dk = key + ".fracture.strength_distribution";
+      values.emplace_back(dk + ".type", static_cast<double>(d.type));
+      values.emplace_back(dk + ".modulus", d.modulus);
+      values.emplace_back(dk + ".cov", d.cov);
+      values.emplace_back(dk + ".seed", static_cast<double>(d.seed));  // < 2^53: exact
+    }
   }
 }
 

@@ -234,6 +234,10 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
   j << "  \"broken_joints\": " << r.broken_joints << ",\n";
   j << "  \"broken_by_mode\": {\"tension\": " << r.broken_by_mode[0]
     << ", \"shear\": " << r.broken_by_mode[1] << ", \"mixed\": " << r.broken_by_mode[2] << "},\n";
+  if (r.joints > 0)
+    j << "  \"joint_strength\": {\"tensile_min\": " << JsonNumber{r.joint_tensile_min}
+      << ", \"tensile_max\": " << JsonNumber{r.joint_tensile_max} << ", \"hash\": \""
+      << r.joint_strength_hash << "\"},\n";
   if (r.fragments >= 0) j << "  \"fragments\": " << r.fragments << ",\n";
   j << "  \"gids\": {\"offset\": " << r.gid_offset << ", \"node_max\": " << r.node_gid_max
     << ", \"tet_max\": " << r.tet_gid_max << ", \"joint_max\": " << r.joint_gid_max << "},\n";

@@ -667,6 +667,10 @@ RunReport Simulation::report() const {
   for (LocalIndex i = 0; i < joint_rows.size(); ++i) {
     if (!model_.tets.is_owned(joint_rows.tets[2 * i])) continue;
     ++counts[2];
+    const double f_t =
+        model_.joint_laws[static_cast<std::size_t>(joint_rows.law[i])].fracture.tensile_strength;
+    r.joint_tensile_min = std::min(r.joint_tensile_min, f_t);
+    r.joint_tensile_max = std::max(r.joint_tensile_max, f_t);
     if (!joint_rows.broken[i]) continue;
     ++counts[3];
     const auto mode = static_cast<FailureMode>(joint_rows.mode[i]);
@@ -695,6 +699,9 @@ RunReport Simulation::report() const {
     comm_->sum_in_place(counts);
     r.ranks = comm_->size();
     r.state_hash = hash_to_hex(global_state_hash(model_, *comm_));
+    r.joint_strength_hash = hash_to_hex(comm_->sum(joint_strength_hash(model_)));
+    r.joint_tensile_min = comm_->min(r.joint_tensile_min);
+    r.joint_tensile_max = comm_->max(r.joint_tensile_max);
     r.fragments = global_fragment_count(model_, *comm_);
     const DistributionReport& d = distribution_->report();
     r.parallel = true;
@@ -713,6 +720,7 @@ RunReport Simulation::report() const {
         clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;
   } else {
     r.state_hash = hash_to_hex(state_hash(model_.nodes, model_.gid_offset));
+    r.joint_strength_hash = hash_to_hex(joint_strength_hash(model_));
     r.fragments = count_fragments(model_);
   }
   r.node_gid_max = gid_max[0];

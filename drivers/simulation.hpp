@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -59,6 +60,11 @@ struct RunReport {
   EnergyTerms energy;
   double balance_error = 0.0;
   std::string state_hash;
+  // The joints' strengths (core/state_hash: joint_strength_hash) and the range of their tensile
+  // strengths (Pa; +inf/−inf without joints): the same on any rank count.
+  std::string joint_strength_hash;
+  double joint_tensile_min = std::numeric_limits<double>::infinity();
+  double joint_tensile_max = -std::numeric_limits<double>::infinity();
   std::vector<StageClock> stages;
   // Counts over all ranks.
   int ranks = 1;

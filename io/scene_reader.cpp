@@ -204,6 +204,11 @@ class Reader {
   }
 
   const std::string& file() const { return file_; }
+  // "file:line" of a node, or the file when the node has no place in it (an override).
+  std::string location(const YAML::Node& node) const {
+    const YAML::Mark mark = node.IsDefined() ? node.Mark() : YAML::Mark::null_mark();
+    return mark.line >= 0 ? file_ + ":" + std::to_string(mark.line + 1) : file_;
+  }
 
  private:
   std::string file_;
@@ -271,11 +276,56 @@ void apply_override(YAML::Node& root, const std::string& assignment, const std::
   set(root, 0);
 }
 
+// {type: none} | {type: weibull, modulus: m, seed: s} | {type: normal, cov: v, seed: s}
+StrengthDistributionSpec read_strength_distribution(const Reader& r, const YAML::Node& node,
+                                                    const std::string& path) {
+  using Type = StrengthDistributionSpec::Type;
+  if (!node.IsMap())
+    r.fail(node, path,
+           "expected {type: weibull, modulus: m, seed: s}, {type: normal, cov: v, seed: s} or "
+           "{type: none}");
+  StrengthDistributionSpec d;
+  const std::string type = r.choice(node["type"], path + ".type", {"none", "weibull", "normal"});
+  if (type == "none") {
+    r.check_keys(node, path, {"type", "seed"}, {"type"});
+    return d;
+  }
+  if (type == "weibull") {
+    r.check_keys(node, path, {"type", "modulus", "seed"}, {"type", "modulus", "seed"});
+    d.type = Type::weibull;
+    d.modulus = r.number(node["modulus"], path + ".modulus");
+    if (d.modulus < 1.0)  // below 1 the spread exceeds an exponential distribution's (cov > 1)
+      r.fail(node["modulus"], path + ".modulus",
+             Reader::format(d.modulus) +
+                 " is impossible: the Weibull modulus must be >= 1 (1: cov 1; 2.1: cov 0.5; 5: "
+                 "cov 0.23; 10: cov 0.12)");
+  } else {
+    r.check_keys(node, path, {"type", "cov", "seed"}, {"type", "cov", "seed"});
+    d.type = Type::normal;
+    d.cov = r.positive(node["cov"], path + ".cov", "the coefficient of variation");
+    // Factors are drawn from the normal distribution cut at 0 (a strength is positive); up to
+    // cov = 0.3 the cut removes under 0.05 % of the draws (z < −3.33), moving the mean by
+    // < 0.1 % and the spread by < 0.5 %.
+    if (d.cov > 0.3)
+      r.fail(node["cov"], path + ".cov",
+             Reader::format(d.cov) +
+                 " is too large: cov must be in (0, 0.3] (a wider normal spread puts strengths "
+                 "below zero; use type: weibull for a wide, skewed spread — modulus 2.1 gives "
+                 "cov 0.5)");
+  }
+  const std::int64_t seed = r.integer64(node["seed"], path + ".seed");
+  if (seed < 0 || seed >= (std::int64_t{1} << 53))
+    r.fail(node["seed"], path + ".seed",
+           std::to_string(seed) + " is impossible: the seed is an integer >= 0 and < 2^53");
+  d.seed = static_cast<std::uint64_t>(seed);
+  return d;
+}
+
 FractureSpec read_fracture(const Reader& r, const YAML::Node& node, const std::string& path) {
-  r.check_keys(
-      node, path,
-      {"tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II", "softening"},
-      {"tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II"});
+  r.check_keys(node, path,
+               {"tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II",
+                "softening", "penalty", "strength_distribution"},
+               {"tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II"});
   FractureSpec f;
   f.tensile_strength =
       r.positive(node["tensile_strength"], path + ".tensile_strength", "tensile strength");
@@ -295,6 +345,23 @@ FractureSpec read_fracture(const Reader& r, const YAML::Node& node, const std::s
     if (s["b"]) f.softening_b = r.positive(s["b"], sp + ".b", "softening parameter b");
     if (s["c"]) f.softening_c = r.positive(s["c"], sp + ".c", "softening parameter c");
   }
+  if (const YAML::Node p = node["penalty"]) {  // auto | Pa | {normal: .., tangential: ..}
+    const std::string pp = path + ".penalty";
+    const auto value = [&](const YAML::Node& v, const std::string& vp) {
+      return r.is_auto(v) ? 0.0 : r.positive(v, vp, "the joint penalty (Pa, or 'auto' = 50 E)");
+    };
+    if (p.IsMap()) {
+      r.check_keys(p, pp, {"normal", "tangential"});
+      if (p["normal"]) f.normal_penalty = value(p["normal"], pp + ".normal");
+      if (p["tangential"]) f.tangential_penalty = value(p["tangential"], pp + ".tangential");
+    } else {
+      f.normal_penalty = f.tangential_penalty = value(p, pp);
+    }
+  }
+  if (const YAML::Node d = node["strength_distribution"])
+    f.strength_distribution = read_strength_distribution(r, d, path + ".strength_distribution");
+  f.key = path;
+  f.location = r.location(node);
   return f;
 }
 
