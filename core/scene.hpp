@@ -142,6 +142,24 @@ struct RegionSpec {
   Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // axis-aligned box (m), nodes inside at t = 0
 };
 
+// A viscous absorbing boundary (core/absorbing_boundary): the mesh's boundary faces whose three
+// nodes lie in `region` at t = 0, of the listed bodies (empty: any body).
+struct AbsorbingSpec {
+  RegionSpec region;
+  std::vector<int> bodies;
+};
+
+// Initial (in-situ) stress of the tets (core/initial_stress), Cauchy, tension positive (Pa).
+// uniform: `stress` everywhere; geostatic: σ_v = −ρ·|g|·depth along gravity below `surface` (the
+// height of the free surface along −g, m) and σ_h = K0·σ_v across it.
+struct InitialStressSpec {
+  enum class Kind { none, uniform, geostatic } kind = Kind::none;
+  double stress[6] = {0, 0, 0, 0, 0, 0};  // uniform: xx, yy, zz, yz, xz, xy (Pa)
+  double surface = 0.0;                   // geostatic: height of the free surface (m)
+  double k0 = 1.0;                        // geostatic: σ_h / σ_v
+  std::vector<int> bodies;                // empty: every body
+};
+
 // Ground acceleration record a(t) (m/s² after `scale`), linear between samples, zero outside.
 struct BaseMotionSpec {
   std::string file;                  // resolved CSV path ("" when given in code)
@@ -228,6 +246,8 @@ struct Scene {
   std::vector<BodySpec> bodies;
   std::vector<InterfaceSpec> interfaces;
   std::vector<LoadSpec> loads;
+  std::vector<AbsorbingSpec> absorbing;  // viscous absorbing boundaries
+  std::vector<InitialStressSpec> initial_stress;
   OutputSpec output;
   double contact_buffer = -1.0;  // m; < 0: automatic
   ParallelSpec parallel;

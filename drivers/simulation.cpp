@@ -103,7 +103,8 @@ std::vector<std::string> StagePlan::describe() const {
   s.push_back(contact ? "contact detection + contact forces"
                       : "contact: skipped (no contact partners)");
   s.push_back(std::string("external forces: ") + (gravity ? "gravity" : "none") +
-              (kinematic_loads ? " + prescribed velocities" : ""));
+              (kinematic_loads ? " + prescribed velocities" : "") +
+              (absorbing ? " + absorbing boundaries (dashpots)" : ""));
   s.push_back("integrate (central difference)");
   return s;
 }
@@ -166,6 +167,17 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
           bonds.emplace_back(model_.joints.tets[2 * j], model_.joints.tets[2 * j + 1]);
       contact_->set_bonds(model_.tets.size(), bonds);
     }
+  }
+  if (!scene_.absorbing.empty()) {
+    plan_.absorbing = true;
+    absorbing_ = std::make_unique<AbsorbingBoundary>(scene_.absorbing, model_);
+    check_absorbing_faces(distributed);
+    // Dashpots c at a node of mass m damp its highest mode by ξ = c/(2mω), ω = 2/Δt: the step
+    // shrinks by √(1+ξ²) − ξ as for viscous damping (explicit in v_{n−½}).
+    const double rate =
+        distributed ? comm_->max(absorbing_->max_rate(model_)) : absorbing_->max_rate(model_);
+    const double xi = 0.25 * rate * dt_critical_;
+    dt_critical_ *= std::sqrt(1.0 + xi * xi) - xi;
   }
   dt_ = scene_.time.auto_step ? scene_.time.safety * dt_critical_ : scene_.time.step;
   if (!std::isfinite(dt_) || dt_ <= 0.0)
@@ -246,6 +258,22 @@ void Simulation::check_run_limits() const {
   check_step_limit(scene_, time_, dt_, [this] { return step_origin(); });
 }
 
+void Simulation::check_absorbing_faces(bool distributed) const {
+  std::vector<std::int64_t> count = absorbing_->counted_faces(model_);
+  if (distributed) comm_->sum_in_place(count);
+  for (std::size_t i = 0; i < count.size(); ++i) {
+    if (count[i] > 0) continue;
+    const RegionSpec& r = scene_.absorbing[i].region;
+    std::ostringstream msg;
+    msg << scene_.source_path << ": absorbing[" << i << "].region: no boundary face of the mesh"
+        << (scene_.absorbing[i].bodies.empty() ? "" : " of the listed bodies")
+        << " has all three nodes in the box [" << r.min.transpose() << "] – [" << r.max.transpose()
+        << "] at t = 0 (faces shared by two tets or bonded by a joint are not boundary faces). "
+           "Make the box enclose the outer faces that should absorb, with a margin for round-off.";
+    throw InputError(msg.str());
+  }
+}
+
 // Where the time step comes from, for messages: the element that sets the elastic critical step
 // and the contact and joint stiffness bounds.
 std::string Simulation::step_origin() const {
@@ -279,6 +307,7 @@ void Simulation::rebind_stages(TravellingState& state, bool detected) {
                      state.friction, detected);
   if (joints_) joints_->rebind(model_, std::move(state.joint_history));
   loads_->rebind(model_);
+  if (absorbing_) absorbing_->rebind(model_);
   build_internal_force_split(model_, split_);
 }
 
@@ -444,6 +473,11 @@ void Simulation::step() {
     Timed timed(clocks_[external]);
     add_gravity(model_.gravity, nodes);
   }
+  double boundary_before = 0.0, boundary_after = 0.0;  // J, dashpot dissipation (owned nodes)
+  if (absorbing_) {
+    Timed timed(clocks_[external]);
+    boundary_before = absorbing_->add_forces(dt_, model_);
+  }
 
   // 7 integrate: central difference with prescribed velocities
   IntegrationSummary motion;
@@ -452,6 +486,7 @@ void Simulation::step() {
     // The stored velocity is v(t − dt/2): at the start turn the initial v(0) into it (half kick).
     if (steps_ == 0) start_half_step(nodes);
     motion = integrate_central_difference(dt_, nodes);
+    if (absorbing_) boundary_after = absorbing_->dissipation_after(dt_, model_);
   }
 
   // 8 halo update: post the ghost exchange now, complete it at the start of the next step
@@ -499,7 +534,9 @@ void Simulation::step() {
                   motion.finite ? 0.0 : 1.0,
                   forces.min_jacobian > 0.0 ? 0.0 : 1.0,
                   interrupt_signal() != 0 ? 1.0 : 0.0,
-                  crushed_ranks});
+                  crushed_ranks,
+                  boundary_before,
+                  boundary_after});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
@@ -516,6 +553,8 @@ void Simulation::step() {
     // A signal on any rank ends the run after this step on every rank (no extra collective).
     if (terms[22] > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
     crushed_ranks = terms[23];
+    boundary_before = terms[24];
+    boundary_after = terms[25];
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -544,6 +583,8 @@ void Simulation::step() {
   energy.dissipated_damping = ledger_.damping.add(0.5 * damping_step, 0.5 * damping_step);
   energy.external_work =
       ledger_.external.add(motion.constraint_work_before, motion.constraint_work_after);
+  if (absorbing_)
+    energy.dissipated_boundary = ledger_.boundary.add(boundary_before, boundary_after);
   ledger_.record(energy);
   // Work through t_n+½ counts too: the plain kinetic energy already holds the half step after t_n.
   energy_input_ =

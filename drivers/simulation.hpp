@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/absorbing_boundary.hpp"
 #include "core/dynamics.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
@@ -39,6 +40,7 @@ struct StagePlan {
   bool contact = false;
   bool gravity = false;
   bool kinematic_loads = false;
+  bool absorbing = false;  // viscous absorbing boundaries (core/absorbing_boundary)
   std::vector<std::string> describe() const;
 };
 
@@ -140,6 +142,8 @@ class Simulation {
   };
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
   void check_run_limits() const;
+  // Every `absorbing:` entry must select a boundary face somewhere in the model (InputError).
+  void check_absorbing_faces(bool distributed) const;
   std::string step_advice() const;
   void check_stable_step(const struct CriticalStep& deformed) const;
   std::string step_origin() const;
@@ -173,8 +177,9 @@ class Simulation {
   std::unique_ptr<RunFiles> files_;
   std::unique_ptr<ContactStage> contact_;
   std::unique_ptr<JointStage> joints_;
-  std::unique_ptr<LoadSchedule> loads_;  // time-dependent loads (drivers/loads)
-  WorkAccumulator joint_friction_;       // Coulomb slip inside joints (part of dissipated_friction)
+  std::unique_ptr<LoadSchedule> loads_;           // time-dependent loads (drivers/loads)
+  std::unique_ptr<AbsorbingBoundary> absorbing_;  // scene `absorbing:` only
+  WorkAccumulator joint_friction_;  // Coulomb slip inside joints (part of dissipated_friction)
   const Communicator* comm_ = nullptr;
   std::unique_ptr<Distribution> distribution_;  // N ranks only
   bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step
