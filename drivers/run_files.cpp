@@ -238,6 +238,9 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
     j << "  \"joint_strength\": {\"tensile_min\": " << JsonNumber{r.joint_tensile_min}
       << ", \"tensile_max\": " << JsonNumber{r.joint_tensile_max} << ", \"hash\": \""
       << r.joint_strength_hash << "\"},\n";
+  if (r.initial_equilibrium_residual >= 0.0)
+    j << "  \"initial_stress\": {\"equilibrium_residual\": "
+      << JsonNumber{r.initial_equilibrium_residual} << "},\n";
   if (r.fragments >= 0) j << "  \"fragments\": " << r.fragments << ",\n";
   j << "  \"gids\": {\"offset\": " << r.gid_offset << ", \"node_max\": " << r.node_gid_max
     << ", \"tet_max\": " << r.tet_gid_max << ", \"joint_max\": " << r.joint_gid_max << "},\n";

@@ -15,6 +15,7 @@
 #include "contact/contact_stage.hpp"
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
+#include "core/initial_stress.hpp"
 #include "core/model_builder.hpp"
 #include "core/state_hash.hpp"
 #include "core/time_step.hpp"
@@ -105,6 +106,7 @@ std::vector<std::string> StagePlan::describe() const {
   s.push_back(std::string("external forces: ") + (gravity ? "gravity" : "none") +
               (kinematic_loads ? " + prescribed velocities" : "") +
               (absorbing ? " + absorbing boundaries (dashpots)" : ""));
+  if (initial_stress) s.push_back("initial stress of the tets (added to the internal forces)");
   s.push_back("integrate (central difference)");
   return s;
 }
@@ -167,6 +169,11 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
           bonds.emplace_back(model_.joints.tets[2 * j], model_.joints.tets[2 * j + 1]);
       contact_->set_bonds(model_.tets.size(), bonds);
     }
+  }
+  if (!scene_.initial_stress.empty()) {
+    plan_.initial_stress = true;
+    initial_stress_ = initial_stresses(scene_.initial_stress, scene_.gravity, model_);
+    check_initial_equilibrium(distributed);
   }
   if (!scene_.absorbing.empty()) {
     plan_.absorbing = true;
@@ -258,6 +265,23 @@ void Simulation::check_run_limits() const {
   check_step_limit(scene_, time_, dt_, [this] { return step_origin(); });
 }
 
+// The forces at t = 0 with the initial stress (elastic, initial stress, gravity) over the free
+// components, against the initial stress's alone: the relative equilibrium residual.  The step
+// recomputes every force, so the model's forces may be overwritten here.
+void Simulation::check_initial_equilibrium(bool distributed) {
+  compute_internal_forces(model_);
+  std::fill(model_.nodes.f.begin(), model_.nodes.f.end(), 0.0);
+  add_initial_stress_forces(initial_stress_, model_);
+  const std::vector<double> stress_force = model_.nodes.f;
+  compute_internal_forces(model_);
+  add_initial_stress_forces(initial_stress_, model_);
+  add_gravity(model_.gravity, model_.nodes);
+  const EquilibriumSums e = equilibrium_sums(model_.nodes.f, stress_force, model_.nodes);
+  std::vector<double> sums = {e.residual, e.scale};
+  if (distributed) comm_->sum_in_place(sums);
+  initial_residual_ = sums[1] > 0.0 ? std::sqrt(sums[0] / sums[1]) : 0.0;
+}
+
 void Simulation::check_absorbing_faces(bool distributed) const {
   std::vector<std::int64_t> count = absorbing_->counted_faces(model_);
   if (distributed) comm_->sum_in_place(count);
@@ -308,6 +332,8 @@ void Simulation::rebind_stages(TravellingState& state, bool detected) {
   if (joints_) joints_->rebind(model_, std::move(state.joint_history));
   loads_->rebind(model_);
   if (absorbing_) absorbing_->rebind(model_);
+  if (plan_.initial_stress)
+    initial_stress_ = initial_stresses(scene_.initial_stress, scene_.gravity, model_);
   build_internal_force_split(model_, split_);
 }
 
@@ -427,6 +453,10 @@ void Simulation::step() {
   } else {
     Timed timed(clocks_[internal]);
     forces = compute_internal_forces(model_);
+  }
+  if (plan_.initial_stress) {  // after every tet's own force: tets in gid order again
+    Timed timed(clocks_[internal]);
+    forces.strain_energy += add_initial_stress_forces(initial_stress_, model_).energy;
   }
 
   // 2 joint forces: cohesive joints in ascending joint gid
@@ -727,6 +757,7 @@ RunReport Simulation::report() const {
   std::vector<std::int64_t> gid_max = {last(model_.nodes.gid), last(model_.tets.gid),
                                        last(model_.joints.gid)};
   r.gid_offset = model_.gid_offset;
+  r.initial_equilibrium_residual = initial_residual_;
   if (distribution_) {
     std::vector<std::int64_t> largest = memory;
     largest.insert(largest.end(), gid_max.begin(), gid_max.end());

@@ -40,7 +40,8 @@ struct StagePlan {
   bool contact = false;
   bool gravity = false;
   bool kinematic_loads = false;
-  bool absorbing = false;  // viscous absorbing boundaries (core/absorbing_boundary)
+  bool absorbing = false;       // viscous absorbing boundaries (core/absorbing_boundary)
+  bool initial_stress = false;  // scene `initial_stress:` (core/initial_stress)
   std::vector<std::string> describe() const;
 };
 
@@ -65,6 +66,8 @@ struct RunReport {
   // The joints' strengths (core/state_hash: joint_strength_hash) and the range of their tensile
   // strengths (Pa; +inf/−inf without joints): the same on any rank count.
   std::string joint_strength_hash;
+  // Initial stress: the relative equilibrium residual at t = 0 (−1: none given).
+  double initial_equilibrium_residual = -1.0;
   double joint_tensile_min = std::numeric_limits<double>::infinity();
   double joint_tensile_max = -std::numeric_limits<double>::infinity();
   std::vector<StageClock> stages;
@@ -113,6 +116,7 @@ class Simulation {
   void step();
 
   const Model& model() const { return model_; }
+  double initial_equilibrium_residual() const { return initial_residual_; }
   Model& model() { return model_; }
   const Scene& scene() const { return scene_; }
   const StagePlan& plan() const { return plan_; }
@@ -144,6 +148,10 @@ class Simulation {
   void check_run_limits() const;
   // Every `absorbing:` entry must select a boundary face somewhere in the model (InputError).
   void check_absorbing_faces(bool distributed) const;
+  // Sets initial_residual_: |forces at t = 0| / |initial stress's forces| over free components.
+  void check_initial_equilibrium(bool distributed);
+  std::vector<double> initial_stress_;  // S0, 6 per local tet (Pa)
+  double initial_residual_ = -1.0;      // −1: no initial stress
   std::string step_advice() const;
   void check_stable_step(const struct CriticalStep& deformed) const;
   std::string step_origin() const;
