@@ -1,7 +1,7 @@
 // Energy bookkeeping: E_kin + U + E_grav + U_contact + U_joint + D_friction + D_fracture +
-// D_damping − W_ext = E_0.  Work and dissipation terms grow by increments that cover [t_n − dt/2,
-// t_n + dt/2]; the value reported at t_n takes half of the latest increment so every term refers to
-// t_n.
+// D_damping + D_boundary − W_ext = E_0 (D_boundary: absorbing boundaries' dashpots).  Work and
+// dissipation terms grow by increments that cover [t_n − dt/2, t_n + dt/2]; the value reported at
+// t_n takes half of the latest increment so every term refers to t_n.
 #pragma once
 
 #include <algorithm>
@@ -16,17 +16,18 @@ namespace fdem {
 struct EnergyTerms {
   double kinetic = 0.0, strain = 0.0, gravity = 0.0, contact = 0.0, joint = 0.0;
   double dissipated_fracture = 0.0, dissipated_friction = 0.0, dissipated_damping = 0.0;
+  double dissipated_boundary = 0.0;  // J: absorbing boundaries (core/absorbing_boundary)
   double external_work = 0.0;
 
   double total() const {
     return kinetic + strain + gravity + contact + joint + dissipated_fracture +
-           dissipated_friction + dissipated_damping - external_work;
+           dissipated_friction + dissipated_damping + dissipated_boundary - external_work;
   }
   // The largest magnitude among the terms: the scale that the balance error is measured against.
   double scale() const {
     return std::max({std::abs(kinetic), std::abs(strain), std::abs(gravity), std::abs(contact),
                      std::abs(joint), dissipated_fracture, dissipated_friction, dissipated_damping,
-                     std::abs(external_work)});
+                     dissipated_boundary, std::abs(external_work)});
   }
 };
 
@@ -68,7 +69,7 @@ class EnergyLedger {
     return peak_scale_ > 0.0 ? std::abs(current_.total() - initial_total_) / peak_scale_ : 0.0;
   }
 
-  WorkAccumulator damping, friction, fracture, external, gravity;
+  WorkAccumulator damping, friction, fracture, external, gravity, boundary;
 
   // Restart: every value as (name, number), and back (`value` returns the saved number of a name).
   std::vector<std::pair<std::string, double>> saved_state() const {
@@ -81,15 +82,14 @@ class EnergyLedger {
         {"dissipated_fracture", current_.dissipated_fracture},
         {"dissipated_friction", current_.dissipated_friction},
         {"dissipated_damping", current_.dissipated_damping},
+        {"dissipated_boundary", current_.dissipated_boundary},
         {"external_work", current_.external_work},
         {"initial_total", initial_total_},
         {"peak_scale", peak_scale_},
         {"has_initial", has_initial_ ? 1.0 : 0.0}};
-    const std::pair<const char*, const WorkAccumulator*> accumulators[] = {{"damping", &damping},
-                                                                           {"friction", &friction},
-                                                                           {"fracture", &fracture},
-                                                                           {"external", &external},
-                                                                           {"gravity", &gravity}};
+    const std::pair<const char*, const WorkAccumulator*> accumulators[] = {
+        {"damping", &damping},   {"friction", &friction}, {"fracture", &fracture},
+        {"external", &external}, {"gravity", &gravity},   {"boundary", &boundary}};
     for (const auto& [name, a] : accumulators) {
       out.emplace_back(std::string("work_") + name + "_through_previous", a->through_previous);
       out.emplace_back(std::string("work_") + name + "_first_before", a->first_before);
@@ -97,7 +97,10 @@ class EnergyLedger {
     }
     return out;
   }
-  void restore(const std::function<double(const std::string&)>& value) {
+  // `optional(name, fallback)`: a value that checkpoints from before it existed lack (the
+  // absorbing boundaries' terms: 0 then, as no such boundary existed).
+  void restore(const std::function<double(const std::string&)>& value,
+               const std::function<double(const std::string&, double)>& optional) {
     current_.kinetic = value("kinetic");
     current_.strain = value("strain");
     current_.gravity = value("gravity");
@@ -106,19 +109,21 @@ class EnergyLedger {
     current_.dissipated_fracture = value("dissipated_fracture");
     current_.dissipated_friction = value("dissipated_friction");
     current_.dissipated_damping = value("dissipated_damping");
+    current_.dissipated_boundary = optional("dissipated_boundary", 0.0);
     current_.external_work = value("external_work");
     initial_total_ = value("initial_total");
     peak_scale_ = value("peak_scale");
     has_initial_ = value("has_initial") != 0.0;
-    const std::pair<const char*, WorkAccumulator*> accumulators[] = {{"damping", &damping},
-                                                                     {"friction", &friction},
-                                                                     {"fracture", &fracture},
-                                                                     {"external", &external},
-                                                                     {"gravity", &gravity}};
+    const std::pair<const char*, WorkAccumulator*> accumulators[] = {
+        {"damping", &damping},   {"friction", &friction}, {"fracture", &fracture},
+        {"external", &external}, {"gravity", &gravity},   {"boundary", &boundary}};
     for (const auto& [name, a] : accumulators) {
-      a->through_previous = value(std::string("work_") + name + "_through_previous");
-      a->first_before = value(std::string("work_") + name + "_first_before");
-      a->started = value(std::string("work_") + name + "_started") != 0.0;
+      const std::string w = std::string("work_") + name;
+      const bool old = a == &boundary;  // absent from older checkpoints
+      a->through_previous =
+          old ? optional(w + "_through_previous", 0.0) : value(w + "_through_previous");
+      a->first_before = old ? optional(w + "_first_before", 0.0) : value(w + "_first_before");
+      a->started = (old ? optional(w + "_started", 0.0) : value(w + "_started")) != 0.0;
     }
   }
 

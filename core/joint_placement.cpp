@@ -9,6 +9,7 @@
 
 #include "core/checked_cast.hpp"
 #include "core/error.hpp"
+#include "core/joint_strength.hpp"
 
 namespace fdem {
 
@@ -291,32 +292,18 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     if (drafts.size() == before) throw InputError(no_interface_match_message(scene, k, tol));
   }
 
-  // Laws: one per (group, element-size bin), numbered in ascending (group, bin).
-  std::vector<std::pair<std::int32_t, long>> law_key(drafts.size());
-  std::vector<double> joint_area(drafts.size());
-  std::map<std::pair<std::int32_t, long>, std::int32_t> law_index;
-  for (std::size_t j = 0; j < drafts.size(); ++j) {
-    const JointDraft& d = drafts[j];
-    const double* x0 = nodes.x0.data();
-    joint_area[j] = joint_face_area(vec3_at(x0, d.a[0]), vec3_at(x0, d.a[1]), vec3_at(x0, d.a[2]));
-    law_key[j] = {d.group,
-                  joint_size_bin(tets.volume0[d.tet_a], tets.volume0[d.tet_b], joint_area[j])};
-    law_index.emplace(law_key[j], 0);
-  }
-  for (auto& [key, index] : law_index) {
-    index = static_cast<std::int32_t>(model.joint_laws.size());
-    model.joint_laws.push_back(joint_law(scene, key.first, key.second));
-  }
-
-  // Canonical order: ascending (gid A, gid B).
+  // Canonical order: ascending (gid A, gid B); a joint's gid is its rank in it.
   std::vector<std::size_t> order(drafts.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
     const GlobalId pa = tets.gid[drafts[p].tet_a], qa = tets.gid[drafts[q].tet_a];
     return pa != qa ? pa < qa : tets.gid[drafts[p].tet_b] < tets.gid[drafts[q].tet_b];
   });
+  // Laws: one per (group, element-size bin, strength bin) in use, numbered in ascending key.
   JointArrays& joints = model.joints;
   joints.resize(local_count(drafts.size(), "joints"));
+  std::vector<JointLawKey> law_key(drafts.size());
+  const double* x0 = nodes.x0.data();
   for (std::size_t j = 0; j < order.size(); ++j) {
     const JointDraft& d = drafts[order[j]];
     joints.gid[j] = model.gid_offset + static_cast<GlobalId>(j);
@@ -326,9 +313,19 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     }
     joints.tets[2 * j] = d.tet_a;
     joints.tets[2 * j + 1] = d.tet_b;
-    joints.area0[j] = joint_area[order[j]];
-    joints.law[j] = law_index.at(law_key[order[j]]);
+    joints.area0[j] =
+        joint_face_area(vec3_at(x0, d.a[0]), vec3_at(x0, d.a[1]), vec3_at(x0, d.a[2]));
+    law_key[j] = {d.group,
+                  joint_size_bin(tets.volume0[d.tet_a], tets.volume0[d.tet_b], joints.area0[j]),
+                  joint_strength_bin(scene, d.group, joints.gid[j], model.gid_offset)};
   }
+  std::vector<JointLawKey> keys = law_key;
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  for (const JointLawKey& key : keys) model.joint_laws.push_back(joint_law(scene, key));
+  for (std::size_t j = 0; j < order.size(); ++j)
+    joints.law[j] = static_cast<std::int32_t>(
+        std::lower_bound(keys.begin(), keys.end(), law_key[j]) - keys.begin());
 }
 
 double matching_tolerance(const Vec3& extent) {
@@ -362,26 +359,47 @@ long joint_size_bin(double volume_a, double volume_b, double area) {
   return std::lround(std::log(h) / std::log(element_size_bin_ratio));
 }
 
-JointLawSpec joint_law(const Scene& scene, std::int32_t group, long bin) {
-  const std::int32_t n_materials = static_cast<std::int32_t>(scene.materials.size());
-  JointLawSpec law;
-  double young;
+const FractureSpec& group_fracture(const Scene& scene, std::int64_t group) {
+  const auto n_materials = static_cast<std::int64_t>(scene.materials.size());
   if (group < n_materials) {
-    const MaterialSpec& m = scene.materials[group];
+    const MaterialSpec& m = scene.materials[static_cast<std::size_t>(group)];
     FDEM_VERIFY(m.fracture.has_value(), "joints: all needs a fracture block (reader checks)");
-    law.fracture = *m.fracture;
+    return *m.fracture;
+  }
+  return scene.interfaces[static_cast<std::size_t>(group - n_materials)].fracture;
+}
+
+long joint_strength_bin(const Scene& scene, std::int64_t group, GlobalId gid, GlobalId gid_offset) {
+  return strength_bin(group_fracture(scene, group).strength_distribution,
+                      static_cast<std::uint64_t>(gid - gid_offset));
+}
+
+JointLawSpec joint_law(const Scene& scene, const JointLawKey& key) {
+  const auto n_materials = static_cast<std::int64_t>(scene.materials.size());
+  JointLawSpec law;
+  law.fracture = group_fracture(scene, key.group);
+  double young;
+  if (key.group < n_materials) {
+    const MaterialSpec& m = scene.materials[static_cast<std::size_t>(key.group)];
     law.origin = "material '" + m.name + "'";
     young = m.elastic.young;
   } else {
-    const InterfaceSpec& spec = scene.interfaces[group - n_materials];
-    law.fracture = spec.fracture;
+    const InterfaceSpec& spec = scene.interfaces[static_cast<std::size_t>(key.group - n_materials)];
     law.origin = "interface '" + scene.bodies[spec.body_a].name + "'-'" +
                  scene.bodies[spec.body_b].name + "'";
     young = std::min(scene.materials[scene.bodies[spec.body_a].material].elastic.young,
                      scene.materials[scene.bodies[spec.body_b].material].elastic.young);
   }
-  law.normal_penalty = law.tangential_penalty = joint_penalty_factor * young;
-  law.element_size = std::pow(element_size_bin_ratio, static_cast<double>(bin));
+  law.auto_penalty = joint_penalty_factor * young;
+  const FractureSpec& f = law.fracture;
+  law.normal_penalty = f.normal_penalty > 0.0 ? f.normal_penalty : law.auto_penalty;
+  law.tangential_penalty = f.tangential_penalty > 0.0 ? f.tangential_penalty : law.auto_penalty;
+  law.element_size = std::pow(element_size_bin_ratio, static_cast<double>(key.size_bin));
+  if (key.strength_bin != 0) {  // bin 0 keeps the block's values bit for bit
+    law.strength_scale = strength_bin_factor(static_cast<long>(key.strength_bin));
+    law.fracture.tensile_strength *= law.strength_scale;
+    law.fracture.cohesion *= law.strength_scale;
+  }
   return law;
 }
 

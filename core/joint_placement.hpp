@@ -40,10 +40,28 @@ double joint_face_area(const Vec3& a0, const Vec3& a1, const Vec3& a2);
 // Element-size bin of a joint: h = mean of the two tets' altitudes onto the face (volumes m³,
 // area m²), binned by a ratio of 1.02.
 long joint_size_bin(double volume_a, double volume_b, double area);
-// The law of a joint group (material index, or materials + interface index) and size bin.  Laws
-// are numbered in ascending (group, bin) — not in order of appearance — so that any placement
-// order, and any rank count, numbers them alike.
-JointLawSpec joint_law(const Scene& scene, std::int32_t group, long bin);
+
+// What names a law: the joint group (material index, or materials + interface index), the
+// element-size bin and the strength bin (core/joint_strength; 0 without a strength
+// distribution).  Laws are numbered in ascending key over the keys the model's joints use — not
+// in order of appearance — so that any placement order, and any rank count, numbers them alike.
+struct JointLawKey {
+  std::int64_t group = 0, size_bin = 0, strength_bin = 0;
+  bool operator<(const JointLawKey& o) const {
+    if (group != o.group) return group < o.group;
+    return size_bin != o.size_bin ? size_bin < o.size_bin : strength_bin < o.strength_bin;
+  }
+  bool operator==(const JointLawKey& o) const {
+    return group == o.group && size_bin == o.size_bin && strength_bin == o.strength_bin;
+  }
+};
+// The fracture block of a joint group.
+const FractureSpec& group_fracture(const Scene& scene, std::int64_t group);
+// The strength bin of the joint with gid `gid` in `group` (keyed by gid − gid_offset).
+long joint_strength_bin(const Scene& scene, std::int64_t group, GlobalId gid, GlobalId gid_offset);
+// The law of a key: the block's values, its penalties (auto: 50 E; an interface: of the smaller
+// E), the bin's element size and strength factor.
+JointLawSpec joint_law(const Scene& scene, const JointLawKey& key);
 
 // The builders' messages for a mesh joints cannot be placed on (mesh nodes 0-based).
 std::string non_manifold_message(const std::string& body, const std::string& source,

@@ -79,6 +79,10 @@ struct JointLawSpec {
   double tangential_penalty = 0.0;  // p_t (Pa)
   double element_size = 0.0;        // h (m)
   std::string origin;               // "material 'rock'" or "interface 'a'-'b'", for messages
+  double auto_penalty = 0.0;        // Pa: what `penalty: auto` gives this group (50 E)
+  // Factor on the block's tensile strength and cohesion of the joints of this law (1: a
+  // homogeneous block; else the centre of a strength bin, core/joint_strength).
+  double strength_scale = 1.0;
 };
 
 // Cohesive joints (docs/fracture-model.md): 6-node elements bonding face (a0, a1, a2) of tet A to

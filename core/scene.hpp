@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,16 @@ struct ContactSpec {
   double damping = 0.0;   // normal viscous damping ratio of a contact pair (fraction of critical)
 };
 
+// Spread of joint strength: each joint's tensile strength and cohesion are the block's values
+// times a factor drawn from this distribution by a hash of (seed, joint gid), so the draw does
+// not depend on ranks or on the order joints are found in (core/joint_strength).
+struct StrengthDistributionSpec {
+  enum class Type { none, weibull, normal } type = Type::none;
+  double modulus = 0.0;    // Weibull modulus m (> 0): scatter falls as m grows
+  double cov = 0.0;        // normal: coefficient of variation (standard deviation / mean)
+  std::uint64_t seed = 0;  // any integer; another seed gives another realisation
+};
+
 struct FractureSpec {
   double tensile_strength = 0.0;    // Pa
   double cohesion = 0.0;            // Pa
@@ -39,6 +50,12 @@ struct FractureSpec {
   double energy_I = 0.0;            // J/m^2
   double energy_II = 0.0;           // J/m^2
   double softening_a = 0.63, softening_b = 1.8, softening_c = 6.0;
+  // Joint penalties p_n, p_t (Pa): the joint layer's stiffness is p/h.  0: auto (50 E).
+  double normal_penalty = 0.0, tangential_penalty = 0.0;
+  StrengthDistributionSpec strength_distribution;
+  // Where the block is, for messages raised after reading: its key path
+  // ("materials.rock.fracture") and "file:line" (or the file).
+  std::string key, location;
 };
 
 struct MaterialSpec {
@@ -123,6 +140,24 @@ struct InterfaceSpec {
 
 struct RegionSpec {
   Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // axis-aligned box (m), nodes inside at t = 0
+};
+
+// A viscous absorbing boundary (core/absorbing_boundary): the mesh's boundary faces whose three
+// nodes lie in `region` at t = 0, of the listed bodies (empty: any body).
+struct AbsorbingSpec {
+  RegionSpec region;
+  std::vector<int> bodies;
+};
+
+// Initial (in-situ) stress of the tets (core/initial_stress), Cauchy, tension positive (Pa).
+// uniform: `stress` everywhere; geostatic: σ_v = −ρ·|g|·depth along gravity below `surface` (the
+// height of the free surface along −g, m) and σ_h = K0·σ_v across it.
+struct InitialStressSpec {
+  enum class Kind { none, uniform, geostatic } kind = Kind::none;
+  double stress[6] = {0, 0, 0, 0, 0, 0};  // uniform: xx, yy, zz, yz, xz, xy (Pa)
+  double surface = 0.0;                   // geostatic: height of the free surface (m)
+  double k0 = 1.0;                        // geostatic: σ_h / σ_v
+  std::vector<int> bodies;                // empty: every body
 };
 
 // Ground acceleration record a(t) (m/s² after `scale`), linear between samples, zero outside.
@@ -211,6 +246,8 @@ struct Scene {
   std::vector<BodySpec> bodies;
   std::vector<InterfaceSpec> interfaces;
   std::vector<LoadSpec> loads;
+  std::vector<AbsorbingSpec> absorbing;  // viscous absorbing boundaries
+  std::vector<InitialStressSpec> initial_stress;
   OutputSpec output;
   double contact_buffer = -1.0;  // m; < 0: automatic
   ParallelSpec parallel;

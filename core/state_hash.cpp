@@ -14,6 +14,14 @@ inline void fnv_mix(std::uint64_t& h, const void* data, std::size_t bytes) {
     h *= 0x100000001b3ULL;
   }
 }
+// splitmix64 finaliser: every input bit reaches every output bit before the sum.
+inline std::uint64_t finish(std::uint64_t h) {
+  h ^= h >> 30;
+  h *= 0xbf58476d1ce4e5b9ULL;
+  h ^= h >> 27;
+  h *= 0x94d049bb133111ebULL;
+  return h ^ (h >> 31);
+}
 // Σ over nodes [0, count) of mix(FNV-1a of (gid − gid_offset, the given 3-vectors)), mod 2^64.  A
 // sum of per-node fingerprints does not depend on the order the nodes are visited in nor on how
 // they are split among ranks (partial sums add up exactly), so no rank ever needs the whole state.
@@ -26,13 +34,7 @@ std::uint64_t sum_of_node_hashes(const NodeArrays& nodes, LocalIndex count, Glob
     fnv_mix(h, &index, sizeof(GlobalId));
     for (const std::vector<double>* field : fields)
       fnv_mix(h, field->data() + 3 * static_cast<std::size_t>(n), 3 * sizeof(double));
-    // splitmix64 finaliser: every input bit reaches every output bit before the sum.
-    h ^= h >> 30;
-    h *= 0xbf58476d1ce4e5b9ULL;
-    h ^= h >> 27;
-    h *= 0x94d049bb133111ebULL;
-    h ^= h >> 31;
-    sum += h;
+    sum += finish(h);
   }
   return sum;
 }
@@ -44,6 +46,22 @@ std::uint64_t state_hash(const NodeArrays& nodes, GlobalId gid_offset) {
 
 std::uint64_t reference_hash(const NodeArrays& nodes, GlobalId gid_offset) {
   return sum_of_node_hashes(nodes, nodes.n_owned, gid_offset, {&nodes.x0});
+}
+
+std::uint64_t joint_strength_hash(const Model& model) {
+  const JointArrays& joints = model.joints;
+  std::uint64_t sum = 0;
+  for (LocalIndex j = 0; j < joints.size(); ++j) {
+    if (!model.tets.is_owned(joints.tets[2 * j])) continue;  // a joint lives with its tet A
+    const FractureSpec& f = model.joint_laws[static_cast<std::size_t>(joints.law[j])].fracture;
+    std::uint64_t h = 0xcbf29ce484222325ULL;
+    const GlobalId index = joints.gid[j] - model.gid_offset;
+    fnv_mix(h, &index, sizeof(GlobalId));
+    fnv_mix(h, &f.tensile_strength, sizeof(double));
+    fnv_mix(h, &f.cohesion, sizeof(double));
+    sum += finish(h);
+  }
+  return sum;
 }
 
 std::string hash_to_hex(std::uint64_t hash) {

@@ -20,4 +20,9 @@ std::string hash_to_hex(std::uint64_t hash);
 // the scene a checkpoint belongs to.
 std::uint64_t reference_hash(const NodeArrays& nodes, GlobalId gid_offset);
 
+// The joints' strengths as drawn (core/joint_strength): Σ mix(FNV-1a(gid − gid_offset, f_t, c))
+// over the joints whose tet A this rank owns, f_t and c (Pa) those of the joint's law.  Summed
+// over ranks it is the same on any rank count exactly when every joint got the same strengths.
+std::uint64_t joint_strength_hash(const Model& model);
+
 }  // namespace fdem

@@ -72,6 +72,11 @@ int check(const fdem::Scene& scene) {
   if (model.joints.size() > 0)
     std::printf("  joints: %d cohesive joints, %zu laws\n", model.joints.size(),
                 sim->joint_stage() ? sim->joint_stage()->laws().size() : std::size_t{0});
+  if (sim->initial_equilibrium_residual() >= 0.0)
+    std::printf(
+        "  initial stress: equilibrium residual at t = 0: %.3g (|net force| / |forces of "
+        "the initial stress| over the free components)\n",
+        sim->initial_equilibrium_residual());
   std::printf("  stages:\n");
   for (const auto& s : sim->plan().describe()) std::printf("    %s\n", s.c_str());
   return 0;

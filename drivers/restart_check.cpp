@@ -39,6 +39,20 @@ void add_material(std::vector<std::pair<std::string, double>>& values, const Mat
     values.emplace_back(key + ".fracture.friction_angle", m.fracture->friction_angle_deg);
     values.emplace_back(key + ".fracture.energy_I", m.fracture->energy_I);
     values.emplace_back(key + ".fracture.energy_II", m.fracture->energy_II);
+    // Listed only when set, so that a checkpoint of a scene without them restarts without a
+    // warning about keys it never had.
+    if (m.fracture->normal_penalty > 0.0)
+      values.emplace_back(key + ".fracture.penalty.normal", m.fracture->normal_penalty);
+    if (m.fracture->tangential_penalty > 0.0)
+      values.emplace_back(key + ".fracture.penalty.tangential", m.fracture->tangential_penalty);
+    const StrengthDistributionSpec& d = m.fracture->strength_distribution;
+    if (d.type != StrengthDistributionSpec::Type::none) {
+      const std::string dk = key + ".fracture.strength_distribution";
+      values.emplace_back(dk + ".type", static_cast<double>(d.type));
+      values.emplace_back(dk + ".modulus", d.modulus);
+      values.emplace_back(dk + ".cov", d.cov);
+      values.emplace_back(dk + ".seed", static_cast<double>(d.seed));  // < 2^53: exact
+    }
   }
 }
 
@@ -83,6 +97,8 @@ Effect effect_of(const std::string& key) {
        ends_with(".elastic.model")))
     return Effect::refused;
   if (key.rfind("bodies.", 0) == 0 && ends_with(".material")) return Effect::refused;
+  // The stored strain energy and the state's equilibrium include the initial stress.
+  if (key.rfind("initial_stress[", 0) == 0) return Effect::refused;
   // Initial conditions and the step: the checkpoint's velocities and step continue.
   if (key.find(".velocity.") != std::string::npos && key.rfind("bodies.", 0) == 0)
     return Effect::ignored;
@@ -114,6 +130,20 @@ std::vector<std::pair<std::string, double>> restart_scene_values(const Scene& sc
     add_vec3(values, key + ".angular_velocity", body.angular_velocity);
   }
   for (std::size_t i = 0; i < scene.loads.size(); ++i) add_load(values, scene.loads[i], i);
+  for (std::size_t i = 0; i < scene.absorbing.size(); ++i) {
+    const std::string key = "absorbing[" + std::to_string(i) + "].region.box";
+    add_vec3(values, key + ".min", scene.absorbing[i].region.min);
+    add_vec3(values, key + ".max", scene.absorbing[i].region.max);
+  }
+  for (std::size_t i = 0; i < scene.initial_stress.size(); ++i) {
+    const InitialStressSpec& s = scene.initial_stress[i];
+    const std::string key = "initial_stress[" + std::to_string(i) + "]";
+    values.emplace_back(key + ".kind", static_cast<double>(s.kind));
+    for (int k = 0; k < 6; ++k)
+      values.emplace_back(key + ".uniform." + std::to_string(k), s.stress[k]);
+    values.emplace_back(key + ".geostatic.surface", s.surface);
+    values.emplace_back(key + ".geostatic.k0", s.k0);
+  }
   return values;
 }
 

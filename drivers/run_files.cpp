@@ -62,7 +62,7 @@ RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>&
   if (rank_ != 0) return;
   energy_.open(std::filesystem::path(directory) / "energy.csv");
   energy_ << "time,kinetic,strain,gravity,contact,joint,dissipated_fracture,dissipated_friction,"
-             "dissipated_damping,external_work,total,balance_error\n";
+             "dissipated_damping,dissipated_boundary,external_work,total,balance_error\n";
   bodies_.open(std::filesystem::path(directory) / "bodies.csv");
   bodies_ << bodies_header;
   energy_ << std::setprecision(12);
@@ -75,8 +75,8 @@ void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balanc
   if (rank_ != 0) return;
   energy_ << time << ',' << e.kinetic << ',' << e.strain << ',' << e.gravity << ',' << e.contact
           << ',' << e.joint << ',' << e.dissipated_fracture << ',' << e.dissipated_friction << ','
-          << e.dissipated_damping << ',' << e.external_work << ',' << e.total() << ','
-          << balance_error << '\n';
+          << e.dissipated_damping << ',' << e.dissipated_boundary << ',' << e.external_work << ','
+          << e.total() << ',' << balance_error << '\n';
   energy_.flush();
   if (!energy_) throw IoError("cannot write " + directory_ + "/energy.csv (disk full?)");
 }
@@ -234,6 +234,13 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
   j << "  \"broken_joints\": " << r.broken_joints << ",\n";
   j << "  \"broken_by_mode\": {\"tension\": " << r.broken_by_mode[0]
     << ", \"shear\": " << r.broken_by_mode[1] << ", \"mixed\": " << r.broken_by_mode[2] << "},\n";
+  if (r.joints > 0)
+    j << "  \"joint_strength\": {\"tensile_min\": " << JsonNumber{r.joint_tensile_min}
+      << ", \"tensile_max\": " << JsonNumber{r.joint_tensile_max} << ", \"hash\": \""
+      << r.joint_strength_hash << "\"},\n";
+  if (r.initial_equilibrium_residual >= 0.0)
+    j << "  \"initial_stress\": {\"equilibrium_residual\": "
+      << JsonNumber{r.initial_equilibrium_residual} << "},\n";
   if (r.fragments >= 0) j << "  \"fragments\": " << r.fragments << ",\n";
   j << "  \"gids\": {\"offset\": " << r.gid_offset << ", \"node_max\": " << r.node_gid_max
     << ", \"tet_max\": " << r.tet_gid_max << ", \"joint_max\": " << r.joint_gid_max << "},\n";
@@ -272,6 +279,7 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
     << ", \"dissipated_fracture\": " << JsonNumber{e.dissipated_fracture}
     << ", \"dissipated_friction\": " << JsonNumber{e.dissipated_friction}
     << ", \"dissipated_damping\": " << JsonNumber{e.dissipated_damping}
+    << ", \"dissipated_boundary\": " << JsonNumber{e.dissipated_boundary}
     << ", \"external_work\": " << JsonNumber{e.external_work}
     << ", \"balance_error\": " << JsonNumber{r.balance_error} << "},\n";
   j << "  \"state_hash\": \"" << r.state_hash << "\"\n";

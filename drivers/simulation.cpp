@@ -15,6 +15,7 @@
 #include "contact/contact_stage.hpp"
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
+#include "core/initial_stress.hpp"
 #include "core/model_builder.hpp"
 #include "core/state_hash.hpp"
 #include "core/time_step.hpp"
@@ -23,6 +24,7 @@
 #include "drivers/mesh_files.hpp"
 #include "drivers/mesh_generators.hpp"
 #include "drivers/process_memory.hpp"
+#include "drivers/progress.hpp"
 #include "drivers/restart_check.hpp"
 #include "drivers/run_files.hpp"
 #include "drivers/run_limits.hpp"
@@ -102,7 +104,9 @@ std::vector<std::string> StagePlan::describe() const {
   s.push_back(contact ? "contact detection + contact forces"
                       : "contact: skipped (no contact partners)");
   s.push_back(std::string("external forces: ") + (gravity ? "gravity" : "none") +
-              (kinematic_loads ? " + prescribed velocities" : ""));
+              (kinematic_loads ? " + prescribed velocities" : "") +
+              (absorbing ? " + absorbing boundaries (dashpots)" : ""));
+  if (initial_stress) s.push_back("initial stress of the tets (added to the internal forces)");
   s.push_back("integrate (central difference)");
   return s;
 }
@@ -165,6 +169,22 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
           bonds.emplace_back(model_.joints.tets[2 * j], model_.joints.tets[2 * j + 1]);
       contact_->set_bonds(model_.tets.size(), bonds);
     }
+  }
+  if (!scene_.initial_stress.empty()) {
+    plan_.initial_stress = true;
+    initial_stress_ = initial_stresses(scene_.initial_stress, scene_.gravity, model_);
+    check_initial_equilibrium(distributed);
+  }
+  if (!scene_.absorbing.empty()) {
+    plan_.absorbing = true;
+    absorbing_ = std::make_unique<AbsorbingBoundary>(scene_.absorbing, model_);
+    check_absorbing_faces(distributed);
+    // Dashpots c at a node of mass m damp its highest mode by ξ = c/(2mω), ω = 2/Δt: the step
+    // shrinks by √(1+ξ²) − ξ as for viscous damping (explicit in v_{n−½}).
+    const double rate =
+        distributed ? comm_->max(absorbing_->max_rate(model_)) : absorbing_->max_rate(model_);
+    const double xi = 0.25 * rate * dt_critical_;
+    dt_critical_ *= std::sqrt(1.0 + xi * xi) - xi;
   }
   dt_ = scene_.time.auto_step ? scene_.time.safety * dt_critical_ : scene_.time.step;
   if (!std::isfinite(dt_) || dt_ <= 0.0)
@@ -278,6 +298,9 @@ void Simulation::rebind_stages(TravellingState& state, bool detected) {
                      state.friction, detected);
   if (joints_) joints_->rebind(model_, std::move(state.joint_history));
   loads_->rebind(model_);
+  if (absorbing_) absorbing_->rebind(model_);
+  if (plan_.initial_stress)
+    initial_stress_ = initial_stresses(scene_.initial_stress, scene_.gravity, model_);
   build_internal_force_split(model_, split_);
 }
 
@@ -399,6 +422,10 @@ void Simulation::step() {
     Timed timed(clocks_[internal]);
     forces = compute_internal_forces(model_);
   }
+  if (plan_.initial_stress) {  // after every tet's own force: tets in gid order again
+    Timed timed(clocks_[internal]);
+    forces.strain_energy += add_initial_stress_forces(initial_stress_, model_).energy;
+  }
 
   // 2 joint forces: cohesive joints in ascending joint gid
   JointStepSummary j;
@@ -444,6 +471,11 @@ void Simulation::step() {
     Timed timed(clocks_[external]);
     add_gravity(model_.gravity, nodes);
   }
+  double boundary_before = 0.0, boundary_after = 0.0;  // J, dashpot dissipation (owned nodes)
+  if (absorbing_) {
+    Timed timed(clocks_[external]);
+    boundary_before = absorbing_->add_forces(dt_, model_);
+  }
 
   // 7 integrate: central difference with prescribed velocities
   IntegrationSummary motion;
@@ -452,6 +484,7 @@ void Simulation::step() {
     // The stored velocity is v(t − dt/2): at the start turn the initial v(0) into it (half kick).
     if (steps_ == 0) start_half_step(nodes);
     motion = integrate_central_difference(dt_, nodes);
+    if (absorbing_) boundary_after = absorbing_->dissipation_after(dt_, model_);
   }
 
   // 8 halo update: post the ghost exchange now, complete it at the start of the next step
@@ -499,7 +532,9 @@ void Simulation::step() {
                   motion.finite ? 0.0 : 1.0,
                   forces.min_jacobian > 0.0 ? 0.0 : 1.0,
                   interrupt_signal() != 0 ? 1.0 : 0.0,
-                  crushed_ranks});
+                  crushed_ranks,
+                  boundary_before,
+                  boundary_after});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
@@ -516,6 +551,8 @@ void Simulation::step() {
     // A signal on any rank ends the run after this step on every rank (no extra collective).
     if (terms[22] > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
     crushed_ranks = terms[23];
+    boundary_before = terms[24];
+    boundary_after = terms[25];
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -544,6 +581,8 @@ void Simulation::step() {
   energy.dissipated_damping = ledger_.damping.add(0.5 * damping_step, 0.5 * damping_step);
   energy.external_work =
       ledger_.external.add(motion.constraint_work_before, motion.constraint_work_after);
+  if (absorbing_)
+    energy.dissipated_boundary = ledger_.boundary.add(boundary_before, boundary_after);
   ledger_.record(energy);
   // Work through t_n+½ counts too: the plain kinetic energy already holds the half step after t_n.
   energy_input_ =
@@ -667,6 +706,10 @@ RunReport Simulation::report() const {
   for (LocalIndex i = 0; i < joint_rows.size(); ++i) {
     if (!model_.tets.is_owned(joint_rows.tets[2 * i])) continue;
     ++counts[2];
+    const double f_t =
+        model_.joint_laws[static_cast<std::size_t>(joint_rows.law[i])].fracture.tensile_strength;
+    r.joint_tensile_min = std::min(r.joint_tensile_min, f_t);
+    r.joint_tensile_max = std::max(r.joint_tensile_max, f_t);
     if (!joint_rows.broken[i]) continue;
     ++counts[3];
     const auto mode = static_cast<FailureMode>(joint_rows.mode[i]);
@@ -682,6 +725,7 @@ RunReport Simulation::report() const {
   std::vector<std::int64_t> gid_max = {last(model_.nodes.gid), last(model_.tets.gid),
                                        last(model_.joints.gid)};
   r.gid_offset = model_.gid_offset;
+  r.initial_equilibrium_residual = initial_residual_;
   if (distribution_) {
     std::vector<std::int64_t> largest = memory;
     largest.insert(largest.end(), gid_max.begin(), gid_max.end());
@@ -695,6 +739,9 @@ RunReport Simulation::report() const {
     comm_->sum_in_place(counts);
     r.ranks = comm_->size();
     r.state_hash = hash_to_hex(global_state_hash(model_, *comm_));
+    r.joint_strength_hash = hash_to_hex(comm_->sum(joint_strength_hash(model_)));
+    r.joint_tensile_min = comm_->min(r.joint_tensile_min);
+    r.joint_tensile_max = comm_->max(r.joint_tensile_max);
     r.fragments = global_fragment_count(model_, *comm_);
     const DistributionReport& d = distribution_->report();
     r.parallel = true;
@@ -713,6 +760,7 @@ RunReport Simulation::report() const {
         clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;
   } else {
     r.state_hash = hash_to_hex(state_hash(model_.nodes, model_.gid_offset));
+    r.joint_strength_hash = hash_to_hex(joint_strength_hash(model_));
     r.fragments = count_fragments(model_);
   }
   r.node_gid_max = gid_max[0];
@@ -858,43 +906,33 @@ RunReport Simulation::run() {
   }
   const long total_steps = checked_step_count(0.0, scene_.time.end, dt_);
   RunReport result;
-  auto last_progress = wall_start_;
+  ProgressReport progress(options_.quiet || !is_root(), ProgressReport::stderr_is_terminal());
   try {
     write_outputs(true);
     while (steps_ < total_steps && interrupt_ == 0) {
       step();
       write_outputs(steps_ == total_steps);
-      const auto now = std::chrono::steady_clock::now();
-      if (!options_.quiet && is_root() &&
-          (std::chrono::duration<double>(now - last_progress).count() > 0.5 ||
-           steps_ == total_steps)) {
-        last_progress = now;
-        const double wall = std::chrono::duration<double>(now - wall_start_).count();
-        const double rate = steps_ / std::max(wall, 1e-9);
-        std::fprintf(
-            stderr,
-            "\rstep %ld/%ld  t = %.4g s  %5.1f %%  %.3g steps/s  ETA %.1f s  energy error %.2e   ",
-            steps_, total_steps, time_, 100.0 * steps_ / total_steps, rate,
-            (total_steps - steps_) / std::max(rate, 1e-9), ledger_.balance_error());
-        if (steps_ == total_steps) std::fprintf(stderr, "\n");
-      }
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+      progress.after_step({steps_, total_steps, time_, dt_, ledger_.balance_error(), wall},
+                          steps_ == total_steps);
     }
     mark_phase(CommPhase::finish);
     if (steps_ < total_steps) {
-      if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+      progress.end_line();
       finish_interrupted(result);
     } else {
       result = report();
       result.status = "completed";
     }
   } catch (const NumericalFailure& failure) {
-    if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+    progress.end_line();
     mark_phase(CommPhase::finish);
     result = report();
     result.status = "failed";
     result.reason = failure.what();
   } catch (const IoError& failure) {
-    if (!options_.quiet && is_root()) std::fprintf(stderr, "\n");
+    progress.end_line();
     result = report();
     result.status = "failed";
     result.io_failure = true;

@@ -4,10 +4,12 @@
 
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/absorbing_boundary.hpp"
 #include "core/dynamics.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
@@ -38,6 +40,8 @@ struct StagePlan {
   bool contact = false;
   bool gravity = false;
   bool kinematic_loads = false;
+  bool absorbing = false;       // viscous absorbing boundaries (core/absorbing_boundary)
+  bool initial_stress = false;  // scene `initial_stress:` (core/initial_stress)
   std::vector<std::string> describe() const;
 };
 
@@ -59,6 +63,13 @@ struct RunReport {
   EnergyTerms energy;
   double balance_error = 0.0;
   std::string state_hash;
+  // The joints' strengths (core/state_hash: joint_strength_hash) and the range of their tensile
+  // strengths (Pa; +inf/−inf without joints): the same on any rank count.
+  std::string joint_strength_hash;
+  // Initial stress: the relative equilibrium residual at t = 0 (−1: none given).
+  double initial_equilibrium_residual = -1.0;
+  double joint_tensile_min = std::numeric_limits<double>::infinity();
+  double joint_tensile_max = -std::numeric_limits<double>::infinity();
   std::vector<StageClock> stages;
   // Counts over all ranks.
   int ranks = 1;
@@ -105,6 +116,7 @@ class Simulation {
   void step();
 
   const Model& model() const { return model_; }
+  double initial_equilibrium_residual() const { return initial_residual_; }
   Model& model() { return model_; }
   const Scene& scene() const { return scene_; }
   const StagePlan& plan() const { return plan_; }
@@ -134,6 +146,12 @@ class Simulation {
   };
   void check_state(const struct InternalForceSummary& forces, bool velocities_finite) const;
   void check_run_limits() const;
+  // Every `absorbing:` entry must select a boundary face somewhere in the model (InputError).
+  void check_absorbing_faces(bool distributed) const;
+  // Sets initial_residual_: |forces at t = 0| / |initial stress's forces| over free components.
+  void check_initial_equilibrium(bool distributed);
+  std::vector<double> initial_stress_;  // S0, 6 per local tet (Pa)
+  double initial_residual_ = -1.0;      // −1: no initial stress
   std::string step_advice() const;
   void check_stable_step(const struct CriticalStep& deformed) const;
   std::string step_origin() const;
@@ -167,8 +185,9 @@ class Simulation {
   std::unique_ptr<RunFiles> files_;
   std::unique_ptr<ContactStage> contact_;
   std::unique_ptr<JointStage> joints_;
-  std::unique_ptr<LoadSchedule> loads_;  // time-dependent loads (drivers/loads)
-  WorkAccumulator joint_friction_;       // Coulomb slip inside joints (part of dissipated_friction)
+  std::unique_ptr<LoadSchedule> loads_;           // time-dependent loads (drivers/loads)
+  std::unique_ptr<AbsorbingBoundary> absorbing_;  // scene `absorbing:` only
+  WorkAccumulator joint_friction_;  // Coulomb slip inside joints (part of dissipated_friction)
   const Communicator* comm_ = nullptr;
   std::unique_ptr<Distribution> distribution_;  // N ranks only
   bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step

@@ -233,7 +233,11 @@ void Simulation::restore_checkpoint(const std::string& path) {
   joint_friction_.through_previous = number("joint_friction_through_previous");
   joint_friction_.first_before = number("joint_friction_first_before");
   joint_friction_.started = number("joint_friction_started") != 0.0;
-  ledger_.restore([&](const std::string& name) { return number("ledger_" + name); });
+  ledger_.restore([&](const std::string& name) { return number("ledger_" + name); },
+                  [&](const std::string& name, double fallback) {
+                    const auto it = doubles.find("ledger_" + name);
+                    return it == doubles.end() ? fallback : it->second;
+                  });
 }
 
 }  // namespace fdem

@@ -74,8 +74,23 @@ SofteningCurve::SofteningCurve(double a, double b, double c) : a_(a), b_(b), c_(
   integral_ = integrate_unit([this](double D) { return z(D); }, 2000);
 }
 
+PenaltyBounds minimum_penalties(const CohesiveParameters& p, const SofteningCurve& curve) {
+  PenaltyBounds b;
+  b.normal = p.tensile_strength * p.tensile_strength * p.element_size / (2.0 * p.energy_I);
+  if (p.cohesion > 0.0)
+    b.tangential = curve.integral() * curve.max_slope() * p.cohesion * p.cohesion * p.element_size /
+                   p.energy_II;
+  return b;
+}
+
 CohesiveLaw::CohesiveLaw(const CohesiveParameters& p)
-    : params_(p), curve_(p.softening_a, p.softening_b, p.softening_c) {
+    : CohesiveLaw(p, SofteningCurve(p.softening_a, p.softening_b, p.softening_c)) {}
+
+CohesiveLaw::CohesiveLaw(const CohesiveParameters& p, const SofteningCurve& curve)
+    : params_(p), curve_(curve) {
+  FDEM_VERIFY(
+      curve.a() == p.softening_a && curve.b() == p.softening_b && curve.c() == p.softening_c,
+      "the softening curve of the parameters");
   auto positive = [](double v, const char* name, const char* unit) {
     if (!(std::isfinite(v) && v > 0.0))
       reject(std::string(name) + " must be a positive number (" + unit + "), got " + fmt(v));
@@ -107,7 +122,9 @@ CohesiveLaw::CohesiveLaw(const CohesiveParameters& p)
            " J/m^2 the penalty stores before the peak (δc would be ≤ δt = " + fmt(delta_t_) +
            " m). Use energy_I > " + fmt(pre_peak) + " J/m^2, or raise the normal penalty above " +
            fmt(p.tensile_strength * p.tensile_strength * p.element_size / (2.0 * p.energy_I)) +
-           " Pa (or use smaller elements)");
+           " Pa, or use elements smaller than h = " +
+           fmt(2.0 * p.energy_I * p.normal_penalty / (p.tensile_strength * p.tensile_strength)) +
+           " m");
   }
   delta_c_ = delta_t_ + (p.energy_I - pre_peak) / (I * p.tensile_strength);
   inv_opening_range_ = 1.0 / (delta_c_ - delta_t_);
@@ -125,7 +142,10 @@ CohesiveLaw::CohesiveLaw(const CohesiveParameters& p)
              "steeper than the elastic slope (snap-back). Use energy_II > " +
              fmt(needed) + " J/m^2, or raise the tangential penalty above " +
              fmt(I * curve_.max_slope() * p.cohesion * p.cohesion * p.element_size / p.energy_II) +
-             " Pa");
+             " Pa, or use elements smaller than h = " +
+             fmt(p.energy_II * p.tangential_penalty /
+                 (I * curve_.max_slope() * p.cohesion * p.cohesion)) +
+             " m");
     }
     inv_slip_c_ = 1.0 / slip_c_;
   } else {

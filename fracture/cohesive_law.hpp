@@ -83,9 +83,21 @@ struct CohesivePointResult {
   bool elastic = true;           // no damage growth and no slip this update
 };
 
+// The smallest penalties (Pa) a parameter set works with (the law needs strictly more):
+// normal: the pre-peak energy ½·f_t²·h/p_n must stay below G_I → f_t²·h/(2·G_I);
+// tangential: the cohesion's softening over the slip must not be steeper than the elastic slope
+// p_t/h (snap-back) → I·max|z′|·c²·h/G_II (0 for a dry joint, c = 0).
+struct PenaltyBounds {
+  double normal = 0.0, tangential = 0.0;
+};
+PenaltyBounds minimum_penalties(const CohesiveParameters& p, const SofteningCurve& curve);
+
 class CohesiveLaw {
  public:
   explicit CohesiveLaw(const CohesiveParameters& p);  // validates; throws InputError
+  // The same with the softening curve of p already built (many laws share one curve; building it
+  // samples z 20 001 times).
+  CohesiveLaw(const CohesiveParameters& p, const SofteningCurve& curve);
 
   const CohesiveParameters& parameters() const { return params_; }
   const SofteningCurve& softening() const { return curve_; }

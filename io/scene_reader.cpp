@@ -14,6 +14,7 @@
 
 #include "core/checked_cast.hpp"
 #include "core/error.hpp"
+#include "io/scene_reader_support.hpp"
 
 namespace fdem {
 
@@ -49,166 +50,9 @@ std::string nearest_name(const std::string& word, const std::vector<std::string>
 
 namespace {
 
-std::string join(const std::vector<std::string>& items) {
-  std::string s;
-  for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", " : "") + items[i];
-  return s;
-}
-
-// Reads one YAML document with positions; every accessor knows its key path for messages.
-class Reader {
- public:
-  // overridden: (key path as the reader spells it, "--set" assignment) for each override, so
-  // errors in overridden values point at the override instead of a line of the file.
-  Reader(std::string file, std::vector<std::pair<std::string, std::string>> overridden)
-      : file_(std::move(file)), overridden_(std::move(overridden)) {}
-
-  [[noreturn]] void fail(const YAML::Node& at, const std::string& path,
-                         const std::string& what) const {
-    std::ostringstream msg;
-    msg << file_;
-    const std::string* assignment = nullptr;
-    for (const auto& [prefix, set] : overridden_)
-      if (path == prefix || path.rfind(prefix + ".", 0) == 0 || path.rfind(prefix + "[", 0) == 0)
-        assignment = &set;
-    const YAML::Mark mark = at.IsDefined() ? at.Mark() : YAML::Mark::null_mark();
-    // A key that only an override created has no place in the file either.
-    if (!assignment && mark.line < 0 && !path.empty())
-      for (const auto& [prefix, set] : overridden_)
-        if (prefix.rfind(path + ".", 0) == 0 || prefix.rfind(path + "[", 0) == 0) assignment = &set;
-    if (assignment)
-      msg << ": --set " << *assignment;
-    else if (mark.line >= 0)
-      msg << ":" << mark.line + 1 << ":" << mark.column + 1;
-    msg << ": " << (path.empty() ? std::string("(top level)") : path) << ": " << what;
-    throw InputError(msg.str());
-  }
-
-  // The text of a mapping key (keys must be plain scalars).
-  std::string key_name(const YAML::Node& key, const std::string& path) const {
-    if (!key.IsScalar()) fail(key, path, "a key must be a plain name, not a list or a mapping");
-    return key.Scalar();
-  }
-
-  // Checks a mapping has only allowed keys and has every required key.
-  void check_keys(const YAML::Node& node, const std::string& path,
-                  const std::vector<std::string>& allowed,
-                  const std::vector<std::string>& required = {}) const {
-    if (!node.IsMap())
-      fail(node, path, "expected a mapping (key: value pairs) with keys " + join(allowed));
-    std::vector<std::string> seen;
-    for (auto it = node.begin(); it != node.end(); ++it) {
-      const std::string key = key_name(it->first, path);
-      // YAML forbids repeated keys; yaml-cpp would silently use the first one.
-      if (std::find(seen.begin(), seen.end(), key) != seen.end())
-        fail(it->first, child(path, key), "key '" + key + "' is given twice in this mapping");
-      seen.push_back(key);
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-        const std::string near = nearest_name(key, allowed);
-        fail(it->first, child(path, key),
-             "unknown key '" + key + "'." + (near.empty() ? "" : " Did you mean '" + near + "'?") +
-                 " Valid keys here: " + join(allowed) + ".");
-      }
-    }
-    for (const auto& key : required)
-      if (!node[key]) fail(node, child(path, key), "missing required key '" + key + "'");
-  }
-
-  static std::string child(const std::string& path, const std::string& key) {
-    return path.empty() ? key : path + "." + key;
-  }
-
-  double number(const YAML::Node& node, const std::string& path) const {
-    if (!node.IsScalar()) fail(node, path, "expected a number");
-    try {
-      const double value = node.as<double>();
-      if (!std::isfinite(value)) fail(node, path, "expected a finite number");
-      return value;
-    } catch (const YAML::Exception&) {
-      fail(node, path, "expected a number, got '" + node.Scalar() + "'");
-    }
-  }
-
-  double positive(const YAML::Node& node, const std::string& path, const std::string& what) const {
-    const double value = number(node, path);
-    if (!(value > 0.0))
-      fail(node, path, format(value) + " is impossible: " + what + " must be > 0");
-    return value;
-  }
-
-  double non_negative(const YAML::Node& node, const std::string& path,
-                      const std::string& what) const {
-    const double value = number(node, path);
-    if (value < 0.0) fail(node, path, format(value) + " is impossible: " + what + " must be >= 0");
-    return value;
-  }
-
-  int integer(const YAML::Node& node, const std::string& path) const {
-    if (!node.IsScalar()) fail(node, path, "expected an integer");
-    try {
-      return node.as<int>();
-    } catch (const YAML::Exception&) {
-      fail(node, path, "expected an integer, got '" + node.Scalar() + "'");
-    }
-  }
-
-  std::int64_t integer64(const YAML::Node& node, const std::string& path) const {
-    if (!node.IsScalar()) fail(node, path, "expected an integer");
-    try {
-      return node.as<std::int64_t>();
-    } catch (const YAML::Exception&) {
-      fail(node, path, "expected an integer, got '" + node.Scalar() + "'");
-    }
-  }
-
-  bool boolean(const YAML::Node& node, const std::string& path) const {
-    if (!node.IsScalar()) fail(node, path, "expected true or false");
-    try {
-      return node.as<bool>();
-    } catch (const YAML::Exception&) {
-      fail(node, path, "expected true or false, got '" + node.Scalar() + "'");
-    }
-  }
-
-  std::string string(const YAML::Node& node, const std::string& path) const {
-    if (!node.IsScalar()) fail(node, path, "expected a text value");
-    return node.Scalar();
-  }
-
-  std::string choice(const YAML::Node& node, const std::string& path,
-                     const std::vector<std::string>& valid) const {
-    const std::string value = string(node, path);
-    if (std::find(valid.begin(), valid.end(), value) == valid.end()) {
-      const std::string near = nearest_name(value, valid);
-      fail(node, path,
-           "'" + value + "' is not valid." + (near.empty() ? "" : " Did you mean '" + near + "'?") +
-               " Valid values: " + join(valid) + ".");
-    }
-    return value;
-  }
-
-  Vec3 vec3(const YAML::Node& node, const std::string& path) const {
-    if (!node.IsSequence() || node.size() != 3)
-      fail(node, path, "expected three numbers [x, y, z]");
-    return {number(node[0], path + "[0]"), number(node[1], path + "[1]"),
-            number(node[2], path + "[2]")};
-  }
-
-  // "auto" or a number.
-  bool is_auto(const YAML::Node& node) const { return node.IsScalar() && node.Scalar() == "auto"; }
-
-  static std::string format(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-  }
-
-  const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
-  std::vector<std::pair<std::string, std::string>> overridden_;
-};
+using scene_reading::join;
+using scene_reading::read_body_list;
+using scene_reading::Reader;
 
 // "bodies.0.velocity" → "bodies[0].velocity" (the reader's spelling of key paths).
 std::string reader_path(const std::string& override_path) {
@@ -271,11 +115,56 @@ void apply_override(YAML::Node& root, const std::string& assignment, const std::
   set(root, 0);
 }
 
+// {type: none} | {type: weibull, modulus: m, seed: s} | {type: normal, cov: v, seed: s}
+StrengthDistributionSpec read_strength_distribution(const Reader& r, const YAML::Node& node,
+                                                    const std::string& path) {
+  using Type = StrengthDistributionSpec::Type;
+  if (!node.IsMap())
+    r.fail(node, path,
+           "expected {type: weibull, modulus: m, seed: s}, {type: normal, cov: v, seed: s} or "
+           "{type: none}");
+  StrengthDistributionSpec d;
+  const std::string type = r.choice(node["type"], path + ".type", {"none", "weibull", "normal"});
+  if (type == "none") {
+    r.check_keys(node, path, {"type", "seed"}, {"type"});
+    return d;
+  }
+  if (type == "weibull") {
+    r.check_keys(node, path, {"type", "modulus", "seed"}, {"type", "modulus", "seed"});
+    d.type = Type::weibull;
+    d.modulus = r.number(node["modulus"], path + ".modulus");
+    if (d.modulus < 1.0)  // below 1 the spread exceeds an exponential distribution's (cov > 1)
+      r.fail(node["modulus"], path + ".modulus",
+             Reader::format(d.modulus) +
+                 " is impossible: the Weibull modulus must be >= 1 (1: cov 1; 2.1: cov 0.5; 5: "
+                 "cov 0.23; 10: cov 0.12)");
+  } else {
+    r.check_keys(node, path, {"type", "cov", "seed"}, {"type", "cov", "seed"});
+    d.type = Type::normal;
+    d.cov = r.positive(node["cov"], path + ".cov", "the coefficient of variation");
+    // Factors are drawn from the normal distribution cut at 0 (a strength is positive); up to
+    // cov = 0.3 the cut removes under 0.05 % of the draws (z < −3.33), moving the mean by
+    // < 0.1 % and the spread by < 0.5 %.
+    if (d.cov > 0.3)
+      r.fail(node["cov"], path + ".cov",
+             Reader::format(d.cov) +
+                 " is too large: cov must be in (0, 0.3] (a wider normal spread puts strengths "
+                 "below zero; use type: weibull for a wide, skewed spread — modulus 2.1 gives "
+                 "cov 0.5)");
+  }
+  const std::int64_t seed = r.integer64(node["seed"], path + ".seed");
+  if (seed < 0 || seed >= (std::int64_t{1} << 53))
+    r.fail(node["seed"], path + ".seed",
+           std::to_string(seed) + " is impossible: the seed is an integer >= 0 and < 2^53");
+  d.seed = static_cast<std::uint64_t>(seed);
+  return d;
+}
+
 FractureSpec read_fracture(const Reader& r, const YAML::Node& node, const std::string& path) {
-  r.check_keys(
-      node, path,
-      {"tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II", "softening"},
-      {"tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II"});
+  r.check_keys(node, path,
+               {"tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II",
+                "softening", "penalty", "strength_distribution"},
+               {"tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II"});
   FractureSpec f;
   f.tensile_strength =
       r.positive(node["tensile_strength"], path + ".tensile_strength", "tensile strength");
@@ -295,6 +184,23 @@ FractureSpec read_fracture(const Reader& r, const YAML::Node& node, const std::s
     if (s["b"]) f.softening_b = r.positive(s["b"], sp + ".b", "softening parameter b");
     if (s["c"]) f.softening_c = r.positive(s["c"], sp + ".c", "softening parameter c");
   }
+  if (const YAML::Node p = node["penalty"]) {  // auto | Pa | {normal: .., tangential: ..}
+    const std::string pp = path + ".penalty";
+    const auto value = [&](const YAML::Node& v, const std::string& vp) {
+      return r.is_auto(v) ? 0.0 : r.positive(v, vp, "the joint penalty (Pa, or 'auto' = 50 E)");
+    };
+    if (p.IsMap()) {
+      r.check_keys(p, pp, {"normal", "tangential"});
+      if (p["normal"]) f.normal_penalty = value(p["normal"], pp + ".normal");
+      if (p["tangential"]) f.tangential_penalty = value(p["tangential"], pp + ".tangential");
+    } else {
+      f.normal_penalty = f.tangential_penalty = value(p, pp);
+    }
+  }
+  if (const YAML::Node d = node["strength_distribution"])
+    f.strength_distribution = read_strength_distribution(r, d, path + ".strength_distribution");
+  f.key = path;
+  f.location = r.location(node);
   return f;
 }
 
@@ -553,25 +459,6 @@ MeshSpec read_mesh(const Reader& r, const YAML::Node& node, const std::string& p
   return mesh;
 }
 
-std::vector<int> read_body_list(const Reader& r, const YAML::Node& node, const std::string& path,
-                                const std::vector<std::string>& names) {
-  if (!node.IsSequence()) r.fail(node, path, "expected a list of body names, e.g. [base, wall]");
-  std::vector<int> out;
-  for (std::size_t i = 0; i < node.size(); ++i) {
-    const std::string name = r.string(node[i], path);
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) {
-      const std::string near = nearest_name(name, names);
-      r.fail(node[i], path,
-             "no body named '" + name + "'." +
-                 (near.empty() ? "" : " Did you mean '" + near + "'?") + " Bodies: " + join(names) +
-                 ".");
-    }
-    out.push_back(static_cast<int>(it - names.begin()));
-  }
-  return out;
-}
-
 // A unit vector from a non-zero [x, y, z].
 Vec3 direction(const Reader& r, const YAML::Node& node, const std::string& path) {
   const Vec3 d = r.vec3(node, path);
@@ -674,7 +561,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   scene.source_path = path;
   r.check_keys(root, "",
                {"name", "time", "gravity", "materials", "bodies", "interfaces", "loads", "output",
-                "contact", "parallel", "limits"},
+                "contact", "parallel", "limits", "absorbing", "initial_stress"},
                {"time", "materials", "bodies"});
   scene.name =
       root["name"] ? r.string(root["name"], "name") : std::filesystem::path(path).stem().string();
@@ -832,6 +719,11 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
       scene.loads.push_back(load);
     }
   }
+
+  if (const YAML::Node absorbing = root["absorbing"])
+    scene.absorbing = scene_reading::read_absorbing(r, absorbing, body_names);
+  if (const YAML::Node stress = root["initial_stress"])
+    scene.initial_stress = scene_reading::read_initial_stress(r, stress, body_names, scene.gravity);
 
   if (const YAML::Node out = root["output"]) {
     r.check_keys(out, "output",

@@ -148,6 +148,56 @@ struct Roles {
   bool matched(std::size_t b) const { return bonded[b] || !as_a[b].empty() || !as_b[b].empty(); }
 };
 
+// The law keys the whole model's joints use, ascending, from each rank's: the (group, size bin)
+// pairs are gathered (a few per group), the strength bins travel as one flag per (pair,
+// bin) over each group's range of bins in a max-reduction — so no rank gathers every rank's
+// keys, which with a strength distribution would be hundreds per pair.
+std::vector<JointLawKey> global_law_keys(std::vector<JointLawKey> local, std::int64_t n_groups,
+                                         const Communicator& comm) {
+  using Pair = std::array<std::int64_t, 2>;
+  std::vector<Pair> pairs;
+  std::vector<std::int64_t> lowest(static_cast<std::size_t>(n_groups),
+                                   std::numeric_limits<std::int64_t>::max());
+  std::vector<std::int64_t> highest(static_cast<std::size_t>(n_groups),
+                                    std::numeric_limits<std::int64_t>::min());
+  std::sort(local.begin(), local.end());
+  local.erase(std::unique(local.begin(), local.end()), local.end());
+  for (const JointLawKey& k : local) {
+    pairs.push_back({k.group, k.size_bin});
+    auto g = static_cast<std::size_t>(k.group);
+    lowest[g] = std::min(lowest[g], k.strength_bin);
+    highest[g] = std::max(highest[g], k.strength_bin);
+  }
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  pairs = comm.allgatherv(pairs);
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  comm.min_in_place(lowest);
+  comm.max_in_place(highest);
+  // Flag of (pair p, strength bin b): offset[p] + b − lowest[group].
+  std::vector<std::int64_t> offset(pairs.size() + 1, 0);
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    const auto g = static_cast<std::size_t>(pairs[p][0]);
+    offset[p + 1] = offset[p] + highest[g] - lowest[g] + 1;
+  }
+  std::vector<std::int32_t> used(static_cast<std::size_t>(offset.back()), 0);
+  for (const JointLawKey& k : local) {
+    const auto p = static_cast<std::size_t>(
+        std::lower_bound(pairs.begin(), pairs.end(), Pair{k.group, k.size_bin}) - pairs.begin());
+    used[static_cast<std::size_t>(offset[p] + k.strength_bin -
+                                  lowest[static_cast<std::size_t>(k.group)])] = 1;
+  }
+  comm.max_in_place(used);
+  std::vector<JointLawKey> keys;
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    const std::int64_t low = lowest[static_cast<std::size_t>(pairs[p][0])];
+    for (std::int64_t f = offset[p]; f < offset[p + 1]; ++f)
+      if (used[static_cast<std::size_t>(f)])
+        keys.push_back({pairs[p][0], pairs[p][1], low + f - offset[p]});
+  }
+  return keys;
+}
+
 }  // namespace
 
 bool body_has_faces(const Scene& scene, std::size_t body) {
@@ -510,24 +560,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
   for (const DraftRecord& d : arrived) (d.role == 0 ? place : bond)(d);
   arrived = {};
 
-  // 7  Laws in ascending (group, bin) over all ranks; joint gids in ascending (gid A, gid B).
-  struct LawKey {
-    std::int64_t group, bin;
-    bool operator<(const LawKey& o) const {
-      return group != o.group ? group < o.group : bin < o.bin;
-    }
-    bool operator==(const LawKey& o) const { return group == o.group && bin == o.bin; }
-  };
-  std::vector<LawKey> keys;
-  for (const Placed& p : placed) keys.push_back({p.group, p.bin});
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  keys = comm.allgatherv(keys);
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  for (const LawKey& k : keys)
-    out.laws.push_back(
-        joint_law(scene, static_cast<std::int32_t>(k.group), static_cast<long>(k.bin)));
+  // 7  Joint gids in ascending (gid A, gid B); laws in ascending key over all ranks.
   std::sort(placed.begin(), placed.end(), [](const Placed& p, const Placed& q) {
     return p.joint.tets[0] != q.joint.tets[0] ? p.joint.tets[0] < q.joint.tets[0]
                                               : p.joint.tets[1] < q.joint.tets[1];
@@ -537,13 +570,22 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
   const GlobalId base =
       block.gid_offset + std::accumulate(per_rank.begin(), per_rank.begin() + me, std::int64_t{0});
   out.n_joints = std::accumulate(per_rank.begin(), per_rank.end(), std::int64_t{0});
+  std::vector<JointLawKey> law_key(placed.size());
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    placed[i].joint.gid = base + static_cast<GlobalId>(i);
+    law_key[i] = {
+        placed[i].group, placed[i].bin,
+        joint_strength_bin(scene, placed[i].group, placed[i].joint.gid, block.gid_offset)};
+  }
+  const std::int64_t n_groups =
+      static_cast<std::int64_t>(scene.materials.size() + scene.interfaces.size());
+  const std::vector<JointLawKey> keys = global_law_keys(law_key, n_groups, comm);
+  for (const JointLawKey& k : keys) out.laws.push_back(joint_law(scene, k));
   out.joints.reserve(placed.size());
   for (std::size_t i = 0; i < placed.size(); ++i) {
     StartJoint j = placed[i].joint;
-    j.gid = base + static_cast<GlobalId>(i);
-    j.law = static_cast<std::int32_t>(
-        std::lower_bound(keys.begin(), keys.end(), LawKey{placed[i].group, placed[i].bin}) -
-        keys.begin());
+    j.law = static_cast<std::int32_t>(std::lower_bound(keys.begin(), keys.end(), law_key[i]) -
+                                      keys.begin());
     out.joints.push_back(j);
   }
   return out;

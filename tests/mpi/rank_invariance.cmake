@@ -1,5 +1,6 @@
 # Runs the fdem command on a scene with each rank count of RANKS and passes when every run
-# completes, summary.json's state_hash is the same in all of them and bodies.csv is the same file,
+# completes, summary.json's state_hash (and joint_strength hash, when the scene has joints) is the
+# same in all of them and bodies.csv is the same file,
 # byte for byte.  With RESTART_RANKS, also continues the first run's earliest checkpoint on each
 # of those rank counts and requires the same hash again (checkpoint-and-restart vs.
 # uninterrupted), and the uninterrupted run's bodies.csv rows at the times both runs wrote.  With START, every run on more than
@@ -32,6 +33,11 @@ function(read_hash out variable ranks)
     endif()
     string(APPEND hash "/${count}=${value}")
   endforeach()
+  # The joints' strengths as drawn (a strength distribution: keyed by joint gid).
+  string(REGEX MATCH "\"joint_strength\": {[^}]*\"hash\": \"([0-9a-f]+)\"" _ "${summary}")
+  if(CMAKE_MATCH_1)
+    string(APPEND hash "/joint_strength=${CMAKE_MATCH_1}")
+  endif()
   string(REGEX MATCH "\"migrated_elements\": ([0-9]+)" _ "${summary}")
   set(migrated "${CMAKE_MATCH_1}")
   string(REGEX MATCH "\"start\": \"([a-z_]+)\"" _ "${summary}")

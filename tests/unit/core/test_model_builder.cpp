@@ -180,7 +180,13 @@ TEST_CASE("nodal forces are bit-identical whatever the local order of the tets",
 TEST_CASE("build_model: a gid offset shifts every gid and changes nothing else", "[model]") {
   // A jointed body (joints: all) so that node, tet and joint gids all move.
   Scene scene = scene_for(1);
-  scene.materials[0].fracture = FractureSpec{1e6, 2e6, 30.0, 10.0, 50.0};
+  FractureSpec fracture;
+  fracture.tensile_strength = 1e6;
+  fracture.cohesion = 2e6;
+  fracture.friction_angle_deg = 30.0;
+  fracture.energy_I = 10.0;
+  fracture.energy_II = 50.0;
+  scene.materials[0].fracture = fracture;
   scene.bodies[0].joints = JointPlacement::all;
   const Model plain = build_model(scene, {two_pieces()});
   REQUIRE(plain.joints.size() == 1);  // the face shared by the second piece's two tets

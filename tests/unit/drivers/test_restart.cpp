@@ -93,3 +93,22 @@ TEST_CASE("a restart lists other changes as warnings by key and continues", "[cl
                                    "applies from the checkpoint's time on"));
   CHECK_THAT(changed.err, Contains("gravity.z changed from -9.81 to -5"));
 }
+
+TEST_CASE("a restart refuses a changed initial stress and warns of new absorbing faces",
+          "[cli][restart]") {
+  TempDir dir;
+  const std::string checkpoint = first_checkpoint(dir);
+  const Outcome stressed =
+      run_fdem(dir, "run scene.yaml -o stressed -q --restart " + checkpoint +
+                        " --set 'initial_stress=[{uniform: [0, 0, -1e4, 0, 0, 0]}]'");
+  CHECK(stressed.exit_code == 2);
+  CHECK_THAT(stressed.err, Contains("a restart cannot change: initial_stress[0].") &&
+                               Contains("initial_stress[0].kind (new, 1)"));
+  const Outcome absorbing = run_fdem(
+      dir, "run scene.yaml -o absorbing -q --restart " + checkpoint +
+               " --set 'absorbing=[{region: {box: {min: [-1, -1, -0.11], max: [2, 1, -0.09]}}}]'");
+  INFO(absorbing.err);
+  CHECK(absorbing.exit_code == 0);
+  CHECK_THAT(absorbing.err, Contains("absorbing[0].region.box.min.z (new, -0.11) applies from the "
+                                     "checkpoint's time on"));
+}

@@ -1,0 +1,72 @@
+// Scene keys `absorbing:` and `initial_stress:`: read into the scene, errors naming the key and
+// what is valid.
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "core/error.hpp"
+#include "io/scene_reader.hpp"
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+std::string scene_with(const std::string& extra, const std::string& gravity = "[0, 0, -9.81]") {
+  return "time: {end: 0.1}\n"
+         "gravity: " +
+         gravity +
+         "\n"
+         "materials:\n"
+         "  soil: {density: 1800, elastic: {young: 5.0e7, poisson: 0.3}}\n"
+         "bodies:\n"
+         "  - {name: a, mesh: {box: {min: [0, 0, 0], max: [1, 1, 1]}}, material: soil}\n"
+         "  - {name: b, mesh: {box: {min: [2, 0, 0], max: [3, 1, 1]}}, material: soil}\n" +
+         extra;
+}
+
+std::string error(const std::string& text) {
+  try {
+    fdem::parse_scene(text, "scene.yaml");
+  } catch (const fdem::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("initial_stress: uniform and geostatic entries per body", "[io][initial_stress]") {
+  const fdem::Scene s =
+      fdem::parse_scene(scene_with("initial_stress:\n"
+                                   "  - {uniform: [-1e5, -2e5, -3e5, 1, 2, 3], bodies: [b]}\n"
+                                   "  - {geostatic: {surface: 1.0, k0: 0.5}, bodies: [a]}\n"),
+                        "scene.yaml");
+  REQUIRE(s.initial_stress.size() == 2);
+  CHECK(s.initial_stress[0].kind == fdem::InitialStressSpec::Kind::uniform);
+  CHECK(s.initial_stress[0].stress[2] == -3e5);
+  CHECK(s.initial_stress[0].stress[5] == 3);
+  CHECK(s.initial_stress[0].bodies == std::vector<int>{1});
+  CHECK(s.initial_stress[1].kind == fdem::InitialStressSpec::Kind::geostatic);
+  CHECK(s.initial_stress[1].surface == 1.0);
+  CHECK(s.initial_stress[1].k0 == 0.5);
+}
+
+TEST_CASE("initial_stress and absorbing: errors name the key", "[io][initial_stress]") {
+  CHECK_THAT(
+      error(scene_with("initial_stress:\n  - {uniform: [1, 2, 3]}\n")),
+      Contains("scene.yaml:9:15:") && Contains("initial_stress[0].uniform: expected 6 numbers"));
+  CHECK_THAT(
+      error(scene_with("initial_stress:\n  - {geostatic: {surface: 1, k0: 0.5}}\n", "[0, 0, 0]")),
+      Contains("initial_stress[0].geostatic: a geostatic stress is the weight of the ground "
+               "above: it needs a non-zero top-level 'gravity'"));
+  CHECK_THAT(error(scene_with("initial_stress:\n  - {geostatic: {surface: 1, k0: -0.5}}\n")),
+             Contains("initial_stress[0].geostatic.k0: -0.5 is impossible"));
+  CHECK_THAT(error(scene_with("initial_stress:\n  - {geostatic: {surface: 1}}\n")),
+             Contains("initial_stress[0].geostatic.k0: missing required key 'k0'"));
+  CHECK_THAT(error(scene_with("initial_stress:\n  - {bodies: [a]}\n")),
+             Contains("initial_stress[0]: give one of 'uniform' or 'geostatic'"));
+  CHECK_THAT(error(scene_with("initial_stress:\n  - {uniform: [0, 0, 0, 0, 0, 0]}\n"
+                              "  - {uniform: [0, 0, 0, 0, 0, 0], bodies: [b]}\n")),
+             Contains("initial_stress[1]: body 'b' already has an initial stress"));
+  CHECK_THAT(error(scene_with("absorbing:\n  - {region: {box: {min: [0, 0, 0]}}}\n")),
+             Contains("absorbing[0].region.box.max: missing required key 'max'"));
+}
