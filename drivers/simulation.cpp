@@ -483,6 +483,8 @@ void Simulation::step() {
     motion = integrate_central_difference(dt_, nodes);
     moved_since_distribution_ = true;
   }
+  ContactWork contact_after;  // the "after" halves of friction and dashpot work (v_n+½ known now)
+  if (plan_.contact) contact_after = contact_->work_after(model_, dt_);
   // How far the nodes went: whether the next step must detect, and whether a node crossed more
   // than the thinnest element in this step (tunnelling); both decided in the reduction below.
   NodeTravel travel;
@@ -520,11 +522,11 @@ void Simulation::step() {
                   j.stored_energy,
                   j.fracture_dissipated,
                   j.friction_dissipated,
-                  c.damping_dissipated,
+                  c.work_before.damping,
                   c.energy,
                   c.friction_spring_energy,
-                  c.friction_work_before,
-                  c.friction_work_after,
+                  c.work_before.friction,
+                  contact_after.friction,
                   motion.kinetic_energy,
                   motion.kinetic_energy_half_step,
                   motion.constraint_work_before,
@@ -540,13 +542,14 @@ void Simulation::step() {
                   interrupt_signal() != 0 ? 1.0 : 0.0,
                   crushed_ranks,
                   detect_next ? 1.0 : 0.0,
-                  tunnel_ranks});
+                  tunnel_ranks,
+                  contact_after.damping});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
          {&forces.strain_energy, &forces.damping_power, &j.stored_energy, &j.fracture_dissipated,
-          &j.friction_dissipated, &c.damping_dissipated, &c.energy, &c.friction_spring_energy,
-          &c.friction_work_before, &c.friction_work_after, &motion.kinetic_energy,
+          &j.friction_dissipated, &c.work_before.damping, &c.energy, &c.friction_spring_energy,
+          &c.work_before.friction, &contact_after.friction, &motion.kinetic_energy,
           &motion.kinetic_energy_half_step, &motion.constraint_work_before,
           &motion.constraint_work_after})
       *v = terms[i++];
@@ -559,6 +562,7 @@ void Simulation::step() {
     crushed_ranks = terms[23];
     detection_due_ = terms[24] > 0.0 ? 1 : 0;
     tunnel_ranks = terms[25];
+    contact_after.damping = terms[26];
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -572,9 +576,12 @@ void Simulation::step() {
     energy.dissipated_friction = joint_friction_.add(j.friction_dissipated, 0.0);
   }
   if (plan_.contact) {
+    // What friction took from the bodies (trapezoid work, as the integrator sees it) is stored in
+    // the stick springs or dissipated: slip, and springs released when a contact ends.
     energy.contact = c.energy + c.friction_spring_energy;
     energy.dissipated_friction +=
-        ledger_.friction.add(c.friction_work_before, c.friction_work_after);
+        ledger_.friction.add(c.work_before.friction, contact_after.friction) -
+        c.friction_spring_energy;
   }
   energy.kinetic = motion.kinetic_energy;
   kinetic_half_step_ = motion.kinetic_energy_half_step;
@@ -583,8 +590,9 @@ void Simulation::step() {
   if (plan_.gravity)
     energy.gravity = -ledger_.gravity.add(0.5 * dt_ * model_.gravity.dot(motion.momentum_before),
                                           0.5 * dt_ * model_.gravity.dot(motion.momentum_after));
-  const double damping_step = forces.damping_power * dt_ + c.damping_dissipated;
-  energy.dissipated_damping = ledger_.damping.add(0.5 * damping_step, 0.5 * damping_step);
+  const double viscous_step = forces.damping_power * dt_;  // element damping, J
+  energy.dissipated_damping = ledger_.damping.add(0.5 * viscous_step + c.work_before.damping,
+                                                  0.5 * viscous_step + contact_after.damping);
   energy.external_work =
       ledger_.external.add(motion.constraint_work_before, motion.constraint_work_after);
   ledger_.record(energy);
