@@ -28,6 +28,8 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
     penalty_.push_back(m.contact.auto_penalty ? auto_penalty_factor * m.young : m.contact.penalty);
     friction_coefficient_.push_back(m.contact.friction);
     damping_ratio_.push_back(m.contact.damping);
+    any_friction_ = any_friction_ || m.contact.friction > 0.0;
+    any_damping_ = any_damping_ || m.contact.damping > 0.0;
   }
   x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   buffer_ = settings.buffer;
@@ -162,21 +164,14 @@ bool ContactStage::detect_if_needed(const Model& model) {
 
 void ContactStage::detect(const Model& model) {
   run_detection(model, model.nodes.x.data());
-  // Stick springs of pairs that left the list are released (their energy is dissipated).
+  // Stick springs of pairs that left the list are released (their energy leaves the contact
+  // energy; the ledger counts it as dissipated, docs/verification.md "Impact energy").
   if (!friction_.empty()) {
     std::unordered_set<PairId, PairIdHash> kept;
     kept.reserve(pairs_.size());
     for (const CandidatePair& p : pairs_) kept.insert({model.tets.gid[p.a], model.tets.gid[p.b]});
-    for (auto it = friction_.begin(); it != friction_.end();) {
-      if (kept.count(it->first)) {
-        ++it;
-      } else {
-        if (it->second.owned)
-          released_spring_energy_ +=
-              0.5 * it->second.stiffness * it->second.history.tangential_spring.squaredNorm();
-        it = friction_.erase(it);
-      }
-    }
+    for (auto it = friction_.begin(); it != friction_.end();)
+      it = kept.count(it->first) ? std::next(it) : friction_.erase(it);
   }
   x_at_detection_ = model.nodes.x;
   detected_ = true;
@@ -321,9 +316,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   NodeArrays& nodes = model.nodes;
   records_.clear();
   out.candidate_pairs = static_cast<std::int64_t>(pairs_.size());  // held here, not unique
-  out.friction_dissipated = released_spring_energy_;
-  released_spring_energy_ = 0.0;
   overlapping_.assign(pairs_.size(), 0);
+  if (any_friction_) friction_force_.assign(3 * static_cast<std::size_t>(nodes.size()), 0.0);
+  if (any_damping_) damping_force_.assign(3 * static_cast<std::size_t>(nodes.size()), 0.0);
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
     const CandidatePair& pair = pairs_[index];
     TetCorners a, b;
@@ -339,14 +334,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
     if (!r.overlapping) {
-      if (mu > 0.0) {  // contact lost: the stick spring's energy is released (dissipated)
-        const auto it = friction_.find(key);
-        if (it != friction_.end()) {
-          out.friction_dissipated += share * 0.5 * it->second.stiffness *
-                                     it->second.history.tangential_spring.squaredNorm();
-          friction_.erase(it);
-        }
-      }
+      if (mu > 0.0) friction_.erase(key);  // contact lost: the stick spring is released
       continue;
     }
     overlapping_[index] = 1;
@@ -383,12 +371,13 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       const double f_n = std::max(-2.0 * xi * std::sqrt(k * m) * v_n,
                                   -r.normal_force);  // on the contactor, along n
       for (int c = 0; c < 4; ++c) {
-        vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) +=
-            r.centroid_weights_contactor[c] * f_n * r.normal;
-        vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) -=
-            r.centroid_weights_target[c] * f_n * r.normal;
+        const Vec3 on_a = r.centroid_weights_contactor[c] * f_n * r.normal;
+        const Vec3 on_b = -r.centroid_weights_target[c] * f_n * r.normal;
+        vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += on_a;
+        vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += on_b;
+        vec3_at(damping_force_.data(), tets.nodes[4 * pair.a + c]) += on_a;
+        vec3_at(damping_force_.data(), tets.nodes[4 * pair.b + c]) += on_b;
       }
-      out.damping_dissipated += share * -f_n * v_n * dt;
     }
     Vec3 tangential = Vec3::Zero();
     if (mu > 0.0) {
@@ -405,15 +394,34 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       for (int c = 0; c < 4; ++c) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += f.force_target[c];
+        vec3_at(friction_force_.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
+        vec3_at(friction_force_.data(), tets.nodes[4 * pair.b + c]) += f.force_target[c];
       }
-      out.friction_dissipated += share * (f.slip_dissipation + f.released_energy);
       out.friction_spring_energy += share * f.spring_energy;
       tangential = f.tangential_force;
     }
     if (share > 0.0) records_.push_back({r.centroid, r.normal_force * r.normal, tangential});
   }
-  out.friction_work_before = out.friction_work_after = 0.5 * out.friction_dissipated;
+  // Owned nodes hold the whole force of every pair they take part in (the halo guarantees it).
+  out.work_before = work_against(model, dt);
   return out;
+}
+
+ContactWork ContactStage::work_after(const Model& model, double dt) const {
+  return work_against(model, dt);
+}
+
+// −Σ F·v·dt/2 over the owned nodes at their current velocities (J), for the friction and the
+// dashpot forces of the last add_forces.
+ContactWork ContactStage::work_against(const Model& model, double dt) const {
+  ContactWork w;
+  const double* v = model.nodes.v.data();
+  const std::size_t n = 3 * static_cast<std::size_t>(model.nodes.n_owned);
+  if (any_friction_)
+    for (std::size_t i = 0; i < n; ++i) w.friction -= 0.5 * dt * friction_force_[i] * v[i];
+  if (any_damping_)
+    for (std::size_t i = 0; i < n; ++i) w.damping -= 0.5 * dt * damping_force_[i] * v[i];
+  return w;
 }
 
 }  // namespace fdem

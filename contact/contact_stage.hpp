@@ -27,12 +27,19 @@ struct FrictionEntry {
   double stiffness = 0.0;      // N/m
 };
 
+// Energy taken from the bodies by friction and by the contact dashpots (J): minus the work of
+// those forces on the owned nodes, with the integrator's trapezoid rule.  Step n gives
+// −F_n·v_n−½·dt/2 ("before", in add_forces) and −F_n·v_n+½·dt/2 ("after", in work_after once the
+// step is integrated); central difference's ½m·v_n−½·v_n+½ changes by exactly these halves.
+struct ContactWork {
+  double friction = 0.0;
+  double damping = 0.0;
+};
+
 struct ContactForceSummary {
-  double energy = 0.0;                                           // Σ U of overlapping pairs (J)
-  double friction_work_before = 0.0, friction_work_after = 0.0;  // trapezoid halves (J)
-  double friction_dissipated = 0.0;     // slip work + released stick-spring energy this step (J)
+  double energy = 0.0;                  // Σ U of overlapping pairs (J)
+  ContactWork work_before;              // J, the "before" halves of this step
   double friction_spring_energy = 0.0;  // J stored in stick springs (part of the contact energy)
-  double damping_dissipated = 0.0;      // J dissipated by normal contact dashpots this step
   std::int64_t candidate_pairs = 0;     // may exceed the local tet count many times: 64-bit
   std::int64_t active_pairs = 0;        // overlapping pairs
 };
@@ -83,6 +90,9 @@ class ContactStage {
   bool detected() const { return detected_; }
   // Adds contact forces to model.nodes.f (pairs in ascending (gid, gid) order).
   ContactForceSummary add_forces(Model& model, double dt);
+  // The "after" halves of the friction and dashpot work of the last add_forces, once the step is
+  // integrated (model.nodes.v holds v_n+½ of the owned nodes).
+  ContactWork work_after(const Model& model, double dt) const;
 
   // Tets bonded by an intact cohesive joint never pair (the joint carries their load).  Pairs
   // are model tet indices, at most 4 bonds per tet (one per face).
@@ -108,6 +118,7 @@ class ContactStage {
 
  private:
   void compute_boxes(const Model& model, const double* x);
+  ContactWork work_against(const Model& model, double dt) const;
   void run_detection(const Model& model, const double* x);
 
   double buffer_ = 0.0;
@@ -137,8 +148,11 @@ class ContactStage {
     }
   };
   std::unordered_map<PairId, PairFriction, PairIdHash> friction_;
-  double released_spring_energy_ = 0.0;  // J, springs of pairs dropped at the last detection
   std::vector<double> friction_coefficient_, damping_ratio_;
+  // Friction and dashpot forces of the last add_forces per local node (N, xyz), for their work;
+  // empty when no material has friction / contact damping.
+  std::vector<double> friction_force_, damping_force_;
+  bool any_friction_ = false, any_damping_ = false;
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
   enum class JointState : std::uint8_t { none, intact, cracked };  // of a tet's joints
   std::vector<JointState> joint_state_;

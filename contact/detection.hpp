@@ -18,4 +18,15 @@ inline bool detection_needed(double max_travel, double buffer) {
 // that the caller always re-detects (and the detector then reports the non-finite box).
 double max_node_displacement(const double* x, const double* x_at_detection, LocalIndex n_nodes);
 
+// How far the nodes went, measured after a step: the largest travel since the last detection
+// (m, decides whether the next step detects) and the largest travel of the step itself, dt·|v|
+// (m, the tunnelling guard), with the node that made it.  NaN counts as +infinity.
+struct NodeTravel {
+  double since_detection = 0.0;
+  double step = 0.0;
+  LocalIndex fastest = -1;  // node of `step`; −1 when no node moved
+};
+NodeTravel node_travel(const double* x, const double* x_at_detection, const double* v, double dt,
+                       LocalIndex n_nodes);
+
 }  // namespace fdem

@@ -8,16 +8,19 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
 
 #include "contact/contact_stage.hpp"
+#include "contact/detection.hpp"
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
 #include "core/initial_stress.hpp"
 #include "core/model_builder.hpp"
 #include "core/state_hash.hpp"
+#include "core/tet_kernels.hpp"
 #include "core/time_step.hpp"
 #include "drivers/interrupt.hpp"
 #include "drivers/loads.hpp"
@@ -149,6 +152,16 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
         model_, ContactSettings{distributed ? contact_buffer : scene_.contact_buffer});
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
     const double dt_contact = global_min(contact_->critical_time_step(model_));
+    // Tunnelling guard (check_tunnelling): the thinnest element a node could cross unseen.
+    double thinnest = std::numeric_limits<double>::infinity();
+    for (LocalIndex t = 0; t < model_.tets.size(); ++t) {
+      if (!model_.tets.is_owned(t)) continue;
+      Vec3 x[4];
+      for (int c = 0; c < 4; ++c)
+        x[c] = vec3_at(model_.nodes.x.data(), model_.tets.nodes[4 * t + c]);
+      thinnest = std::min(thinnest, smallest_altitude(x));
+    }
+    tunnel_size_ = global_min(thinnest);
     dt_critical_ =
         1.0 / std::sqrt(1.0 / (dt_critical_ * dt_critical_) + 1.0 / (dt_contact * dt_contact));
   }
@@ -218,6 +231,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   if (!options_.restart_path.empty()) {
     mark_phase(CommPhase::restart);
     restore_checkpoint(options_.restart_path);
+    moved_since_distribution_ = true;  // the halo was made for the start positions
     mark_phase(CommPhase::startup);
   }
   // Every rank decides alike; collectively, so that all leave with the message and exit code 2.
@@ -318,7 +332,7 @@ TravellingState Simulation::travelling_state() const {
   return state;
 }
 
-void Simulation::redistribute() {
+void Simulation::redistribute(bool detecting) {
   TravellingState state = travelling_state();
   std::vector<double> contact_cost;  // per local tet, in units of one tet's internal force
   if (contact_) {
@@ -336,8 +350,9 @@ void Simulation::redistribute() {
   }
   mark_phase(CommPhase::redistribution);
   distribution_->redistribute(model_, state, contact_cost);
-  rebind_stages(state, contact_ && contact_->detected());
+  rebind_stages(state, contact_ && contact_->detected() && !detecting);
   redistribute_pending_ = false;
+  moved_since_distribution_ = false;
   mark_phase(CommPhase::step);
 }
 
@@ -392,13 +407,28 @@ void Simulation::step() {
     distribution_->finish_halo_exchange(nodes);
     halo_in_flight_ = false;
   };
+  // N ranks: does this step detect because a node went more than buffer/2?  Decided from the
+  // last step's reduction (identical on every rank).  The halo is then rebuilt at these positions
+  // before detecting, so that the detection sees every partner however far a node went in the
+  // last step (the halo margin assumes buffer/2 of travel from where it was built).
+  bool travel_detection = false;
+  if (distribution_ && plan_.contact) {
+    Timed timed(clocks_[detection]);
+    travel_detection =
+        detection_due_ >= 0
+            ? detection_due_ > 0 || !contact_->detected()
+            : comm_->max(static_cast<std::int32_t>(contact_->detection_due(model_))) > 0;
+  }
   if (distribution_) {
-    // 4b redistribution after a detection cycle: re-balance, migrate, rebuild the halo
+    // 4b redistribution: before a detection cycle (or after one that a broken joint started):
+    // re-balance, migrate, rebuild the halo
     const long every = scene_.parallel.redistribute_every;
-    if (redistribute_pending_ || (every > 0 && steps_ > 0 && steps_ % every == 0)) {
+    const bool before_detection = travel_detection && moved_since_distribution_;
+    if (redistribute_pending_ || before_detection ||
+        (every > 0 && steps_ > 0 && steps_ % every == 0)) {
       complete_halo();
       Timed timed(clocks_[migration]);
-      redistribute();
+      redistribute(travel_detection);
     }
   }
 
@@ -438,7 +468,7 @@ void Simulation::step() {
     // 3 fracture: the tets of newly broken joints become contact partners
     Timed timed(clocks_[fracture]);
     if (distribution_)
-      detection_due = share_broken_joints(contact_ && contact_->detection_due(model_));
+      detection_due = share_broken_joints(travel_detection);
     else if (j.newly_broken > 0 && contact_)
       for (LocalIndex b : joints_->newly_broken())
         contact_->release_bond(model_.joints.tets[2 * b], model_.joints.tets[2 * b + 1]);
@@ -448,11 +478,11 @@ void Simulation::step() {
   if (plan_.contact) {
     Timed timed(clocks_[detection]);
     if (distribution_) {
-      if (!plan_.joints)  // with joints, stage 3's reduction has answered already
-        detection_due = comm_->max(static_cast<std::int32_t>(contact_->detection_due(model_))) > 0;
+      if (!plan_.joints) detection_due = travel_detection;  // with joints: stage 3's answer
       if (detection_due) {
         contact_->detect(model_);
-        redistribute_pending_ = true;
+        // A detection that a broken joint started mid-step redistributes at the next step.
+        if (!travel_detection) redistribute_pending_ = true;
       }
     } else {
       contact_->detect_if_needed(model_);
@@ -485,7 +515,19 @@ void Simulation::step() {
     if (steps_ == 0) start_half_step(nodes);
     motion = integrate_central_difference(dt_, nodes);
     if (absorbing_) boundary_after = absorbing_->dissipation_after(dt_, model_);
+    moved_since_distribution_ = true;
   }
+  ContactWork contact_after;  // the "after" halves of friction and dashpot work (v_n+½ known now)
+  if (plan_.contact) contact_after = contact_->work_after(model_, dt_);
+  // How far the nodes went: whether the next step must detect, and whether a node crossed more
+  // than the thinnest element in this step (tunnelling); both decided in the reduction below.
+  NodeTravel travel;
+  if (plan_.contact)
+    travel = node_travel(nodes.x.data(), contact_->x_at_detection().data(), nodes.v.data(), dt_,
+                         nodes.n_owned);
+  const bool detect_next =
+      plan_.contact && detection_needed(travel.since_detection, contact_->buffer());
+  double tunnel_ranks = plan_.contact && travel.step > tunnel_size_ ? 1.0 : 0.0;
 
   // 8 halo update: post the ghost exchange now, complete it at the start of the next step
   if (distribution_) {
@@ -514,11 +556,11 @@ void Simulation::step() {
                   j.stored_energy,
                   j.fracture_dissipated,
                   j.friction_dissipated,
-                  c.damping_dissipated,
+                  c.work_before.damping,
                   c.energy,
                   c.friction_spring_energy,
-                  c.friction_work_before,
-                  c.friction_work_after,
+                  c.work_before.friction,
+                  contact_after.friction,
                   motion.kinetic_energy,
                   motion.kinetic_energy_half_step,
                   motion.constraint_work_before,
@@ -533,14 +575,17 @@ void Simulation::step() {
                   forces.min_jacobian > 0.0 ? 0.0 : 1.0,
                   interrupt_signal() != 0 ? 1.0 : 0.0,
                   crushed_ranks,
+                  detect_next ? 1.0 : 0.0,
+                  tunnel_ranks,
+                  contact_after.damping,
                   boundary_before,
                   boundary_after});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
          {&forces.strain_energy, &forces.damping_power, &j.stored_energy, &j.fracture_dissipated,
-          &j.friction_dissipated, &c.damping_dissipated, &c.energy, &c.friction_spring_energy,
-          &c.friction_work_before, &c.friction_work_after, &motion.kinetic_energy,
+          &j.friction_dissipated, &c.work_before.damping, &c.energy, &c.friction_spring_energy,
+          &c.work_before.friction, &contact_after.friction, &motion.kinetic_energy,
           &motion.kinetic_energy_half_step, &motion.constraint_work_before,
           &motion.constraint_work_after})
       *v = terms[i++];
@@ -551,8 +596,11 @@ void Simulation::step() {
     // A signal on any rank ends the run after this step on every rank (no extra collective).
     if (terms[22] > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
     crushed_ranks = terms[23];
-    boundary_before = terms[24];
-    boundary_after = terms[25];
+    detection_due_ = terms[24] > 0.0 ? 1 : 0;
+    tunnel_ranks = terms[25];
+    contact_after.damping = terms[26];
+    boundary_before = terms[27];
+    boundary_after = terms[28];
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -566,9 +614,12 @@ void Simulation::step() {
     energy.dissipated_friction = joint_friction_.add(j.friction_dissipated, 0.0);
   }
   if (plan_.contact) {
+    // What friction took from the bodies (trapezoid work, as the integrator sees it) is stored in
+    // the stick springs or dissipated: slip, and springs released when a contact ends.
     energy.contact = c.energy + c.friction_spring_energy;
     energy.dissipated_friction +=
-        ledger_.friction.add(c.friction_work_before, c.friction_work_after);
+        ledger_.friction.add(c.work_before.friction, contact_after.friction) -
+        c.friction_spring_energy;
   }
   energy.kinetic = motion.kinetic_energy;
   kinetic_half_step_ = motion.kinetic_energy_half_step;
@@ -577,8 +628,9 @@ void Simulation::step() {
   if (plan_.gravity)
     energy.gravity = -ledger_.gravity.add(0.5 * dt_ * model_.gravity.dot(motion.momentum_before),
                                           0.5 * dt_ * model_.gravity.dot(motion.momentum_after));
-  const double damping_step = forces.damping_power * dt_ + c.damping_dissipated;
-  energy.dissipated_damping = ledger_.damping.add(0.5 * damping_step, 0.5 * damping_step);
+  const double viscous_step = forces.damping_power * dt_;  // element damping, J
+  energy.dissipated_damping = ledger_.damping.add(0.5 * viscous_step + c.work_before.damping,
+                                                  0.5 * viscous_step + contact_after.damping);
   energy.external_work =
       ledger_.external.add(motion.constraint_work_before, motion.constraint_work_after);
   if (absorbing_)
@@ -596,6 +648,12 @@ void Simulation::step() {
     comm_->run_collectively([&] { check_state(forces, motion.finite); });
   else
     check_state(forces, motion.finite);
+  // Tunnelling first: a body that jumped an element in one step also deforms the tets that hold
+  // ghost copies of its nodes (not yet exchanged), which the minimum-step guard would report.
+  if (distribution_ && tunnel_ranks > 0)
+    comm_->run_collectively([&] { check_tunnelling(travel); });
+  else if (tunnel_ranks > 0)
+    check_tunnelling(travel);
   if (distribution_ && crushed_ranks > 0)
     comm_->run_collectively([&] { check_stable_step(deformed); });
   else if (step_too_large)
@@ -684,6 +742,30 @@ void Simulation::check_stable_step(const CriticalStep& deformed) const {
       << (steps_ > 0 ? "deformed " : "") << "mesh is " << deformed.dt
       << " s, below half the time step (minimum-step guard), set by "
       << describe_tet(model_, deformed.limiting_tet) << "." << step_advice();
+  throw NumericalFailure(msg.str());
+}
+
+// Throws NumericalFailure when a node of this rank went further in one step than the thinnest
+// element is thick: contact only sees positions at whole steps, so it could have passed through an
+// element unseen (tunnelling), and a penetration that deep pushes the wrong way anyway.
+void Simulation::check_tunnelling(const NodeTravel& travel) const {
+  if (!(travel.step > tunnel_size_) || travel.fastest < 0) return;
+  const NodeArrays& nodes = model_.nodes;
+  const LocalIndex n = travel.fastest;
+  const std::int32_t piece = nodes.piece[n];
+  const double speed = travel.step / dt_;
+  std::ostringstream msg;
+  msg << "numerical failure at step " << steps_ << " (t = " << time_ << " s): node " << nodes.gid[n]
+      << " of body '" << model_.body_names[model_.pieces.body_of(piece)] << "' (piece "
+      << model_.pieces.index_in_body(piece) << ") moved " << travel.step << " m in one step (speed "
+      << speed << " m/s), more than the smallest element size " << tunnel_size_
+      << " m: contact only sees the positions at whole steps, so the body would pass through "
+         "elements without touching them (tunnelling). Use a smaller time step (below "
+      << tunnel_size_ / speed
+      << " s: time.step, or a smaller time.safety) or check the initial and prescribed "
+         "velocities; a larger contact buffer (contact.buffer, now "
+      << contact_->buffer()
+      << " m) makes detection less frequent but cannot catch a crossing within one step.";
   throw NumericalFailure(msg.str());
 }
 

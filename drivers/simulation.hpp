@@ -154,8 +154,11 @@ class Simulation {
   double initial_residual_ = -1.0;      // −1: no initial stress
   std::string step_advice() const;
   void check_stable_step(const struct CriticalStep& deformed) const;
+  void check_tunnelling(const struct NodeTravel& travel) const;
   std::string step_origin() const;
-  void redistribute();
+  // `detecting`: a detection at the current positions follows at once (the halo is built for it,
+  // and the last detection is not repeated).
+  void redistribute(bool detecting = false);
   TravellingState travelling_state() const;
   void rebind_stages(TravellingState& state, bool detected);
   bool share_broken_joints(bool detection_due);
@@ -191,7 +194,12 @@ class Simulation {
   const Communicator* comm_ = nullptr;
   std::unique_ptr<Distribution> distribution_;  // N ranks only
   bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step
-  bool halo_in_flight_ = false;                 // ghost exchange posted, not yet completed
+  // N ranks: whether the step ahead detects because a node went more than buffer/2 (from the last
+  // step's reduction, the same on every rank; −1 unknown: before the first step, after a restart).
+  int detection_due_ = -1;
+  bool moved_since_distribution_ = false;  // positions changed since the halo was built
+  double tunnel_size_ = 0.0;               // m, smallest tet altitude at the start (contact scenes)
+  bool halo_in_flight_ = false;            // ghost exchange posted, not yet completed
   double reduction_seconds_ = 0.0;
   std::vector<double> reduced_terms_;         // scratch of the per-step energy reduction
   std::vector<std::int64_t> reduced_counts_;  // scratch of the broken-joint/detection reduction

@@ -272,7 +272,11 @@ std::vector<char> Distribution::exchange_rows(std::vector<char>& send,
 void Distribution::migrate(Model& model, TravellingState& state, Model& out,
                            TravellingState& out_state, const std::vector<StartJoint>* start_joints,
                            const std::vector<double>* start_reach) {
-  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false, start_reach);
+  // Boxes span the positions at the last detection too: a rank repeats that detection after the
+  // migration (rebind), however far the nodes went since.
+  const std::vector<double>* also =
+      state.x_at_detection.size() == model.nodes.x.size() ? &state.x_at_detection : nullptr;
+  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false, start_reach, also);
   // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
   std::vector<char> send, own;
   std::vector<std::size_t> send_counts;
@@ -391,7 +395,8 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
 }
 
 std::vector<std::vector<LocalIndex>> Distribution::destinations(
-    const Model& model, bool whole, const std::vector<double>* start_reach) const {
+    const Model& model, bool whole, const std::vector<double>* start_reach,
+    const std::vector<double>* x_also) const {
   // Senders: the tets this rank owns, or (at the start, every rank holding the whole model) all.
   const TetArrays& tets = model.tets;
   const int ranks = comm_.size();
@@ -402,6 +407,14 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     double* b = &tet_boxes[6 * static_cast<std::size_t>(t)];
     tet_box(model, t, b);
+    if (x_also)
+      for (int c = 0; c < 4; ++c) {
+        const LocalIndex n = model.tets.nodes[4 * static_cast<std::size_t>(t) + c];
+        for (int k = 0; k < 3; ++k) {
+          b[k] = std::min(b[k], (*x_also)[3 * static_cast<std::size_t>(n) + k]);
+          b[3 + k] = std::max(b[3 + k], (*x_also)[3 * static_cast<std::size_t>(n) + k]);
+        }
+      }
     if (!sends(t)) continue;
     sums[0] += std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
     sums[1] += 1.0;

@@ -133,9 +133,11 @@ class Distribution {
   // the cells within reach of each tet it will own.  `whole`: every rank holds the whole model
   // (the start) and all tets send, without exchanging claims; else the owned tets send.
   // `start_reach`: a lower bound of each local tet's reach (the distributed start's blocks do not
-  // hold their neighbours in other blocks).
+  // hold their neighbours in other blocks).  `x_also`: other positions per local node (those of
+  // the last contact detection) that each tet's box must span as well.
   std::vector<std::vector<LocalIndex>> destinations(
-      const Model& model, bool whole, const std::vector<double>* start_reach = nullptr) const;
+      const Model& model, bool whole, const std::vector<double>* start_reach = nullptr,
+      const std::vector<double>* x_also = nullptr) const;
   void update_report(const Model& model);
 
   Communicator comm_;
