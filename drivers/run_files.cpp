@@ -61,8 +61,9 @@ RunFiles::RunFiles(const std::string& directory, const std::vector<std::string>&
   if (xdmf_) xdmf_series_ = std::make_unique<XdmfSeries>(directory, "frames", rank == 0);
   if (rank_ != 0) return;
   energy_.open(std::filesystem::path(directory) / "energy.csv");
+  // Columns added after the first release go at the end, so that readers by position still work.
   energy_ << "time,kinetic,strain,gravity,contact,joint,dissipated_fracture,dissipated_friction,"
-             "dissipated_damping,dissipated_boundary,external_work,total,balance_error\n";
+             "dissipated_damping,external_work,total,balance_error,dissipated_boundary\n";
   bodies_.open(std::filesystem::path(directory) / "bodies.csv");
   bodies_ << bodies_header;
   energy_ << std::setprecision(12);
@@ -75,8 +76,8 @@ void RunFiles::write_energy_row(double time, const EnergyTerms& e, double balanc
   if (rank_ != 0) return;
   energy_ << time << ',' << e.kinetic << ',' << e.strain << ',' << e.gravity << ',' << e.contact
           << ',' << e.joint << ',' << e.dissipated_fracture << ',' << e.dissipated_friction << ','
-          << e.dissipated_damping << ',' << e.dissipated_boundary << ',' << e.external_work << ','
-          << e.total() << ',' << balance_error << '\n';
+          << e.dissipated_damping << ',' << e.external_work << ',' << e.total() << ','
+          << balance_error << ',' << e.dissipated_boundary << '\n';
   energy_.flush();
   if (!energy_) throw IoError("cannot write " + directory_ + "/energy.csv (disk full?)");
 }
