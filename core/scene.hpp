@@ -154,6 +154,7 @@ struct RampSpec {
 // null in the scene stay free: mask), a base motion of some bodies, or a time-varying gravity.
 struct LoadSpec {
   enum class Kind { velocity, base_motion, tilt, ramp } kind = Kind::velocity;
+  std::string name;         // for output.histories columns (default load<index in the list>)
   std::vector<int> bodies;  // body indices (empty: use region)
   std::optional<RegionSpec> region;
   Vec3 velocity = Vec3::Zero();  // m/s
@@ -161,6 +162,25 @@ struct LoadSpec {
   BaseMotionSpec base_motion;    // kind == base_motion (all components prescribed)
   TiltSpec tilt;                 // kind == tilt
   RampSpec ramp;                 // kind == ramp
+};
+
+// A point whose displacement, velocity and stress histories.csv records, interpolated in the tet
+// that holds it at t = 0.
+struct MonitorSpec {
+  std::string name;
+  Vec3 point = Vec3::Zero();  // m, reference configuration
+  std::string where;          // "FILE:LINE:COLUMN: output.histories.monitors[i]", for messages
+};
+
+// output.histories: rows of histories.csv (drivers/histories).  Loads: reaction and mean
+// displacement of a prescribed-velocity or base-motion load; bodies: mean displacement and
+// resultant force; monitors: values at a point.
+struct HistoriesSpec {
+  bool enabled = false;
+  double every = -1.0;     // s between rows; 0: every step; < 0: the energy.csv interval
+  std::vector<int> loads;  // indices into Scene::loads (velocity and base-motion loads only)
+  std::vector<int> bodies;
+  std::vector<MonitorSpec> monitors;
 };
 
 struct OutputSpec {
@@ -175,6 +195,7 @@ struct OutputSpec {
   // MPI-IO hints (MPI_Info key/value, e.g. striping_factor = 16) for the xdmf frames' HDF5 files;
   // the FDEM_MPIIO_HINTS environment variable adds to and overrides these.
   std::vector<std::pair<std::string, std::string>> mpi_io_hints;
+  HistoriesSpec histories;
 };
 
 // Parallel runs (docs/parallel.md): when the decomposition is revisited.

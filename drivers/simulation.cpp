@@ -18,10 +18,12 @@
 #include "core/model_builder.hpp"
 #include "core/state_hash.hpp"
 #include "core/time_step.hpp"
+#include "drivers/histories.hpp"
 #include "drivers/interrupt.hpp"
 #include "drivers/loads.hpp"
 #include "drivers/mesh_files.hpp"
 #include "drivers/mesh_generators.hpp"
+#include "drivers/output_times.hpp"
 #include "drivers/process_memory.hpp"
 #include "drivers/restart_check.hpp"
 #include "drivers/run_files.hpp"
@@ -51,18 +53,6 @@ class Timed {
   StageClock& clock_;
   std::chrono::steady_clock::time_point start_;
 };
-
-// The first of next, next + every, next + 2 every, ... after `now` (s).  Many intervals within
-// one step are skipped at once (the scene reader guarantees every ≥ 1e-12 time.end, so that
-// next + every > next); the same sums as adding `every` one at a time when they are few.
-double next_output_time(double next, double now, double every) {
-  if (next <= now) {
-    const double skipped = std::floor((now - next) / every);
-    if (skipped > 16) next += (skipped - 1) * every;
-  }
-  while (next <= now) next += every;
-  return next;
-}
 
 // Steps between two checks of the deformed mesh's stable step against the time step (the
 // minimum-step guard, LS-DYNA's DTMIN idea): a pass over the tets like one internal-force pass,
@@ -194,6 +184,10 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
     }
     rebind_stages(state, false);
   }
+  // Monitors are found by tet gid (rank-independent), so before the restart and the whole-model
+  // start's distribution.
+  if (scene_.output.histories.enabled && options_.write_output)
+    histories_ = std::make_unique<HistoryRecorder>(scene_, model_, comm_);
   // A restart overwrites the state of the model (and of the stages) with the checkpoint's.
   if (!options_.restart_path.empty()) {
     mark_phase(CommPhase::restart);
@@ -442,6 +436,12 @@ void Simulation::step() {
   if (plan_.gravity) {
     Timed timed(clocks_[external]);
     add_gravity(model_.gravity, nodes);
+  }
+
+  // 6b histories.csv row at t_n: reactions (f complete), positions x_n, before they move
+  if (histories_ && histories_->due(time_, dt_)) {
+    Timed timed(clocks_[output]);
+    histories_->sample(model_, time_, dt_);
   }
 
   // 7 integrate: central difference with prescribed velocities
@@ -750,6 +750,7 @@ void Simulation::write_outputs(bool force) {
       next_frame_time_ = scene_.time.end;
   }
   if (energy_row || frame) write_files(frame, energy_row, energy_time);
+  if (histories_) histories_->write(options_.output_dir);  // the row of this step, if it took one
   const double every = scene_.output.checkpoint_every;
   if (comm_ && every > 0 && steps_ > 0 && time_ >= next_checkpoint_time_ - 1e-12 * dt_) {
     next_checkpoint_time_ = next_output_time(next_checkpoint_time_, time_ + 1e-12 * dt_, every);

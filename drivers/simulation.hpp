@@ -23,6 +23,7 @@ struct TravellingState;
 class ContactStage;
 class JointStage;
 class LoadSchedule;
+class HistoryRecorder;
 
 struct RunOptions {
   std::string output_dir = "out";
@@ -167,8 +168,9 @@ class Simulation {
   std::unique_ptr<RunFiles> files_;
   std::unique_ptr<ContactStage> contact_;
   std::unique_ptr<JointStage> joints_;
-  std::unique_ptr<LoadSchedule> loads_;  // time-dependent loads (drivers/loads)
-  WorkAccumulator joint_friction_;       // Coulomb slip inside joints (part of dissipated_friction)
+  std::unique_ptr<LoadSchedule> loads_;         // time-dependent loads (drivers/loads)
+  std::unique_ptr<HistoryRecorder> histories_;  // histories.csv (output.histories), with output
+  WorkAccumulator joint_friction_;  // Coulomb slip inside joints (part of dissipated_friction)
   const Communicator* comm_ = nullptr;
   std::unique_ptr<Distribution> distribution_;  // N ranks only
   bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step
