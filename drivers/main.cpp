@@ -71,6 +71,15 @@ int check(const fdem::Scene& scene) {
   if (model.joints.size() > 0)
     std::printf("  joints: %d cohesive joints, %zu laws\n", model.joints.size(),
                 sim->joint_stage() ? sim->joint_stage()->laws().size() : std::size_t{0});
+  if (const fdem::HistoriesSpec& h = scene.output.histories; h.enabled) {
+    // Monitors were placed in their tets when the simulation was made (or refused there).
+    std::string what;
+    for (const int l : h.loads) what += " load " + scene.loads[l].name + ",";
+    for (const int b : h.bodies) what += " body " + scene.bodies[b].name + ",";
+    for (const auto& m : h.monitors) what += " monitor " + m.name + ",";
+    what.pop_back();
+    std::printf("  histories.csv:%s\n", what.c_str());
+  }
   std::printf("  stages:\n");
   for (const auto& s : sim->plan().describe()) std::printf("    %s\n", s.c_str());
   return 0;
