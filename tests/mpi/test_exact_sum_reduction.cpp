@@ -16,7 +16,9 @@ using namespace fdem;
 
 namespace {
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 // Value i of sum s: magnitudes from 1e-300 to 1e300, signs mixed.
 double value(int s, int i) {

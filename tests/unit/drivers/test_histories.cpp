@@ -113,8 +113,9 @@ TEST_CASE("histories: the reaction of a statically stretched bar is E·A·ε",
   }
 }
 
-TEST_CASE("histories: monitors interpolate linear fields exactly; a uniform stretch's stress",
-          "[drivers][histories]") {
+TEST_CASE(
+    "histories: monitors interpolate linear fields exactly, and the stress of a uniform stretch",
+    "[drivers][histories]") {
   Scene scene = builders::basic_scene(1.0);
   scene.materials.push_back(builders::elastic_material(2000, 3.0e9, 0.3));
   scene.bodies.push_back(builders::box_body("block", Vec3(-1, 0, 2), Vec3(1, 0.5, 3), 4, 3, 2));
