@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/materials.hpp"
+#include "core/time_history.hpp"
 #include "core/types.hpp"
 
 namespace fdem {
@@ -142,26 +143,43 @@ struct TiltSpec {
   double start = 0.0;         // s
 };
 
-// Uniform horizontal acceleration added to gravity: direction·min(rate·(t − start), max).
+// Uniform horizontal acceleration added to gravity: direction·min(rate·(t − start), max), or
+// direction·history(t) when a history is given instead of rate and max.
 struct RampSpec {
-  Vec3 direction = Vec3::UnitX();  // unit vector
-  double rate = 0.0;               // m/s³
-  double max = 0.0;                // m/s²
-  double start = 0.0;              // s
+  Vec3 direction = Vec3::UnitX();      // unit vector
+  double rate = 0.0;                   // m/s³
+  double max = 0.0;                    // m/s²
+  double start = 0.0;                  // s
+  std::optional<TimeHistory> history;  // m/s²
+};
+
+// A pressure or traction on the boundary faces of a region (faces whose three corners lie in
+// the box at t = 0) or of bodies (all their boundary faces).  Boundary faces belong to one tet
+// and are not a joint's face.  Pressure p pushes along the inward normal: with `follower` the
+// force is −p·a on the current area vector a (finite strain, rotating faces), else −p·A on the
+// reference one.  Traction t (Pa, fixed direction) gives t·A on the reference area.  Either is
+// multiplied by LoadSpec::history(t).
+struct SurfaceLoadSpec {
+  enum class Kind { pressure, traction } kind = Kind::pressure;
+  double pressure = 0.0;         // Pa, > 0 compresses
+  Vec3 traction = Vec3::Zero();  // Pa
+  bool follower = true;          // pressure only
 };
 
 // A load: prescribed velocity on the nodes of some bodies or of a region (components given as
 // null in the scene stay free: mask), a base motion of some bodies, or a time-varying gravity.
 struct LoadSpec {
-  enum class Kind { velocity, base_motion, tilt, ramp } kind = Kind::velocity;
+  enum class Kind { velocity, base_motion, tilt, ramp, surface } kind = Kind::velocity;
   std::string name;         // for output.histories columns (default load<index in the list>)
   std::vector<int> bodies;  // body indices (empty: use region)
   std::optional<RegionSpec> region;
-  Vec3 velocity = Vec3::Zero();  // m/s
+  Vec3 velocity = Vec3::Zero();  // m/s, × history(t)
   unsigned dof_mask = 7;         // bit k set: component k prescribed
+  TimeHistory history;           // velocity and surface loads: factor of the magnitude (1)
   BaseMotionSpec base_motion;    // kind == base_motion (all components prescribed)
   TiltSpec tilt;                 // kind == tilt
   RampSpec ramp;                 // kind == ramp
+  SurfaceLoadSpec surface;       // kind == surface (bodies or region select the faces)
 };
 
 // A point whose displacement, velocity and stress histories.csv records, interpolated in the tet

@@ -1,6 +1,7 @@
 // Time-dependent loads (scene `loads:`): ground motion from an acceleration record, tilting
-// tables and horizontal-acceleration ramps.  LoadSchedule::apply is the one place where they are
-// evaluated each step; constant prescribed velocities stay in apply_constraints.
+// tables, horizontal-acceleration ramps and prescribed velocities with a time history.
+// LoadSchedule::apply is the one place where they are evaluated each step; constant prescribed
+// velocities stay in apply_constraints.
 #pragma once
 
 #include <string>
@@ -36,10 +37,11 @@ class LoadSchedule {
 
   bool changes_gravity() const { return changes_gravity_; }
   bool moves_bases() const { return !bases_.empty(); }
-  bool active() const { return changes_gravity_ || moves_bases(); }
+  bool active() const { return changes_gravity_ || moves_bases() || !varying_.empty(); }
 
   // Sets the model's loads for the step from t to t + dt: gravity at t (forces at t), base
-  // nodes' prescribed velocity at t + dt/2 (central difference stores half-step velocities).
+  // nodes' and varying loads' prescribed velocity at t + dt/2 (central difference stores
+  // half-step velocities).
   void apply(double t, double dt, Model& model) const;
 
   const Scene& scene() const { return scene_; }
@@ -52,8 +54,18 @@ class LoadSchedule {
     std::vector<std::int32_t> bodies;
     std::vector<LocalIndex> nodes;
   };
+  // A prescribed velocity × history(t): the nodes and components it sets (a later load in the
+  // scene that holds the same component sets it instead, as in apply_constraints).
+  struct Varying {
+    LoadSpec load;
+    int index = -1;  // in the scene's loads
+    std::vector<LocalIndex> nodes;
+    std::vector<std::uint8_t> masks;
+  };
   Scene scene_;  // gravity, tilts and ramps (records filled)
   std::vector<Base> bases_;
+  std::vector<Varying> varying_;
+  std::vector<LoadSpec> all_loads_;
   bool changes_gravity_ = false;
 };
 
