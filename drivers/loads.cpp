@@ -129,6 +129,8 @@ LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
         throw InputError(scene.source_path +
                          ": a base motion needs at least two samples of time and acceleration");
       bases_.push_back(std::move(base));
+    } else if (load.kind == LoadSpec::Kind::surface) {
+      surfaces_.push_back({load, static_cast<int>(&load - scene.loads.data()), {}});
     } else if (load.kind == LoadSpec::Kind::velocity && load.history.varies()) {
       varying_.push_back({load, static_cast<int>(&load - scene.loads.data()), {}, {}});
     }
@@ -138,6 +140,7 @@ LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
 }
 
 void LoadSchedule::rebind(const Model& model) {
+  for (Surface& surface : surfaces_) surface.faces = select_surface_faces(model, surface.load);
   if (!varying_.empty()) {
     // Which load sets each prescribed component: the last in scene order that holds the node, as
     // apply_constraints sets them (fixed bodies first).
@@ -189,6 +192,28 @@ void LoadSchedule::apply(double t, double dt, Model& model) const {
           model.nodes.prescribed_velocity[3 * static_cast<std::size_t>(varying.nodes[i]) + k] =
               v[k];
   }
+}
+
+void LoadSchedule::add_surface_forces(double t, Model& model) {
+  for (Surface& surface : surfaces_)
+    fdem::add_surface_forces(surface.load.surface, surface.load.history(t), surface.faces,
+                             model.nodes);
+}
+
+double LoadSchedule::surface_power(const Model& model) const {
+  double power = 0.0;
+  for (const Surface& surface : surfaces_) power += fdem::surface_power(surface.faces, model.nodes);
+  return power;
+}
+
+std::vector<std::pair<int, std::int64_t>> LoadSchedule::surface_face_counts() const {
+  std::vector<std::pair<int, std::int64_t>> counts;
+  for (const Surface& surface : surfaces_) {
+    std::int64_t owned = 0;
+    for (const std::uint8_t o : surface.faces.owned) owned += o;
+    counts.emplace_back(surface.index, owned);
+  }
+  return counts;
 }
 
 }  // namespace fdem

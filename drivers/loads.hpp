@@ -9,6 +9,7 @@
 
 #include "core/model.hpp"
 #include "core/scene.hpp"
+#include "core/surface_loads.hpp"
 
 namespace fdem {
 
@@ -38,11 +39,21 @@ class LoadSchedule {
   bool changes_gravity() const { return changes_gravity_; }
   bool moves_bases() const { return !bases_.empty(); }
   bool active() const { return changes_gravity_ || moves_bases() || !varying_.empty(); }
+  bool has_surface_loads() const { return !surfaces_.empty(); }
 
   // Sets the model's loads for the step from t to t + dt: gravity at t (forces at t), base
   // nodes' and varying loads' prescribed velocity at t + dt/2 (central difference stores
   // half-step velocities).
   void apply(double t, double dt, Model& model) const;
+
+  // Surface loads (stage 6): adds each one's face forces at time t (s) to the nodes, in scene
+  // order, and returns nothing; surface_power then gives Σ F·v over the owned corners (W) for the
+  // work: before the integration with v(t − dt/2), after it with v(t + dt/2).
+  void add_surface_forces(double t, Model& model);
+  double surface_power(const Model& model) const;
+  // Per surface load (scene order): its index in the scene's loads and the number of faces
+  // whose tet is owned here (to refuse a load that acts on no face).
+  std::vector<std::pair<int, std::int64_t>> surface_face_counts() const;
 
   const Scene& scene() const { return scene_; }
   // The model's nodes changed (parallel redistribution): list the base nodes again.
@@ -65,6 +76,12 @@ class LoadSchedule {
   Scene scene_;  // gravity, tilts and ramps (records filled)
   std::vector<Base> bases_;
   std::vector<Varying> varying_;
+  struct Surface {
+    LoadSpec load;
+    int index = -1;  // in the scene's loads
+    SurfaceFaces faces;
+  };
+  std::vector<Surface> surfaces_;
   std::vector<LoadSpec> all_loads_;
   bool changes_gravity_ = false;
 };

@@ -92,7 +92,8 @@ std::vector<std::string> StagePlan::describe() const {
   s.push_back(contact ? "contact detection + contact forces"
                       : "contact: skipped (no contact partners)");
   s.push_back(std::string("external forces: ") + (gravity ? "gravity" : "none") +
-              (kinematic_loads ? " + prescribed velocities" : ""));
+              (kinematic_loads ? " + prescribed velocities" : "") +
+              (surface_loads ? " + surface loads" : ""));
   s.push_back("integrate (central difference)");
   return s;
 }
@@ -118,7 +119,21 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   const auto global_sum = [&](auto v) { return distributed ? comm_->sum(v) : v; };
   loads_ = std::make_unique<LoadSchedule>(scene_, model_);
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
-  plan_.kinematic_loads = !scene_.loads.empty();
+  plan_.kinematic_loads =
+      std::any_of(scene_.loads.begin(), scene_.loads.end(), [](const LoadSpec& l) {
+        return l.kind == LoadSpec::Kind::velocity || l.kind == LoadSpec::Kind::base_motion;
+      });
+  plan_.surface_loads = loads_->has_surface_loads();
+  // A surface load that acts on no face is a mistake in the scene (a region beside the model).
+  for (const auto& [index, owned] : loads_->surface_face_counts())
+    if (global_sum(owned) == 0) {
+      const LoadSpec& load = scene_.loads[static_cast<std::size_t>(index)];
+      throw InputError(scene_.source_path + ": loads[" + std::to_string(index) + "] ('" +
+                       load.name + "'): no boundary face " +
+                       (load.region ? "has its three corners in the region's box at t = 0"
+                                    : "belongs to its bodies") +
+                       " (faces shared by two tets or by a joint are not boundary faces)");
+    }
 
   plan_.contact = ContactStage::needed(model_);
   const CriticalStep critical = fdem::critical_time_step(model_);
@@ -438,6 +453,14 @@ void Simulation::step() {
     add_gravity(model_.gravity, nodes);
   }
 
+  // 6 surface loads: pressure and traction on boundary faces, at t_n
+  double surface_power_before = 0.0;  // W, with v(t_n − dt/2)
+  if (plan_.surface_loads) {
+    Timed timed(clocks_[external]);
+    loads_->add_surface_forces(time_, model_);
+    surface_power_before = loads_->surface_power(model_);
+  }
+
   // 6b histories.csv row at t_n: reactions (f complete), positions x_n, before they move
   if (histories_ && histories_->due(time_, dt_)) {
     Timed timed(clocks_[output]);
@@ -451,6 +474,11 @@ void Simulation::step() {
     // The stored velocity is v(t − dt/2): at the start turn the initial v(0) into it (half kick).
     if (steps_ == 0) start_half_step(nodes);
     motion = integrate_central_difference(dt_, nodes);
+    // The surface loads' work goes with the reactions' (external_work), by the same trapezoid.
+    if (plan_.surface_loads) {
+      motion.constraint_work_before += 0.5 * dt_ * surface_power_before;
+      motion.constraint_work_after += 0.5 * dt_ * loads_->surface_power(model_);
+    }
   }
 
   // 8 halo update: post the ghost exchange now, complete it at the start of the next step

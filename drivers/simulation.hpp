@@ -39,6 +39,7 @@ struct StagePlan {
   bool contact = false;
   bool gravity = false;
   bool kinematic_loads = false;
+  bool surface_loads = false;  // pressure or traction on boundary faces
   std::vector<std::string> describe() const;
 };
 
