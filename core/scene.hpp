@@ -180,6 +180,7 @@ struct LoadSpec {
   TiltSpec tilt;                 // kind == tilt
   RampSpec ramp;                 // kind == ramp
   SurfaceLoadSpec surface;       // kind == surface (bodies or region select the faces)
+  std::string where;             // "FILE:LINE:COLUMN: loads[i].region" (or .bodies), for messages
 };
 
 // A point whose displacement, velocity and stress histories.csv records, interpolated in the tet

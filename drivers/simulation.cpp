@@ -128,8 +128,10 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   for (const auto& [index, owned] : loads_->surface_face_counts())
     if (global_sum(owned) == 0) {
       const LoadSpec& load = scene_.loads[static_cast<std::size_t>(index)];
-      throw InputError(scene_.source_path + ": loads[" + std::to_string(index) + "] ('" +
-                       load.name + "'): no boundary face " +
+      throw InputError((load.where.empty()
+                            ? scene_.source_path + ": loads[" + std::to_string(index) + "]"
+                            : load.where) +
+                       ": surface load '" + load.name + "' acts on no face: no boundary face " +
                        (load.region ? "has its three corners in the region's box at t = 0"
                                     : "belongs to its bodies") +
                        " (faces shared by two tets or by a joint are not boundary faces)");

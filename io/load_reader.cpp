@@ -219,6 +219,8 @@ void read_loads(const Reader& r, const YAML::Node& loads, const std::string& sce
     if (!surface && l["follower"])
       r.fail(l["follower"], lp + ".follower", "'follower' applies to a pressure load only");
     read_where(r, l, lp, body_names, load);
+    load.where = l["region"] ? r.location(l["region"], lp + ".region")
+                             : r.location(l["bodies"], lp + ".bodies");
     if (const YAML::Node h = l["history"])
       load.history = read_time_history(r, h, lp + ".history", scene_dir);
     if (surface) {

@@ -12,6 +12,10 @@ scripts/install-deps.sh):
                                its force-displacement curve along the direction it moved most
   histories_body_NAME.png      a body's mean displacement and resultant force against time
   histories_monitor_NAME.png   a monitor's displacement, velocity and stress against time
+  stress_strain_NAME.png       with --specimen NAME AREA LENGTH: load NAME's reaction over AREA
+                               (m²) against its displacement over LENGTH (m), along the direction
+                               it moved most (a compression test's stress-strain curve); --line
+                               LABEL=MPA draws a reference stress on it (repeatable)
 
 Files that are missing are skipped; exit code 2 when OUT holds none of the CSVs.
 """
@@ -130,6 +134,25 @@ def plot_monitor(plt, name, h, t, label, out, fmt, dpi):
     return save(fig, out, f"histories_monitor_{name}", fmt, dpi)
 
 
+def plot_stress_strain(plt, name, area, length, lines, h, out, fmt, dpi):
+    """Load NAME's reaction / area (MPa) against displacement / length (%), both positive."""
+    col = lambda q: h[f"load.{name}.{q}"]
+    axis = max("xyz", key=lambda a: max((abs(v) for v in col("u" + a)), default=0.0))
+    u, f = col("u" + axis), col("f" + axis)
+    sign = -1.0 if sum(u) < 0 else 1.0
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot([100 * sign * v / length for v in u], [1e-6 * sign * v / area for v in f], color="C3",
+            label=f"load '{name}'")
+    for k, (label, stress) in enumerate(lines):
+        ax.axhline(stress, color=f"C{k}", linestyle="--", linewidth=1, label=f"{label} {stress:g} MPa")
+    ax.set_xlabel(f"strain {'−' if sign < 0 else ''}u{axis} / {length:g} m (%)")
+    ax.set_ylabel(f"stress {'−' if sign < 0 else ''}f{axis} / {area:g} m² (MPa)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small")
+    ax.set_title(f"stress-strain, load '{name}' (histories.csv)")
+    return save(fig, out, f"stress_strain_{name}", fmt, dpi)
+
+
 def save(fig, out, stem, fmt, dpi):
     path = os.path.join(out, f"{stem}.{fmt}")
     fig.tight_layout()
@@ -143,7 +166,19 @@ def main():
     parser.add_argument("out", help="an fdem output directory (fdem run ... -o OUT)")
     parser.add_argument("--format", default="png", help="image format (default png)")
     parser.add_argument("--dpi", type=int, default=120)
+    parser.add_argument("--specimen", nargs=3, action="append", default=[],
+                        metavar=("LOAD", "AREA", "LENGTH"),
+                        help="also draw LOAD's stress-strain curve (area m², length m)")
+    parser.add_argument("--line", action="append", default=[], metavar="LABEL=MPA",
+                        help="a reference stress on the stress-strain curves")
     args = parser.parse_args()
+    try:
+        specimens = [(n, float(a), float(l)) for n, a, l in args.specimen]
+        lines = [(x.rsplit("=", 1)[0], float(x.rsplit("=", 1)[1])) for x in args.line]
+    except (ValueError, IndexError):
+        parser.error("--specimen takes LOAD AREA LENGTH (numbers in m², m), --line LABEL=MPA")
+    if any(a <= 0 or l <= 0 for _, a, l in specimens):
+        parser.error("--specimen: AREA and LENGTH must be > 0")
     try:
         import matplotlib
         matplotlib.use("Agg")  # no display needed
@@ -179,6 +214,13 @@ def main():
                 elif kind == "monitor":
                     written.append(plot_monitor(plt, name, h, t, label, args.out, args.format,
                                                 args.dpi))
+            for name, area, length in specimens:
+                if f"load.{name}.fx" not in h:
+                    print(f"plot.py: --specimen: histories.csv has no load '{name}'",
+                          file=sys.stderr)
+                    return 2
+                written.append(plot_stress_strain(plt, name, area, length, lines, h, args.out,
+                                                  args.format, args.dpi))
         plt.close("all")
     for path in written:
         print(path)

@@ -27,6 +27,19 @@ for stem in energy balance histories_load_left histories_load_right histories_lo
     exit 1
   fi
 done
+# A load's stress-strain curve (--specimen) with a reference line; an unknown load is exit 2.
+"$python" "$source/scripts/plot.py" "$work" --specimen press 0.0048 0.06 --line "limit=1.5" \
+  >/dev/null
+file="$work/stress_strain_press.png"
+if [ "$(head -c 8 "$file" 2>/dev/null | od -An -tx1 | tr -d ' \n')" != "89504e470d0a1a0a" ]; then
+  echo "plot_test: $file is missing or not a PNG" >&2
+  exit 1
+fi
+set +e
+"$python" "$source/scripts/plot.py" "$work" --specimen nosuch 1 1 2>/dev/null >/dev/null
+code=$?
+set -e
+[ "$code" -eq 2 ] || { echo "plot_test: --specimen nosuch gave exit code $code, not 2" >&2; exit 1; }
 # A directory without the CSVs is refused with exit code 2.
 mkdir -p "$work/empty"
 set +e
@@ -34,4 +47,4 @@ set +e
 code=$?
 set -e
 [ "$code" -eq 2 ] || { echo "plot_test: an empty directory gave exit code $code, not 2" >&2; exit 1; }
-echo "plot_test: 9 PNGs drawn with $python"
+echo "plot_test: 10 PNGs drawn with $python"

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "cli_test_support.hpp"
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
 #include "drivers/scene_builders.hpp"
@@ -125,5 +126,36 @@ TEST_CASE("surface loads: a region that holds no boundary face is refused",
   load.name = "middle";
   scene.loads.push_back(load);
   CHECK_THROWS_WITH(builders::quiet_simulation(scene),
-                    Contains("loads[0] ('middle'): no boundary face has its three corners"));
+                    Contains("verification: loads[0]: surface load 'middle' acts on no face: no "
+                             "boundary face has its three corners"));
+}
+
+TEST_CASE("surface loads: fdem check and run accept and refuse alike, naming the key's line",
+          "[drivers][surface_loads][cli]") {
+  fdem_test::TempDir dir;
+  const std::string scene =
+      "time: {end: 1.0e-5}\n"
+      "materials:\n"
+      "  rock: {density: 1000, elastic: {young: 1.0e9, poisson: 0.25}}\n"
+      "bodies:\n"
+      "  - {name: bar, mesh: {box: {min: [0, 0, 0], max: [1, 0.1, 0.1], cells: [4, 1, 1]}}, "
+      "material: rock}\n"
+      "loads:\n"
+      "  - {name: end, region: {box: {min: [0.99, -1, -1], max: [2, 2, 2]}}, pressure: 1.0e5}\n";
+  fdem_test::write_text(dir / "good.yaml", scene);
+  std::string bad = scene;
+  bad.replace(bad.find("[0.99, -1, -1]"), 14, "[0.4, -1, -1]");
+  bad.replace(bad.find("[2, 2, 2]"), 9, "[0.6, 2, 2]");
+  fdem_test::write_text(dir / "bad.yaml", bad);
+  const fdem_test::Outcome check = fdem_test::run_fdem(dir, "check good.yaml");
+  CHECK(check.exit_code == 0);
+  CHECK_THAT(check.out, Contains("+ surface loads"));
+  CHECK(fdem_test::run_fdem(dir, "run good.yaml -o out -q").exit_code == 0);
+  for (const char* command : {"check bad.yaml", "run bad.yaml -o out2 -q"}) {
+    const fdem_test::Outcome o = fdem_test::run_fdem(dir, command);
+    INFO(command << ": " << o.err);
+    CHECK(o.exit_code == 2);
+    CHECK_THAT(o.err, Contains("bad.yaml:7:25: loads[0].region: surface load 'end' acts on no "
+                               "face"));
+  }
 }
