@@ -164,6 +164,10 @@ struct SurfaceLoadSpec {
   double pressure = 0.0;         // Pa, > 0 compresses
   Vec3 traction = Vec3::Zero();  // Pa
   bool follower = true;          // pressure only
+  // A Gmsh physical surface of the (one) body's mesh file: only faces that coincide with one of
+  // its triangles (9 coordinates each, m) are loaded.  Empty: every boundary face of the bodies.
+  std::string physical;
+  std::vector<double> triangles;
 };
 
 // A load: prescribed velocity on the nodes of some bodies or of a region (components given as

@@ -43,6 +43,27 @@ SurfaceFaces select_surface_faces(const Model& model, const LoadSpec& load) {
   std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
     return a.key != b.key ? a.key < b.key : a.tet < b.tet;
   });
+  // A physical surface: its triangles by their sorted corners (the file's coordinates, which the
+  // model's reference positions are, bit for bit).
+  using Corner = std::array<double, 3>;
+  using Triangle = std::array<Corner, 3>;
+  const auto triangle_of = [](Corner a, Corner b, Corner c) {
+    Triangle t{a, b, c};
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  std::vector<Triangle> wanted;
+  const std::vector<double>& tri = load.surface.triangles;
+  for (std::size_t i = 0; i + 9 <= tri.size(); i += 9)
+    wanted.push_back(triangle_of({tri[i], tri[i + 1], tri[i + 2]},
+                                 {tri[i + 3], tri[i + 4], tri[i + 5]},
+                                 {tri[i + 6], tri[i + 7], tri[i + 8]}));
+  std::sort(wanted.begin(), wanted.end());
+  const auto corner = [&](LocalIndex n) {
+    return Corner{nodes.x0[3 * static_cast<std::size_t>(n)],
+                  nodes.x0[3 * static_cast<std::size_t>(n) + 1],
+                  nodes.x0[3 * static_cast<std::size_t>(n) + 2]};
+  };
   std::vector<std::pair<LocalIndex, int>> chosen;  // (tet, corner)
   const auto inside = [&](LocalIndex n) {
     const Vec3 X = vec3_at(nodes.x0.data(), n);
@@ -62,6 +83,9 @@ SurfaceFaces select_surface_faces(const Model& model, const LoadSpec& load) {
       } else {
         const std::int32_t body = model.pieces.body_of(tets.piece[e.tet]);
         selected = std::find(load.bodies.begin(), load.bodies.end(), body) != load.bodies.end();
+        if (selected && !tri.empty())
+          selected = std::binary_search(wanted.begin(), wanted.end(),
+                                        triangle_of(corner(k[0]), corner(k[1]), corner(k[2])));
       }
       if (selected) chosen.emplace_back(e.tet, e.corner);
     }

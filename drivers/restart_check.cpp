@@ -102,6 +102,8 @@ void add_load(std::vector<std::pair<std::string, double>>& values, const LoadSpe
       values.emplace_back(key + ".pressure", load.surface.pressure);
       add_vec3(values, key + ".traction", load.surface.traction);
       values.emplace_back(key + ".follower", load.surface.follower);
+      values.emplace_back(key + ".physical.triangles",
+                          static_cast<double>(load.surface.triangles.size() / 9));
       break;
   }
   if (load.kind == LoadSpec::Kind::velocity || load.kind == LoadSpec::Kind::surface)

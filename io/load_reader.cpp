@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/gmsh_reader.hpp"
 #include "io/histories_reader.hpp"
 
 namespace fdem {
@@ -186,7 +187,7 @@ void read_loads(const Reader& r, const YAML::Node& loads, const std::string& sce
     const YAML::Node l = loads[i];
     r.check_keys(l, lp,
                  {"name", "bodies", "region", "velocity", "base_motion", "tilt", "ramp", "pressure",
-                  "traction", "follower", "history"});
+                  "traction", "follower", "history", "physical"});
     LoadSpec load;
     load.name = read_load_name(r, l, lp, scene.loads);
     if (l["tilt"] || l["ramp"]) {
@@ -223,8 +224,33 @@ void read_loads(const Reader& r, const YAML::Node& loads, const std::string& sce
                              : r.location(l["bodies"], lp + ".bodies");
     if (const YAML::Node h = l["history"])
       load.history = read_time_history(r, h, lp + ".history", scene_dir);
+    if (!surface && l["physical"])
+      r.fail(l["physical"], lp + ".physical",
+             "'physical' (a Gmsh physical surface) applies to pressure and traction loads only");
     if (surface) {
       read_surface(r, l, lp, load);
+      if (const YAML::Node ph = l["physical"]) {
+        const std::string pp = lp + ".physical";
+        if (!l["bodies"] || load.bodies.size() != 1)
+          r.fail(ph, pp,
+                 "a physical surface belongs to one body's Gmsh file: give {bodies: [one body], "
+                 "physical: NAME}");
+        const BodySpec& body = scene.bodies[static_cast<std::size_t>(load.bodies[0])];
+        if (body.mesh.kind != MeshSpec::Kind::file)
+          r.fail(ph, pp,
+                 "body '" + body.name +
+                     "' is not meshed from a Gmsh file; physical surfaces need mesh: {file: "
+                     "part.msh}");
+        load.surface.physical = r.string(ph, pp);
+        try {
+          load.surface.triangles = read_gmsh_surface(body.mesh.file, load.surface.physical);
+        } catch (const InputError& e) {
+          r.fail(ph, pp,
+                 std::string(e.what()) +
+                     " (physical surfaces are read from the .msh file, not a prepared model "
+                     "file)");
+        }
+      }
       scene.loads.push_back(load);
       continue;
     }

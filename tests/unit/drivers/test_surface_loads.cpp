@@ -7,8 +7,10 @@
 #include "cli_test_support.hpp"
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
+#include "core/surface_loads.hpp"
 #include "drivers/scene_builders.hpp"
 #include "drivers/simulation.hpp"
+#include "io/scene_reader.hpp"
 
 using namespace fdem;
 using Catch::Matchers::Contains;
@@ -158,4 +160,71 @@ TEST_CASE("surface loads: fdem check and run accept and refuse alike, naming the
     CHECK_THAT(o.err, Contains("bad.yaml:7:25: loads[0].region: surface load 'end' acts on no "
                                "face"));
   }
+}
+
+TEST_CASE("surface loads: a Gmsh physical surface selects the faces on its triangles",
+          "[drivers][surface_loads][gmsh]") {
+  // cube_two_volumes: a unit cube of two volumes, 2D physical group "bottom" (10) = the faces at
+  // z = 0.  The pressure on it pushes the cube up with p·1 m², and it chooses the faces a thin
+  // region at z = 0 chooses; ASCII and binary files alike.
+  for (const char* file : {"cube_two_volumes_ascii.msh", "cube_two_volumes_binary.msh"}) {
+    INFO(file);
+    const std::string mesh = std::string(FDEM_TEST_DATA) + "/gmsh/" + file;
+    const auto scene_text = [&](const std::string& load) {
+      return "time: {end: 1.0e-5}\n"
+             "materials:\n"
+             "  rock: {density: 1000, elastic: {young: 1.0e9, poisson: 0.25}}\n"
+             "bodies:\n"
+             "  - {name: cube, mesh: {file: " +
+             mesh +
+             "}, material: rock}\n"
+             "loads:\n"
+             "  - " +
+             load + "\n";
+    };
+    const auto resultant = [&](const std::string& load, int& faces) {
+      const Scene scene = parse_scene(scene_text(load), "scene.yaml");
+      auto sim = builders::quiet_simulation(scene);
+      Model& model = sim->model();
+      SurfaceFaces chosen = select_surface_faces(model, scene.loads[0]);
+      faces = chosen.size();
+      std::fill(model.nodes.f.begin(), model.nodes.f.end(), 0.0);
+      add_surface_forces(scene.loads[0].surface, 1.0, chosen, model.nodes);
+      return surface_resultant(chosen);
+    };
+    int by_group = 0, by_region = 0;
+    const Vec3 group = resultant("{bodies: [cube], physical: bottom, pressure: 1.0e3}", by_group);
+    const Vec3 region = resultant(
+        "{region: {box: {min: [-1, -1, -1], max: [2, 2, 1.0e-9]}}, pressure: 1.0e3}", by_region);
+    CHECK(by_group > 0);
+    CHECK(by_group == by_region);
+    CHECK((group - Vec3(0, 0, 1.0e3)).norm() < 1e-9);
+    CHECK((region - group).norm() < 1e-9);
+    int by_number = 0;
+    resultant("{bodies: [cube], physical: '10', pressure: 1.0e3}", by_number);
+    CHECK(by_number == by_group);
+    // Errors: an unknown group lists the file's 2D groups; a volume group is not a surface.
+    try {
+      parse_scene(scene_text("{bodies: [cube], physical: top, pressure: 1.0e3}"), "scene.yaml");
+      FAIL("an unknown physical surface was accepted");
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Contains("scene.yaml:7:") && Contains("loads[0].physical") &&
+                               Contains("no 2D physical group 'top'") &&
+                               Contains("Its 2D groups: bottom (10)"));
+    }
+  }
+  const std::string box =
+      "time: {end: 1.0e-5}\nmaterials:\n  rock: {density: 1000, elastic: {young: 1.0e9, "
+      "poisson: 0.25}}\nbodies:\n  - {name: b, mesh: {box: {min: [0, 0, 0], max: [1, 1, 1]}}, "
+      "material: rock}\nloads:\n  - ";
+  CHECK_THROWS_WITH(parse_scene(box + "{bodies: [b], physical: top, pressure: 1}\n", "s.yaml"),
+                    Contains("loads[0].physical") && Contains("not meshed from a Gmsh file"));
+  CHECK_THROWS_WITH(
+      parse_scene(box + "{region: {box: {min: [0, 0, 0], max: [1, 1, 1]}}, physical: top, "
+                        "pressure: 1}\n",
+                  "s.yaml"),
+      Contains("loads[0].physical") && Contains("{bodies: [one body], physical: NAME}"));
+  CHECK_THROWS_WITH(
+      parse_scene(box + "{bodies: [b], physical: top, velocity: [0, 0, 0]}\n", "s.yaml"),
+      Contains("loads[0].physical") && Contains("pressure and traction loads only"));
 }
