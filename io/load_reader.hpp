@@ -20,7 +20,7 @@ void read_loads(const scene_yaml::Reader& r, const YAML::Node& loads, const std:
 
 // A time history at key `path`: a number (constant), {table: [[t, v], ...]}, {file: amp.csv}
 // (rows "time, value"; path relative to the scene) or {smooth_step: {start, end, from, to,
-// shape}}.  `unit` names the values' unit for messages ("-" for a factor).
+// shape}}.
 TimeHistory read_time_history(const scene_yaml::Reader& r, const YAML::Node& node,
                               const std::string& path, const std::string& scene_dir);
 
