@@ -36,6 +36,20 @@ FrameArray filtered(const FrameField& f, std::size_t all_entries,
 
 }  // namespace
 
+Mat3 elastic_cauchy_stress(const Model& model, LocalIndex t) {
+  const TetArrays& tets = model.tets;
+  Vec3 x[4];
+  for (int k = 0; k < 4; ++k) x[k] = vec3_at(model.nodes.x.data(), tets.nodes[4 * t + k]);
+  const Mat3 F = edge_matrix(x) * Eigen::Map<const Mat3>(tets.dm_inv.data() + 9 * t);
+  const double J = F.determinant();
+  if (!(J > 0.0)) return Mat3::Zero();
+  const MaterialProperties& mat = model.materials[tets.material[t]];
+  const Mat3 P = mat.model == ElasticModel::neo_hookean
+                     ? NeoHookean{mat.lame}.first_piola(F)
+                     : StVenantKirchhoff{mat.lame}.first_piola(F);
+  return P * F.transpose() / J;
+}
+
 std::vector<LocalIndex> owned_tets(const TetArrays& tets) {
   std::vector<LocalIndex> cells;
   for (LocalIndex t = 0; t < tets.size(); ++t)
@@ -89,19 +103,7 @@ std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<L
     FrameArray sigma = real_array("stress", true, 9, n_cells);
     FrameArray mises = real_array("von_mises", true, 1, n_cells);
     for (std::size_t c = 0; c < n_cells; ++c) {
-      const LocalIndex t = cells[c];
-      Vec3 x[4];
-      for (int k = 0; k < 4; ++k) x[k] = vec3_at(nodes.x.data(), tets.nodes[4 * t + k]);
-      const Mat3 F = edge_matrix(x) * Eigen::Map<const Mat3>(tets.dm_inv.data() + 9 * t);
-      const MaterialProperties& mat = model.materials[tets.material[t]];
-      Mat3 cauchy = Mat3::Zero();  // an inverted tet (J <= 0) shows zero stress
-      const double J = F.determinant();
-      if (J > 0.0) {
-        const Mat3 P = mat.model == ElasticModel::neo_hookean
-                           ? NeoHookean{mat.lame}.first_piola(F)
-                           : StVenantKirchhoff{mat.lame}.first_piola(F);
-        cauchy = P * F.transpose() / J;
-      }
+      const Mat3 cauchy = elastic_cauchy_stress(model, cells[c]);
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) sigma.real[9 * c + 3 * i + j] = cauchy(i, j);
       const Mat3 dev = cauchy - cauchy.trace() / 3.0 * Mat3::Identity();

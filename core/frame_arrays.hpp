@@ -40,6 +40,10 @@ struct FrameArray {
 // ascending gid (all of them on one rank).
 std::vector<LocalIndex> owned_tets(const TetArrays& tets);
 
+// Cauchy stress (Pa) of local tet t at the current positions, from its elastic law (no viscous
+// part); zero for an inverted tet (J <= 0).  Frames and history monitors show this stress.
+Mat3 elastic_cauchy_stress(const Model& model, LocalIndex t);
+
 // The arrays of a tet frame for the local tets `cells` and the local nodes `points`, in this
 // order: point data gid (i64), displacement (x − x0, m) and velocity (m/s) if in `fields`; cell
 // data gid (i64), piece, body, material (i32), stress (Cauchy, Pa, 9 row-major) and von_mises

@@ -317,6 +317,12 @@ void apply_constraints(const Scene& scene, Model& model) {
     }
   }
   for (const LoadSpec& load : scene.loads) {
+    // Tilts, ramps and surface loads hold no node.
+    if (load.kind != LoadSpec::Kind::velocity && load.kind != LoadSpec::Kind::base_motion) continue;
+    // The velocity at t = 0 (drivers/loads sets it each step when it varies).
+    const Vec3 velocity = load.kind == LoadSpec::Kind::velocity
+                              ? Vec3(load.history(0.0) * load.velocity)
+                              : load.velocity;
     for (LocalIndex n = 0; n < nodes.size(); ++n) {
       bool applies = false;
       if (load.region) {
@@ -331,8 +337,8 @@ void apply_constraints(const Scene& scene, Model& model) {
       nodes.constrained[n] |= static_cast<std::uint8_t>(load.dof_mask);
       for (int k = 0; k < 3; ++k)
         if (load.dof_mask & (1u << k)) {
-          nodes.prescribed_velocity[3 * n + k] = load.velocity[k];
-          nodes.v[3 * n + k] = load.velocity[k];
+          nodes.prescribed_velocity[3 * n + k] = velocity[k];
+          nodes.v[3 * n + k] = velocity[k];
         }
     }
   }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/materials.hpp"
+#include "core/time_history.hpp"
 #include "core/types.hpp"
 
 namespace fdem {
@@ -177,25 +178,67 @@ struct TiltSpec {
   double start = 0.0;         // s
 };
 
-// Uniform horizontal acceleration added to gravity: direction·min(rate·(t − start), max).
+// Uniform horizontal acceleration added to gravity: direction·min(rate·(t − start), max), or
+// direction·history(t) when a history is given instead of rate and max.
 struct RampSpec {
-  Vec3 direction = Vec3::UnitX();  // unit vector
-  double rate = 0.0;               // m/s³
-  double max = 0.0;                // m/s²
-  double start = 0.0;              // s
+  Vec3 direction = Vec3::UnitX();      // unit vector
+  double rate = 0.0;                   // m/s³
+  double max = 0.0;                    // m/s²
+  double start = 0.0;                  // s
+  std::optional<TimeHistory> history;  // m/s²
+};
+
+// A pressure or traction on the boundary faces of a region (faces whose three corners lie in
+// the box at t = 0) or of bodies (all their boundary faces).  Boundary faces belong to one tet
+// and are not a joint's face.  Pressure p pushes along the inward normal: with `follower` the
+// force is −p·a on the current area vector a (finite strain, rotating faces), else −p·A on the
+// reference one.  Traction t (Pa, fixed direction) gives t·A on the reference area.  Either is
+// multiplied by LoadSpec::history(t).
+struct SurfaceLoadSpec {
+  enum class Kind { pressure, traction } kind = Kind::pressure;
+  double pressure = 0.0;         // Pa, > 0 compresses
+  Vec3 traction = Vec3::Zero();  // Pa
+  bool follower = true;          // pressure only
+  // A Gmsh physical surface of the (one) body's mesh file: only faces that coincide with one of
+  // its triangles (9 coordinates each, m) are loaded.  Empty: every boundary face of the bodies.
+  std::string physical;
+  std::vector<double> triangles;
 };
 
 // A load: prescribed velocity on the nodes of some bodies or of a region (components given as
 // null in the scene stay free: mask), a base motion of some bodies, or a time-varying gravity.
 struct LoadSpec {
-  enum class Kind { velocity, base_motion, tilt, ramp } kind = Kind::velocity;
+  enum class Kind { velocity, base_motion, tilt, ramp, surface } kind = Kind::velocity;
+  std::string name;         // for output.histories columns (default load<index in the list>)
   std::vector<int> bodies;  // body indices (empty: use region)
   std::optional<RegionSpec> region;
-  Vec3 velocity = Vec3::Zero();  // m/s
+  Vec3 velocity = Vec3::Zero();  // m/s, × history(t)
   unsigned dof_mask = 7;         // bit k set: component k prescribed
+  TimeHistory history;           // velocity and surface loads: factor of the magnitude (1)
   BaseMotionSpec base_motion;    // kind == base_motion (all components prescribed)
   TiltSpec tilt;                 // kind == tilt
   RampSpec ramp;                 // kind == ramp
+  SurfaceLoadSpec surface;       // kind == surface (bodies or region select the faces)
+  std::string where;             // "FILE:LINE:COLUMN: loads[i].region" (or .bodies), for messages
+};
+
+// A point whose displacement, velocity and stress histories.csv records, interpolated in the tet
+// that holds it at t = 0.
+struct MonitorSpec {
+  std::string name;
+  Vec3 point = Vec3::Zero();  // m, reference configuration
+  std::string where;          // "FILE:LINE:COLUMN: output.histories.monitors[i]", for messages
+};
+
+// output.histories: rows of histories.csv (drivers/histories).  Loads: reaction and mean
+// displacement of a prescribed-velocity or base-motion load; bodies: mean displacement and
+// resultant force; monitors: values at a point.
+struct HistoriesSpec {
+  bool enabled = false;
+  double every = -1.0;     // s between rows; 0: every step; < 0: the energy.csv interval
+  std::vector<int> loads;  // indices into Scene::loads (velocity and base-motion loads only)
+  std::vector<int> bodies;
+  std::vector<MonitorSpec> monitors;
 };
 
 struct OutputSpec {
@@ -210,6 +253,7 @@ struct OutputSpec {
   // MPI-IO hints (MPI_Info key/value, e.g. striping_factor = 16) for the xdmf frames' HDF5 files;
   // the FDEM_MPIIO_HINTS environment variable adds to and overrides these.
   std::vector<std::pair<std::string, std::string>> mpi_io_hints;
+  HistoriesSpec histories;
 };
 
 // Parallel runs (docs/parallel.md): when the decomposition is revisited.

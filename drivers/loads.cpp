@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/history_sums.hpp"
 
 namespace fdem {
 
@@ -100,6 +101,7 @@ double tilt_angle(const TiltSpec& tilt, double t) {
 }
 
 double ramp_acceleration(const RampSpec& ramp, double t) {
+  if (ramp.history) return (*ramp.history)(t);
   return std::clamp(ramp.rate * (t - ramp.start), 0.0, ramp.max);
 }
 
@@ -127,12 +129,45 @@ LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
         throw InputError(scene.source_path +
                          ": a base motion needs at least two samples of time and acceleration");
       bases_.push_back(std::move(base));
+    } else if (load.kind == LoadSpec::Kind::surface) {
+      surfaces_.push_back({load, static_cast<int>(&load - scene.loads.data()), {}});
+    } else if (load.kind == LoadSpec::Kind::velocity && load.history.varies()) {
+      varying_.push_back({load, static_cast<int>(&load - scene.loads.data()), {}, {}});
     }
   }
+  all_loads_ = scene.loads;
   rebind(model);
 }
 
 void LoadSchedule::rebind(const Model& model) {
+  for (Surface& surface : surfaces_) surface.faces = select_surface_faces(model, surface.load);
+  if (!varying_.empty()) {
+    // Which load sets each prescribed component: the last in scene order that holds the node, as
+    // apply_constraints sets them (fixed bodies first).
+    std::vector<int> setter(3 * static_cast<std::size_t>(model.nodes.size()), -1);
+    for (int l = 0; l < static_cast<int>(all_loads_.size()); ++l) {
+      const LoadSpec& load = all_loads_[static_cast<std::size_t>(l)];
+      if (load.kind != LoadSpec::Kind::velocity && load.kind != LoadSpec::Kind::base_motion)
+        continue;
+      for (LocalIndex n = 0; n < model.nodes.size(); ++n)
+        if (load_holds_node(load, model, n))
+          for (int k = 0; k < 3; ++k)
+            if (load.dof_mask & (1u << k)) setter[3 * static_cast<std::size_t>(n) + k] = l;
+    }
+    for (Varying& v : varying_) {
+      v.nodes.clear();
+      v.masks.clear();
+      for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
+        std::uint8_t mask = 0;
+        for (int k = 0; k < 3; ++k)
+          if (setter[3 * static_cast<std::size_t>(n) + k] == v.index) mask |= 1u << k;
+        if (mask) {
+          v.nodes.push_back(n);
+          v.masks.push_back(mask);
+        }
+      }
+    }
+  }
   for (Base& base : bases_) {
     base.nodes.clear();
     for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
@@ -149,6 +184,36 @@ void LoadSchedule::apply(double t, double dt, Model& model) const {
     const Vec3 v = base_velocity(base.motion, t + 0.5 * dt) * base.motion.direction;
     for (LocalIndex n : base.nodes) vec3_at(model.nodes.prescribed_velocity.data(), n) = v;
   }
+  for (const Varying& varying : varying_) {
+    const Vec3 v = varying.load.history(t + 0.5 * dt) * varying.load.velocity;
+    for (std::size_t i = 0; i < varying.nodes.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        if (varying.masks[i] & (1u << k))
+          model.nodes.prescribed_velocity[3 * static_cast<std::size_t>(varying.nodes[i]) + k] =
+              v[k];
+  }
+}
+
+void LoadSchedule::add_surface_forces(double t, Model& model) {
+  for (Surface& surface : surfaces_)
+    fdem::add_surface_forces(surface.load.surface, surface.load.history(t), surface.faces,
+                             model.nodes);
+}
+
+double LoadSchedule::surface_power(const Model& model) const {
+  double power = 0.0;
+  for (const Surface& surface : surfaces_) power += fdem::surface_power(surface.faces, model.nodes);
+  return power;
+}
+
+std::vector<std::pair<int, std::int64_t>> LoadSchedule::surface_face_counts() const {
+  std::vector<std::pair<int, std::int64_t>> counts;
+  for (const Surface& surface : surfaces_) {
+    std::int64_t owned = 0;
+    for (const std::uint8_t o : surface.faces.owned) owned += o;
+    counts.emplace_back(surface.index, owned);
+  }
+  return counts;
 }
 
 }  // namespace fdem

@@ -1,6 +1,7 @@
 // Time-dependent loads (scene `loads:`): ground motion from an acceleration record, tilting
-// tables and horizontal-acceleration ramps.  LoadSchedule::apply is the one place where they are
-// evaluated each step; constant prescribed velocities stay in apply_constraints.
+// tables, horizontal-acceleration ramps and prescribed velocities with a time history.
+// LoadSchedule::apply is the one place where they are evaluated each step; constant prescribed
+// velocities stay in apply_constraints.
 #pragma once
 
 #include <string>
@@ -8,6 +9,7 @@
 
 #include "core/model.hpp"
 #include "core/scene.hpp"
+#include "core/surface_loads.hpp"
 
 namespace fdem {
 
@@ -36,11 +38,22 @@ class LoadSchedule {
 
   bool changes_gravity() const { return changes_gravity_; }
   bool moves_bases() const { return !bases_.empty(); }
-  bool active() const { return changes_gravity_ || moves_bases(); }
+  bool active() const { return changes_gravity_ || moves_bases() || !varying_.empty(); }
+  bool has_surface_loads() const { return !surfaces_.empty(); }
 
   // Sets the model's loads for the step from t to t + dt: gravity at t (forces at t), base
-  // nodes' prescribed velocity at t + dt/2 (central difference stores half-step velocities).
+  // nodes' and varying loads' prescribed velocity at t + dt/2 (central difference stores
+  // half-step velocities).
   void apply(double t, double dt, Model& model) const;
+
+  // Surface loads (stage 6): adds each one's face forces at time t (s) to the nodes, in scene
+  // order, and returns nothing; surface_power then gives Σ F·v over the owned corners (W) for the
+  // work: before the integration with v(t − dt/2), after it with v(t + dt/2).
+  void add_surface_forces(double t, Model& model);
+  double surface_power(const Model& model) const;
+  // Per surface load (scene order): its index in the scene's loads and the number of faces
+  // whose tet is owned here (to refuse a load that acts on no face).
+  std::vector<std::pair<int, std::int64_t>> surface_face_counts() const;
 
   const Scene& scene() const { return scene_; }
   // The model's nodes changed (parallel redistribution): list the base nodes again.
@@ -52,8 +65,24 @@ class LoadSchedule {
     std::vector<std::int32_t> bodies;
     std::vector<LocalIndex> nodes;
   };
+  // A prescribed velocity × history(t): the nodes and components it sets (a later load in the
+  // scene that holds the same component sets it instead, as in apply_constraints).
+  struct Varying {
+    LoadSpec load;
+    int index = -1;  // in the scene's loads
+    std::vector<LocalIndex> nodes;
+    std::vector<std::uint8_t> masks;
+  };
   Scene scene_;  // gravity, tilts and ramps (records filled)
   std::vector<Base> bases_;
+  std::vector<Varying> varying_;
+  struct Surface {
+    LoadSpec load;
+    int index = -1;  // in the scene's loads
+    SurfaceFaces faces;
+  };
+  std::vector<Surface> surfaces_;
+  std::vector<LoadSpec> all_loads_;
   bool changes_gravity_ = false;
 };
 

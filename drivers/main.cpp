@@ -77,6 +77,15 @@ int check(const fdem::Scene& scene) {
         "  initial stress: equilibrium residual at t = 0: %.3g (|net force| / |forces of "
         "the initial stress| over the free components)\n",
         sim->initial_equilibrium_residual());
+  if (const fdem::HistoriesSpec& h = scene.output.histories; h.enabled) {
+    // Monitors were placed in their tets when the simulation was made (or refused there).
+    std::string what;
+    for (const int l : h.loads) what += " load " + scene.loads[l].name + ",";
+    for (const int b : h.bodies) what += " body " + scene.bodies[b].name + ",";
+    for (const auto& m : h.monitors) what += " monitor " + m.name + ",";
+    what.pop_back();
+    std::printf("  histories.csv:%s\n", what.c_str());
+  }
   std::printf("  stages:\n");
   for (const auto& s : sim->plan().describe()) std::printf("    %s\n", s.c_str());
   return 0;

@@ -56,6 +56,38 @@ void add_material(std::vector<std::pair<std::string, double>>& values, const Mat
   }
 }
 
+// A time history by its kind and numbers (a table by its rows).
+void add_history(std::vector<std::pair<std::string, double>>& values, const std::string& key,
+                 const TimeHistory& h) {
+  values.emplace_back(key + ".kind", static_cast<double>(h.kind));
+  switch (h.kind) {
+    case TimeHistory::Kind::constant:
+      values.emplace_back(key, h.value);
+      break;
+    case TimeHistory::Kind::table: {  // a few numbers that change with any row (a table may have
+                                      // thousands of rows)
+      double sum_t = 0, sum_v = 0, sum_tv = 0;
+      for (std::size_t i = 0; i < h.times.size(); ++i) {
+        sum_t += h.times[i];
+        sum_v += h.values[i];
+        sum_tv += (1.0 + h.times[i]) * h.values[i];
+      }
+      values.emplace_back(key + ".table.rows", static_cast<double>(h.times.size()));
+      values.emplace_back(key + ".table.sum_of_times", sum_t);
+      values.emplace_back(key + ".table.sum_of_values", sum_v);
+      values.emplace_back(key + ".table.weighted_sum", sum_tv);
+      break;
+    }
+    case TimeHistory::Kind::smooth_step:
+      values.emplace_back(key + ".smooth_step.start", h.start);
+      values.emplace_back(key + ".smooth_step.end", h.end);
+      values.emplace_back(key + ".smooth_step.from", h.from);
+      values.emplace_back(key + ".smooth_step.to", h.to);
+      values.emplace_back(key + ".smooth_step.shape", static_cast<double>(h.shape));
+      break;
+  }
+}
+
 void add_load(std::vector<std::pair<std::string, double>>& values, const LoadSpec& load,
               std::size_t index) {
   const std::string key = "loads[" + std::to_string(index) + "]";
@@ -78,8 +110,18 @@ void add_load(std::vector<std::pair<std::string, double>>& values, const LoadSpe
       values.emplace_back(key + ".ramp.rate", load.ramp.rate);
       values.emplace_back(key + ".ramp.max", load.ramp.max);
       values.emplace_back(key + ".ramp.start", load.ramp.start);
+      if (load.ramp.history) add_history(values, key + ".ramp.history", *load.ramp.history);
+      break;
+    case LoadSpec::Kind::surface:
+      values.emplace_back(key + ".pressure", load.surface.pressure);
+      add_vec3(values, key + ".traction", load.surface.traction);
+      values.emplace_back(key + ".follower", load.surface.follower);
+      values.emplace_back(key + ".physical.triangles",
+                          static_cast<double>(load.surface.triangles.size() / 9));
       break;
   }
+  if (load.kind == LoadSpec::Kind::velocity || load.kind == LoadSpec::Kind::surface)
+    add_history(values, key + ".history", load.history);
 }
 
 // What a changed key does on a restart: refused, or a warning saying what happens.

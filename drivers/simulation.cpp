@@ -22,10 +22,12 @@
 #include "core/state_hash.hpp"
 #include "core/tet_kernels.hpp"
 #include "core/time_step.hpp"
+#include "drivers/histories.hpp"
 #include "drivers/interrupt.hpp"
 #include "drivers/loads.hpp"
 #include "drivers/mesh_files.hpp"
 #include "drivers/mesh_generators.hpp"
+#include "drivers/output_times.hpp"
 #include "drivers/process_memory.hpp"
 #include "drivers/progress.hpp"
 #include "drivers/restart_check.hpp"
@@ -56,18 +58,6 @@ class Timed {
   StageClock& clock_;
   std::chrono::steady_clock::time_point start_;
 };
-
-// The first of next, next + every, next + 2 every, ... after `now` (s).  Many intervals within
-// one step are skipped at once (the scene reader guarantees every ≥ 1e-12 time.end, so that
-// next + every > next); the same sums as adding `every` one at a time when they are few.
-double next_output_time(double next, double now, double every) {
-  if (next <= now) {
-    const double skipped = std::floor((now - next) / every);
-    if (skipped > 16) next += (skipped - 1) * every;
-  }
-  while (next <= now) next += every;
-  return next;
-}
 
 // Steps between two checks of the deformed mesh's stable step against the time step (the
 // minimum-step guard, LS-DYNA's DTMIN idea): a pass over the tets like one internal-force pass,
@@ -108,6 +98,7 @@ std::vector<std::string> StagePlan::describe() const {
                       : "contact: skipped (no contact partners)");
   s.push_back(std::string("external forces: ") + (gravity ? "gravity" : "none") +
               (kinematic_loads ? " + prescribed velocities" : "") +
+              (surface_loads ? " + surface loads" : "") +
               (absorbing ? " + absorbing boundaries (dashpots)" : ""));
   if (initial_stress) s.push_back("initial stress of the tets (added to the internal forces)");
   s.push_back("integrate (central difference)");
@@ -135,7 +126,23 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   const auto global_sum = [&](auto v) { return distributed ? comm_->sum(v) : v; };
   loads_ = std::make_unique<LoadSchedule>(scene_, model_);
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
-  plan_.kinematic_loads = !scene_.loads.empty();
+  plan_.kinematic_loads =
+      std::any_of(scene_.loads.begin(), scene_.loads.end(), [](const LoadSpec& l) {
+        return l.kind == LoadSpec::Kind::velocity || l.kind == LoadSpec::Kind::base_motion;
+      });
+  plan_.surface_loads = loads_->has_surface_loads();
+  // A surface load that acts on no face is a mistake in the scene (a region beside the model).
+  for (const auto& [index, owned] : loads_->surface_face_counts())
+    if (global_sum(owned) == 0) {
+      const LoadSpec& load = scene_.loads[static_cast<std::size_t>(index)];
+      throw InputError((load.where.empty()
+                            ? scene_.source_path + ": loads[" + std::to_string(index) + "]"
+                            : load.where) +
+                       ": surface load '" + load.name + "' acts on no face: no boundary face " +
+                       (load.region ? "has its three corners in the region's box at t = 0"
+                                    : "belongs to its bodies") +
+                       " (faces shared by two tets or by a joint are not boundary faces)");
+    }
 
   plan_.contact = ContactStage::needed(model_);
   const CriticalStep critical = fdem::critical_time_step(model_);
@@ -227,6 +234,10 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
     }
     rebind_stages(state, false);
   }
+  // Monitors are found by tet gid (rank-independent), so before the restart and the whole-model
+  // start's distribution.
+  if (scene_.output.histories.enabled && options_.write_output)
+    histories_ = std::make_unique<HistoryRecorder>(scene_, model_, comm_);
   // A restart overwrites the state of the model (and of the stages) with the checkpoint's.
   if (!options_.restart_path.empty()) {
     mark_phase(CommPhase::restart);
@@ -507,6 +518,20 @@ void Simulation::step() {
     boundary_before = absorbing_->add_forces(dt_, model_);
   }
 
+  // 6 surface loads: pressure and traction on boundary faces, at t_n
+  double surface_power_before = 0.0;  // W, with v(t_n − dt/2)
+  if (plan_.surface_loads) {
+    Timed timed(clocks_[external]);
+    loads_->add_surface_forces(time_, model_);
+    surface_power_before = loads_->surface_power(model_);
+  }
+
+  // 6b histories.csv row at t_n: reactions (f complete), positions x_n, before they move
+  if (histories_ && histories_->due(time_, dt_)) {
+    Timed timed(clocks_[output]);
+    histories_->sample(model_, time_, dt_);
+  }
+
   // 7 integrate: central difference with prescribed velocities
   IntegrationSummary motion;
   {
@@ -516,6 +541,11 @@ void Simulation::step() {
     motion = integrate_central_difference(dt_, nodes);
     if (absorbing_) boundary_after = absorbing_->dissipation_after(dt_, model_);
     moved_since_distribution_ = true;
+    // The surface loads' work goes with the reactions' (external_work), by the same trapezoid.
+    if (plan_.surface_loads) {
+      motion.constraint_work_before += 0.5 * dt_ * surface_power_before;
+      motion.constraint_work_after += 0.5 * dt_ * loads_->surface_power(model_);
+    }
   }
   ContactWork contact_after;  // the "after" halves of friction and dashpot work (v_n+½ known now)
   if (plan_.contact) contact_after = contact_->work_after(model_, dt_);
@@ -881,6 +911,7 @@ void Simulation::write_outputs(bool force) {
       next_frame_time_ = scene_.time.end;
   }
   if (energy_row || frame) write_files(frame, energy_row, energy_time);
+  if (histories_) histories_->write(options_.output_dir);  // the row of this step, if it took one
   const double every = scene_.output.checkpoint_every;
   if (comm_ && every > 0 && steps_ > 0 && time_ >= next_checkpoint_time_ - 1e-12 * dt_) {
     next_checkpoint_time_ = next_output_time(next_checkpoint_time_, time_ + 1e-12 * dt_, every);

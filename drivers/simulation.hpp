@@ -25,6 +25,7 @@ struct TravellingState;
 class ContactStage;
 class JointStage;
 class LoadSchedule;
+class HistoryRecorder;
 
 struct RunOptions {
   std::string output_dir = "out";
@@ -42,6 +43,7 @@ struct StagePlan {
   bool kinematic_loads = false;
   bool absorbing = false;       // viscous absorbing boundaries (core/absorbing_boundary)
   bool initial_stress = false;  // scene `initial_stress:` (core/initial_stress)
+  bool surface_loads = false;  // pressure or traction on boundary faces
   std::vector<std::string> describe() const;
 };
 
@@ -190,6 +192,7 @@ class Simulation {
   std::unique_ptr<JointStage> joints_;
   std::unique_ptr<LoadSchedule> loads_;           // time-dependent loads (drivers/loads)
   std::unique_ptr<AbsorbingBoundary> absorbing_;  // scene `absorbing:` only
+  std::unique_ptr<HistoryRecorder> histories_;    // histories.csv (output.histories), with output
   WorkAccumulator joint_friction_;  // Coulomb slip inside joints (part of dissipated_friction)
   const Communicator* comm_ = nullptr;
   std::unique_ptr<Distribution> distribution_;  // N ranks only

@@ -11,6 +11,7 @@
 #include "contact/contact_stage.hpp"
 #include "core/error.hpp"
 #include "core/state_hash.hpp"
+#include "drivers/histories.hpp"
 #include "drivers/restart_check.hpp"
 #include "drivers/simulation.hpp"
 #include "fracture/joint_kernels.hpp"
@@ -39,6 +40,7 @@ void Simulation::write_checkpoint() {
                     {"next_frame_time", next_frame_time_},
                     {"next_energy_time", next_energy_time_},
                     {"next_checkpoint_time", next_checkpoint_time_},
+                    {"next_history_time", histories_ ? histories_->next_time() : 0.0},
                     {"joint_friction_through_previous", joint_friction_.through_previous},
                     {"joint_friction_first_before", joint_friction_.first_before},
                     {"joint_friction_started", joint_friction_.started ? 1.0 : 0.0}};
@@ -230,6 +232,10 @@ void Simulation::restore_checkpoint(const std::string& path) {
   next_frame_time_ = number("next_frame_time");
   next_energy_time_ = number("next_energy_time");
   next_checkpoint_time_ = number("next_checkpoint_time");
+  // Rows continue at the uninterrupted run's times (a checkpoint without the value, or of a run
+  // without histories, gives 0: the next step takes a row and the rest follow the interval).
+  if (histories_ && doubles.count("next_history_time"))
+    histories_->set_next_time(doubles["next_history_time"]);
   joint_friction_.through_previous = number("joint_friction_through_previous");
   joint_friction_.first_before = number("joint_friction_first_before");
   joint_friction_.started = number("joint_friction_started") != 0.0;

@@ -19,6 +19,7 @@ using gmsh::excerpt;
 namespace {
 
 constexpr int kLinearTet = 4;
+constexpr int kTriangle = 2;
 
 struct ElementType {
   int num_nodes;
@@ -209,6 +210,8 @@ void read_physical_names(Cursor& cur, GmshTables& mesh) {
     if (dim == 3) {
       mesh.names_3d.emplace(name, static_cast<int>(tag));
       mesh.tag_names_3d.emplace(static_cast<int>(tag), name);
+    } else if (dim == 2) {
+      mesh.names_2d.emplace(name, static_cast<int>(tag));
     }
   }
   cur.expect_end("PhysicalNames");
@@ -239,6 +242,7 @@ void read_entities(Cursor& cur, GmshTables& mesh) {
         for (std::int64_t b = 0; b < num_bounding; ++b) cur.read_int("a bounding entity tag");
       }
       if (dim == 3) mesh.volume_physicals[tag] = std::move(physicals);
+      if (dim == 2) mesh.surface_physicals[tag] = std::move(physicals);
     }
   }
   cur.expect_end("Entities");
@@ -344,6 +348,23 @@ void read_elements(Cursor& cur, GmshTables& mesh, NodeTagIndex& index, GmshSink&
         }
         sink.tet(tag, entity_dim == 3 ? entity_tag : -1, nodes);
         ++mesh.n_tets;
+      }
+      continue;
+    }
+    if (type == kTriangle && entity_dim == 2) {
+      for (std::int64_t i = 0; i < count; ++i) {
+        const std::int64_t tag = cur.read_size("an element tag");
+        std::int64_t nodes[3];
+        for (int k = 0; k < 3; ++k) {
+          const std::int64_t node_tag =
+              cur.read_size("a node tag of triangle " + std::to_string(tag));
+          nodes[k] = index.find(node_tag);
+          if (nodes[k] < 0)
+            cur.fail_at(cur.value_start(), "triangle " + std::to_string(tag) +
+                                               " references node tag " + std::to_string(node_tag) +
+                                               ", which is not defined in $Nodes.");
+        }
+        sink.triangle(entity_tag, nodes);
       }
       continue;
     }

@@ -23,7 +23,9 @@ class Cursor;
 struct GmshTables {
   std::map<std::string, int> names_3d;  // $PhysicalNames, dimension 3: name -> tag
   std::map<int, std::string> tag_names_3d;
-  std::map<int, std::vector<int>> volume_physicals;  // volume entity tag -> physical tags
+  std::map<int, std::vector<int>> volume_physicals;   // volume entity tag -> physical tags
+  std::map<std::string, int> names_2d;                // $PhysicalNames, dimension 2
+  std::map<int, std::vector<int>> surface_physicals;  // surface entity tag -> physical tags
   // Blocks of volume elements fdem cannot use (10-node tets, hexahedra, ...): an error when a
   // selected volume holds one.  message: location and advice, after "Gmsh file '...', ".
   struct Unsupported {
@@ -44,6 +46,12 @@ class GmshSink {
   // A 4-node tetrahedron: element tag, volume entity tag (-1 if its block is not a volume), node
   // indices of its corners.
   virtual void tet(std::int64_t tag, int entity, const std::int64_t (&nodes)[4]) = 0;
+  // A 3-node triangle of a surface entity (surface loads on a physical surface); ignored unless
+  // a sink wants them.
+  virtual void triangle(int entity, const std::int64_t (&nodes)[3]) {
+    (void)entity;
+    (void)nodes;
+  }
 };
 
 // Node tag -> node index.

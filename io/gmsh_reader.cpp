@@ -2,6 +2,7 @@
 // selection and the used nodes.
 #include "io/gmsh_reader.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -45,7 +46,74 @@ struct WholeFile : GmshSink {
   }
 };
 
+// Every node's coordinates and the triangles of surface entities.
+struct SurfaceTriangles : GmshSink {
+  std::vector<double> xyz;
+  std::vector<std::int64_t> corners;  // 3 per triangle, node indices
+  std::vector<int> entity;
+
+  void node_tag(std::int64_t, std::int64_t) override {}
+  void node_coords(std::int64_t, const double (&x)[3]) override { xyz.insert(xyz.end(), x, x + 3); }
+  void tet(std::int64_t, int, const std::int64_t (&)[4]) override {}
+  void triangle(int e, const std::int64_t (&nodes)[3]) override {
+    corners.insert(corners.end(), nodes, nodes + 3);
+    entity.push_back(e);
+  }
+};
+
 }  // namespace
+
+std::vector<double> read_gmsh_surface(const std::string& path, const std::string& physical) {
+  const std::string data = read_whole_file(path);
+  gmsh::Cursor cur(path, data);
+  SurfaceTriangles sink;
+  const auto index = make_table_index();
+  const GmshTables tables = parse_gmsh_sections(cur, path, *index, sink);
+  const std::string file = "Gmsh file '" + path + "'";
+  int group = 0;
+  if (const auto it = tables.names_2d.find(physical); it != tables.names_2d.end()) {
+    group = it->second;
+  } else {
+    bool known = false;
+    try {
+      std::size_t used = 0;
+      group = std::stoi(physical, &used);
+      known = used == physical.size();
+      if (known) {
+        known = false;
+        for (const auto& [entity, tags] : tables.surface_physicals)
+          known = known || std::find(tags.begin(), tags.end(), group) != tags.end();
+      }
+    } catch (const std::exception&) {
+    }
+    if (!known) {
+      std::string names;
+      for (const auto& [name, tag] : tables.names_2d)
+        names += (names.empty() ? "" : ", ") + name + " (" + std::to_string(tag) + ")";
+      throw InputError(file + " has no 2D physical group '" + physical + "'. Its 2D groups: " +
+                       (names.empty() ? std::string("none (name the surface in Gmsh with "
+                                                    "Physical Surface(\"top\") = {...};)")
+                                      : names) +
+                       ".");
+    }
+  }
+  std::vector<double> out;
+  for (std::size_t t = 0; t < sink.entity.size(); ++t) {
+    const auto it = tables.surface_physicals.find(sink.entity[t]);
+    if (it == tables.surface_physicals.end() ||
+        std::find(it->second.begin(), it->second.end(), group) == it->second.end())
+      continue;
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t n = static_cast<std::size_t>(sink.corners[3 * t + k]);
+      out.insert(out.end(), sink.xyz.begin() + 3 * n, sink.xyz.begin() + 3 * n + 3);
+    }
+  }
+  if (out.empty())
+    throw InputError(file + ": the 2D physical group '" + physical +
+                     "' holds no 3-node triangles (save the surface mesh with the volume mesh: "
+                     "Mesh.SaveAll = 1, or a Physical Surface for it)");
+  return out;
+}
 
 GmshMesh read_gmsh(const std::string& path, const std::string& physical) {
   return parse_gmsh(read_whole_file(path), path, physical);

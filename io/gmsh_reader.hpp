@@ -41,6 +41,12 @@ GmshMesh read_gmsh(const std::string& path, const std::string& physical = "");
 GmshMesh parse_gmsh(const std::string& data, const std::string& path,
                     const std::string& physical = "");
 
+// The triangles of a 2D physical group (name or number) of an MSH 4.1 file: 9 coordinates (m)
+// per triangle, corners as in the file.  Throws InputError naming the file and the group for an
+// unknown group (listing the file's 2D groups) or a group without 3-node triangles, and as
+// read_gmsh does for a malformed file.
+std::vector<double> read_gmsh_surface(const std::string& path, const std::string& physical);
+
 struct GmshTables;
 
 // Every node and 4-node tet of a file, in file order, as io/gmsh_parser reads them (or as a

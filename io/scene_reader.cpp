@@ -14,7 +14,10 @@
 
 #include "core/checked_cast.hpp"
 #include "core/error.hpp"
+#include "io/histories_reader.hpp"
+#include "io/load_reader.hpp"
 #include "io/scene_reader_support.hpp"
+#include "io/yaml_reader.hpp"
 
 namespace fdem {
 
@@ -50,9 +53,9 @@ std::string nearest_name(const std::string& word, const std::vector<std::string>
 
 namespace {
 
-using scene_reading::join;
 using scene_reading::read_body_list;
-using scene_reading::Reader;
+using scene_yaml::join;
+using scene_yaml::Reader;
 
 // "bodies.0.velocity" → "bodies[0].velocity" (the reader's spelling of key paths).
 std::string reader_path(const std::string& override_path) {
@@ -459,57 +462,6 @@ MeshSpec read_mesh(const Reader& r, const YAML::Node& node, const std::string& p
   return mesh;
 }
 
-// A unit vector from a non-zero [x, y, z].
-Vec3 direction(const Reader& r, const YAML::Node& node, const std::string& path) {
-  const Vec3 d = r.vec3(node, path);
-  if (!(d.norm() > 0.0)) r.fail(node, path, "a direction must not be [0, 0, 0]");
-  return d.normalized();
-}
-
-BaseMotionSpec read_base_motion(const Reader& r, const YAML::Node& node, const std::string& path,
-                                const std::string& scene_dir) {
-  r.check_keys(node, path, {"file", "direction", "scale"}, {"file", "direction"});
-  BaseMotionSpec spec;
-  const std::filesystem::path p(r.string(node["file"], path + ".file"));
-  spec.file = p.is_absolute() ? p.string()
-                              : (std::filesystem::path(scene_dir) / p).lexically_normal().string();
-  if (!std::filesystem::exists(spec.file))
-    r.fail(node["file"], path + ".file",
-           "acceleration record '" + spec.file +
-               "' does not exist (paths are relative to the scene file; CSV rows: time, "
-               "acceleration)");
-  spec.direction = direction(r, node["direction"], path + ".direction");
-  if (node["scale"]) spec.scale = r.number(node["scale"], path + ".scale");
-  return spec;
-}
-
-LoadSpec read_tilt(const Reader& r, const YAML::Node& node, const std::string& path) {
-  r.check_keys(node, path, {"axis", "rate", "max", "start"}, {"axis", "rate", "max"});
-  LoadSpec load;
-  load.kind = LoadSpec::Kind::tilt;
-  load.tilt.axis = direction(r, node["axis"], path + ".axis");
-  const double deg = M_PI / 180.0;
-  load.tilt.rate = r.positive(node["rate"], path + ".rate", "tilt rate (degrees/s)") * deg;
-  load.tilt.max = r.positive(node["max"], path + ".max", "largest tilt (degrees)") * deg;
-  if (load.tilt.max > M_PI)
-    r.fail(node["max"], path + ".max", "the largest tilt is in degrees and at most 180");
-  if (node["start"])
-    load.tilt.start = r.non_negative(node["start"], path + ".start", "start time (s)");
-  return load;
-}
-
-LoadSpec read_ramp(const Reader& r, const YAML::Node& node, const std::string& path) {
-  r.check_keys(node, path, {"direction", "rate", "max", "start"}, {"direction", "rate", "max"});
-  LoadSpec load;
-  load.kind = LoadSpec::Kind::ramp;
-  load.ramp.direction = direction(r, node["direction"], path + ".direction");
-  load.ramp.rate = r.positive(node["rate"], path + ".rate", "acceleration rate (m/s^3)");
-  load.ramp.max = r.positive(node["max"], path + ".max", "largest acceleration (m/s^2)");
-  if (node["start"])
-    load.ramp.start = r.non_negative(node["start"], path + ".start", "start time (s)");
-  return load;
-}
-
 void read_limits(const Reader& r, const YAML::Node& node, LimitsSpec& limits) {
   r.check_keys(node, "limits", {"max_steps", "max_memory_per_rank"});
   if (node["max_steps"])
@@ -658,67 +610,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     }
   }
 
-  if (const YAML::Node loads = root["loads"]) {
-    if (!loads.IsSequence()) r.fail(loads, "loads", "expected a list of loads");
-    for (std::size_t i = 0; i < loads.size(); ++i) {
-      const std::string lp = "loads[" + std::to_string(i) + "]";
-      const YAML::Node l = loads[i];
-      r.check_keys(l, lp, {"bodies", "region", "velocity", "base_motion", "tilt", "ramp"});
-      LoadSpec load;
-      if (l["tilt"] || l["ramp"]) {
-        const bool tilt = static_cast<bool>(l["tilt"]);
-        const std::string key = tilt ? "tilt" : "ramp";
-        if (l.size() != 1)
-          r.fail(l, lp,
-                 "a '" + key + "' load changes gravity everywhere: give it alone, as {" + key +
-                     ": {...}}");
-        scene.loads.push_back(tilt ? read_tilt(r, l["tilt"], lp + ".tilt")
-                                   : read_ramp(r, l["ramp"], lp + ".ramp"));
-        continue;
-      }
-      if (const YAML::Node bm = l["base_motion"]) {
-        if (!l["bodies"] || l["region"] || l["velocity"])
-          r.fail(l, lp,
-                 "a base motion moves whole bodies: give {bodies: [...], base_motion: {...}} "
-                 "without 'region' or 'velocity'");
-        load.kind = LoadSpec::Kind::base_motion;
-        load.bodies = read_body_list(r, l["bodies"], lp + ".bodies", body_names);
-        load.base_motion = read_base_motion(r, bm, lp + ".base_motion", scene_dir);
-        scene.loads.push_back(load);
-        continue;
-      }
-      if (!l["velocity"])
-        r.fail(l, lp + ".velocity",
-               "missing required key 'velocity' (or give base_motion, tilt or ramp)");
-      if (l["bodies"] && l["region"]) r.fail(l, lp, "give either 'bodies' or 'region', not both");
-      if (l["bodies"]) {
-        load.bodies = read_body_list(r, l["bodies"], lp + ".bodies", body_names);
-      } else if (const YAML::Node region = l["region"]) {
-        r.check_keys(region, lp + ".region", {"box"}, {"box"});
-        r.check_keys(region["box"], lp + ".region.box", {"min", "max"}, {"min", "max"});
-        RegionSpec reg;
-        reg.min = r.vec3(region["box"]["min"], lp + ".region.box.min");
-        reg.max = r.vec3(region["box"]["max"], lp + ".region.box.max");
-        for (int k = 0; k < 3; ++k)
-          if (reg.max[k] < reg.min[k])
-            r.fail(region["box"]["max"], lp + ".region.box.max",
-                   "each component of max must be at least min's (the box would hold no node)");
-        load.region = reg;
-      } else {
-        r.fail(l, lp, "a load needs 'bodies' or 'region' to say where it acts");
-      }
-      const YAML::Node v = l["velocity"];
-      if (!v.IsSequence() || v.size() != 3)
-        r.fail(v, lp + ".velocity", "expected [vx, vy, vz] in m/s (null leaves a component free)");
-      load.dof_mask = 0;
-      for (int k = 0; k < 3; ++k) {
-        if (v[k].IsNull()) continue;
-        load.velocity[k] = r.number(v[k], lp + ".velocity");
-        load.dof_mask |= 1u << k;
-      }
-      scene.loads.push_back(load);
-    }
-  }
+  if (const YAML::Node loads = root["loads"]) read_loads(r, loads, scene_dir, body_names, scene);
 
   if (const YAML::Node absorbing = root["absorbing"])
     scene.absorbing = scene_reading::read_absorbing(r, absorbing, body_names);
@@ -727,7 +619,11 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
 
   if (const YAML::Node out = root["output"]) {
     r.check_keys(out, "output",
-                 {"every", "fields", "checkpoint_every", "energy_every", "format", "mpi_io_hints"});
+                 {"every", "fields", "checkpoint_every", "energy_every", "format", "mpi_io_hints",
+                  "histories"});
+    if (out["histories"])
+      scene.output.histories =
+          read_histories(r, out["histories"], "output.histories", scene, body_names);
     if (out["format"])
       scene.output.format = r.choice(out["format"], "output.format", {"vtu", "xdmf"}) == "xdmf"
                                 ? OutputSpec::FrameFormat::xdmf

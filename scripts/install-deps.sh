@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages fdem needs, only those that are missing.  Safe to run repeatedly.
+# python3-matplotlib: scripts/plot.py (and its test).
 set -euo pipefail
 packages=(g++ make cmake libeigen3-dev libopenmpi-dev openmpi-bin libmetis-dev libhdf5-openmpi-dev
-          libvtk9-dev catch2 libyaml-cpp-dev libtrilinos-zoltan-dev)
+          libvtk9-dev catch2 libyaml-cpp-dev libtrilinos-zoltan-dev python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -23,7 +23,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 # Every example, in order of run time (the cantilever scene was once examples/default.yaml).
-all_examples="tower-projectile mortared-wall-push cantilever-sag brazilian-disc arch-acceleration
+all_examples="tower-projectile triaxial-jointed-prism mortared-wall-push cantilever-sag brazilian-disc arch-acceleration
 dry-stone-wall-seismic"
 ranks_list="1 2"
 out="$root/out/examples"

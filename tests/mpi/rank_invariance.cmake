@@ -1,11 +1,12 @@
 # Runs the fdem command on a scene with each rank count of RANKS and passes when every run
 # completes, summary.json's state_hash (and joint_strength hash, when the scene has joints) is the
-# same in all of them and bodies.csv is the same file,
-# byte for byte.  With RESTART_RANKS, also continues the first run's earliest checkpoint on each
-# of those rank counts and requires the same hash again (checkpoint-and-restart vs.
-# uninterrupted), and the uninterrupted run's bodies.csv rows at the times both runs wrote.  With START, every run on more than
-# one rank must report that start-up in summary.json (decomposition.start: "distributed" when no
-# rank held the whole model, "whole_model").
+# same in all of them and bodies.csv (and histories.csv, when the scene writes one) is the same
+# file, byte for byte.  With RESTART_RANKS, also continues the first run's earliest checkpoint on
+# each of those rank counts and requires the same hash again (checkpoint-and-restart vs.
+# uninterrupted), and the uninterrupted run's bodies.csv (histories.csv) rows at the times both
+# runs wrote.  With START, every run on more than one rank must report that start-up in
+# summary.json (decomposition.start: "distributed" when no rank held the whole model,
+# "whole_model").
 # -D MPIEXEC, NP_FLAG, FDEM, SCENE, WORK, RANKS (list), RESTART_RANKS (list, optional),
 #    START (optional)
 file(REMOVE_RECURSE ${WORK})
@@ -49,20 +50,20 @@ function(read_hash out variable ranks)
   set(${variable} ${hash} PARENT_SCOPE)
 endfunction()
 
-# bodies.csv of `out` must be the bytes of `reference_out`'s.
-function(compare_bodies out reference_out)
-  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${out}/bodies.csv
-                          ${reference_out}/bodies.csv RESULT_VARIABLE different)
+# CSV file `name` of `out` must be the bytes of `reference_out`'s.
+function(compare_csv name out reference_out)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${out}/${name}
+                          ${reference_out}/${name} RESULT_VARIABLE different)
   if(different)
-    message(FATAL_ERROR "${out}/bodies.csv differs from ${reference_out}/bodies.csv")
+    message(FATAL_ERROR "${out}/${name} differs from ${reference_out}/${name}")
   endif()
 endfunction()
 
-# Every row of a restarted run's bodies.csv at a time the uninterrupted run wrote must be that
-# run's row, byte for byte (the restart also writes a frame at the checkpoint's time).
-function(compare_restarted_bodies out reference_out)
-  file(READ ${reference_out}/bodies.csv reference_text)
-  file(STRINGS ${out}/bodies.csv rows)
+# Every row of a restarted run's CSV file `name` at a time the uninterrupted run wrote must be
+# that run's row, byte for byte (the restart also writes a frame at the checkpoint's time).
+function(compare_restarted_rows name out reference_out)
+  file(READ ${reference_out}/${name} reference_text)
+  file(STRINGS ${out}/${name} rows)
   list(REMOVE_AT rows 0)  # the header
   set(compared 0)
   foreach(row ${rows})
@@ -73,12 +74,12 @@ function(compare_restarted_bodies out reference_out)
     endif()
     string(FIND "${reference_text}" "\n${row}\n" found)
     if(found EQUAL -1)
-      message(FATAL_ERROR "${out}/bodies.csv: row '${row}' is not in ${reference_out}/bodies.csv")
+      message(FATAL_ERROR "${out}/${name}: row '${row}' is not in ${reference_out}/${name}")
     endif()
     math(EXPR compared "${compared} + 1")
   endforeach()
   if(compared EQUAL 0)
-    message(FATAL_ERROR "${out}/bodies.csv has no row at a time of ${reference_out}/bodies.csv")
+    message(FATAL_ERROR "${out}/${name} has no row at a time of ${reference_out}/${name}")
   endif()
 endfunction()
 
@@ -92,7 +93,10 @@ foreach(ranks ${RANKS})
   elseif(NOT hash STREQUAL reference)
     message(FATAL_ERROR "state_hash on ${ranks} ranks is ${hash}, expected ${reference}")
   else()
-    compare_bodies(${WORK}/ranks${ranks} ${first_run})
+    compare_csv(bodies.csv ${WORK}/ranks${ranks} ${first_run})
+    if(EXISTS ${first_run}/histories.csv)
+      compare_csv(histories.csv ${WORK}/ranks${ranks} ${first_run})
+    endif()
   endif()
 endforeach()
 
@@ -111,7 +115,14 @@ if(RESTART_RANKS)
       message(FATAL_ERROR "restart from ${earliest} on ${ranks} ranks: state_hash ${hash}, "
                           "uninterrupted ${reference}")
     endif()
-    compare_restarted_bodies(${WORK}/restart${ranks} ${first_run})
+    compare_restarted_rows(bodies.csv ${WORK}/restart${ranks} ${first_run})
+    if(EXISTS ${first_run}/histories.csv)
+      compare_restarted_rows(histories.csv ${WORK}/restart${ranks} ${first_run})
+    endif()
   endforeach()
 endif()
-message("all runs: state_hash ${reference}, bodies.csv the same")
+if(EXISTS ${first_run}/histories.csv)
+  message("all runs: state_hash ${reference}, bodies.csv and histories.csv the same")
+else()
+  message("all runs: state_hash ${reference}, bodies.csv the same")
+endif()

@@ -263,3 +263,44 @@ TEST_CASE(
   const double T = moving->time();
   CHECK(m.centroid.y() - y0 == Approx(9.81 * 5.0 / 3.0 * T * T * T).epsilon(1e-3));
 }
+
+TEST_CASE("a prescribed velocity follows its time history; a later constant load keeps its nodes",
+          "[drivers][loads]") {
+  // The block's top nodes move along z with v·h(t), h a quintic step over [0, T]: their
+  // displacement after t_end > T is v·(T/2 + t_end − T) (the step is symmetric about T/2); the
+  // mid-step velocities make the sum the midpoint rule, exact to O(dt²).  The bottom nodes are
+  // held by a constant load; a corner node is also held by a later constant load, which wins.
+  const double dt = 1e-6, T = 20e-6, end = 40e-6, v = 1e-3;  // s, s, s, m/s
+  Scene s = block_scene(end);
+  s.time.auto_step = false;
+  s.time.step = dt;
+  LoadSpec top;
+  top.region = RegionSpec{Vec3(-1, -1, 0.19), Vec3(1, 1, 1)};
+  top.velocity = Vec3(0, 0, v);
+  top.history = TimeHistory::smooth_step(0.0, T, 0.0, 1.0);
+  LoadSpec bottom;
+  bottom.region = RegionSpec{Vec3(-1, -1, -1), Vec3(1, 1, 0.01)};
+  LoadSpec corner;  // the top corner at the origin's column, held along z only
+  corner.region = RegionSpec{Vec3(-1, -1, 0.19), Vec3(0.01, 0.01, 1)};
+  corner.dof_mask = 4;
+  s.loads = {bottom, top, corner};
+  auto sim = quiet(s);
+  const NodeArrays& nodes = sim->model().nodes;
+  int top_nodes = 0;
+  for (LocalIndex n = 0; n < nodes.size(); ++n)  // at rest at t = 0: h(0) = 0
+    if (nodes.x0[3 * n + 2] > 0.19) CHECK(nodes.v[3 * n + 2] == 0.0);
+  while (sim->time() < end - 0.5 * dt) sim->step();
+  const double expected = v * (T / 2 + end - T);  // m
+  for (LocalIndex n = 0; n < nodes.size(); ++n) {
+    if (nodes.x0[3 * n + 2] < 0.19) continue;
+    const double uz = nodes.x[3 * n + 2] - nodes.x0[3 * n + 2];
+    if (nodes.x0[3 * n] < 0.01 && nodes.x0[3 * n + 1] < 0.01) {
+      CHECK(uz == 0.0);  // the corner load comes later in the scene
+      continue;
+    }
+    ++top_nodes;
+    CHECK(uz == Approx(expected).epsilon(1e-5));
+    CHECK(nodes.v[3 * n + 2] == Approx(v).epsilon(1e-12));  // h = 1 after T
+  }
+  CHECK(top_nodes == 3);  // 2 × 2 corners of one cell, less the held one
+}
