@@ -43,7 +43,7 @@ struct StagePlan {
   bool kinematic_loads = false;
   bool absorbing = false;       // viscous absorbing boundaries (core/absorbing_boundary)
   bool initial_stress = false;  // scene `initial_stress:` (core/initial_stress)
-  bool surface_loads = false;  // pressure or traction on boundary faces
+  bool surface_loads = false;   // pressure or traction on boundary faces
   std::vector<std::string> describe() const;
 };
 

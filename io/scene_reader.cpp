@@ -53,7 +53,6 @@ std::string nearest_name(const std::string& word, const std::vector<std::string>
 
 namespace {
 
-using scene_reading::read_body_list;
 using scene_yaml::join;
 using scene_yaml::Reader;
 

@@ -27,7 +27,15 @@ Scene one_body(bool jointed) {
   m.density = 2000;
   m.elastic.young = 1e9;
   m.elastic.poisson = 0.2;
-  if (jointed) m.fracture = FractureSpec{1e6, 2e6, 30.0, 10.0, 50.0};
+  if (jointed) {
+    FractureSpec f;
+    f.tensile_strength = 1e6;
+    f.cohesion = 2e6;
+    f.friction_angle_deg = 30.0;
+    f.energy_I = 10.0;
+    f.energy_II = 50.0;
+    m.fracture = f;
+  }
   s.materials.push_back(m);
   BodySpec body;
   body.name = "b";
