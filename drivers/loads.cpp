@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/csv_fields.hpp"
 #include "core/error.hpp"
 #include "core/history_sums.hpp"
 
@@ -13,20 +14,8 @@ namespace fdem {
 
 namespace {
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
-
-// Parses a whole field as a finite number.
-bool parse_number(const std::string& field, double& out) {
-  const std::string f = trim(field);
-  if (f.empty()) return false;
-  char* end = nullptr;
-  out = std::strtod(f.c_str(), &end);
-  return end == f.c_str() + f.size() && std::isfinite(out);
-}
+using csv_fields::parse_number;
+using csv_fields::trim;
 
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/csv_fields.hpp"
 #include "core/error.hpp"
 #include "io/gmsh_reader.hpp"
 #include "io/histories_reader.hpp"
@@ -19,20 +20,8 @@ using scene_yaml::Reader;
 
 namespace {
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
-
-// A whole field as a finite number.
-bool parse_number(const std::string& field, double& out) {
-  const std::string f = trim(field);
-  if (f.empty()) return false;
-  char* end = nullptr;
-  out = std::strtod(f.c_str(), &end);
-  return end == f.c_str() + f.size() && std::isfinite(out);
-}
+using csv_fields::parse_number;
+using csv_fields::trim;
 
 // A path given in the scene, relative to the scene file.
 std::string scene_relative(const std::string& given, const std::string& scene_dir) {
