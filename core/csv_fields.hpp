@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 namespace fdem::csv_fields {
 
@@ -22,5 +23,16 @@ inline bool parse_number(const std::string& field, double& out) {
   out = std::strtod(f.c_str(), &end);
   return end == f.c_str() + f.size() && std::isfinite(out);
 }
+
+// Rows "time, value" of a CSV file: blank lines, lines starting with '#' and one header line
+// before the first row are skipped.  InputError naming the file and line for any other line that
+// is not two numbers, for times that are negative or do not increase, and for fewer than two rows.
+// `value_name` names the column in messages ("acceleration"), `what` the file ("an acceleration
+// record").
+struct TimeValueRows {
+  std::vector<double> time, value;
+};
+TimeValueRows read_time_value_rows(const std::string& path, const std::string& value_name,
+                                   const std::string& what);
 
 }  // namespace fdem::csv_fields

@@ -12,60 +12,11 @@
 
 namespace fdem {
 
-namespace {
-
-using csv_fields::parse_number;
-using csv_fields::trim;
-
-}  // namespace
-
 void read_acceleration_record(const std::string& path, BaseMotionSpec& spec) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the acceleration record");
-  spec.time.clear();
-  spec.acceleration.clear();
-  std::string line;
-  int line_number = 0;
-  bool header_allowed = true;
-  while (std::getline(in, line)) {
-    ++line_number;
-    const std::string text = trim(line);
-    if (text.empty() || text[0] == '#') continue;
-    const auto comma = text.find(',');
-    double t = 0, a = 0;
-    const bool two = comma != std::string::npos && text.find(',', comma + 1) == std::string::npos;
-    if (!two || !parse_number(text.substr(0, comma), t) ||
-        !parse_number(text.substr(comma + 1), a)) {
-      if (header_allowed && spec.time.empty()) {  // a column header such as "time,acceleration"
-        header_allowed = false;
-        continue;
-      }
-      std::ostringstream msg;
-      msg << path << ":" << line_number << ": expected a row 'time, acceleration' (two numbers "
-          << "separated by a comma), got '" << text << "'";
-      throw InputError(msg.str());
-    }
-    header_allowed = false;
-    if (t < 0.0) {
-      std::ostringstream msg;
-      msg << path << ":" << line_number << ": time " << t << " s is negative; records start at "
-          << "t >= 0";
-      throw InputError(msg.str());
-    }
-    if (!spec.time.empty() && !(t > spec.time.back())) {
-      std::ostringstream msg;
-      msg << path << ":" << line_number << ": time " << t
-          << " s does not increase (previous row: " << spec.time.back() << " s)";
-      throw InputError(msg.str());
-    }
-    spec.time.push_back(t);
-    spec.acceleration.push_back(a);
-  }
-  if (spec.time.size() < 2)
-    throw InputError(path +
-                     ": an acceleration record needs at least two rows 'time, "
-                     "acceleration' (found " +
-                     std::to_string(spec.time.size()) + ")");
+  csv_fields::TimeValueRows rows =
+      csv_fields::read_time_value_rows(path, "acceleration", "an acceleration record");
+  spec.time = std::move(rows.time);
+  spec.acceleration = std::move(rows.value);
 }
 
 double base_velocity(const BaseMotionSpec& spec, double t) {

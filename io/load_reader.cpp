@@ -20,9 +20,6 @@ using scene_yaml::Reader;
 
 namespace {
 
-using csv_fields::parse_number;
-using csv_fields::trim;
-
 // A path given in the scene, relative to the scene file.
 std::string scene_relative(const std::string& given, const std::string& scene_dir) {
   const std::filesystem::path p(given);
@@ -257,44 +254,9 @@ void read_loads(const Reader& r, const YAML::Node& loads, const std::string& sce
 }
 
 TimeHistory read_history_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the time history (CSV rows: time, value)");
-  std::vector<double> times, values;
-  std::string line;
-  int line_number = 0;
-  bool header_allowed = true;
-  while (std::getline(in, line)) {
-    ++line_number;
-    const std::string text = trim(line);
-    if (text.empty() || text[0] == '#') continue;
-    const auto comma = text.find(',');
-    double t = 0, v = 0;
-    const bool two = comma != std::string::npos && text.find(',', comma + 1) == std::string::npos;
-    if (!two || !parse_number(text.substr(0, comma), t) ||
-        !parse_number(text.substr(comma + 1), v)) {
-      if (header_allowed && times.empty()) {  // a column header such as "time,value"
-        header_allowed = false;
-        continue;
-      }
-      std::ostringstream msg;
-      msg << path << ":" << line_number << ": expected a row 'time, value' (two numbers "
-          << "separated by a comma), got '" << text << "'";
-      throw InputError(msg.str());
-    }
-    header_allowed = false;
-    std::ostringstream where;
-    where << path << ":" << line_number << ": time " << t << " s";
-    if (t < 0.0) throw InputError(where.str() + " is negative; times start at t >= 0");
-    if (!times.empty() && !(t > times.back()))
-      throw InputError(where.str() +
-                       " does not increase (previous row: " + Reader::format(times.back()) + " s)");
-    times.push_back(t);
-    values.push_back(v);
-  }
-  if (times.size() < 2)
-    throw InputError(path + ": a time history needs at least two rows 'time, value' (found " +
-                     std::to_string(times.size()) + ")");
-  TimeHistory h = TimeHistory::table(std::move(times), std::move(values));
+  csv_fields::TimeValueRows rows =
+      csv_fields::read_time_value_rows(path, "value", "a time history");
+  TimeHistory h = TimeHistory::table(std::move(rows.time), std::move(rows.value));
   h.source = path;
   return h;
 }
