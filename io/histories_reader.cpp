@@ -24,6 +24,7 @@ const char* column_rule = "a name in histories.csv column headers has no comma, 
 std::vector<int> read_selection(const Reader& r, const YAML::Node& node, const std::string& path,
                                 const std::vector<std::string>& names, const std::string& what) {
   std::vector<int> out;
+  r.require_present(node, path, "'all' or a list of names");
   if (node.IsScalar() && node.Scalar() == "all") {
     for (std::size_t i = 0; i < names.size(); ++i) out.push_back(static_cast<int>(i));
     return out;

@@ -31,6 +31,7 @@ std::string scene_relative(const std::string& given, const std::string& scene_di
 
 std::vector<int> read_body_list(const Reader& r, const YAML::Node& node, const std::string& path,
                                 const std::vector<std::string>& names) {
+  r.require_present(node, path, "a list of body names, e.g. [base, wall]");
   if (!node.IsSequence()) r.fail(node, path, "expected a list of body names, e.g. [base, wall]");
   std::vector<int> out;
   for (std::size_t i = 0; i < node.size(); ++i) {
@@ -266,6 +267,7 @@ TimeHistory read_time_history(const Reader& r, const YAML::Node& node, const std
   const char* forms =
       "a number, {table: [[t0, v0], [t1, v1], ...]}, {file: history.csv} or {smooth_step: "
       "{start, end, from, to, shape}}";
+  r.require_present(node, path, forms);
   if (node.IsScalar()) {
     TimeHistory h = TimeHistory::constant_value(r.number(node, path));
     h.source = r.location(node, path);

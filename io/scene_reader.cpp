@@ -259,6 +259,7 @@ MaterialSpec read_material(const Reader& r, const std::string& name, const YAML:
 
 // [nx, ny, nz] positive integers (cells per generated unit).
 void read_cells(const Reader& r, const YAML::Node& cells, const std::string& path, int out[3]) {
+  r.require_present(cells, path, "three positive integers [nx, ny, nz]");
   if (!cells.IsSequence() || cells.size() != 3)
     r.fail(cells, path, "expected three integers [nx, ny, nz]");
   for (int k = 0; k < 3; ++k) {

@@ -60,6 +60,13 @@ class Reader {
     throw InputError(location(at, path) + ": " + what);
   }
 
+  // yaml-cpp hands back an invalid node for a key missing from a const mapping, and asking its
+  // kind throws; every accessor asks this first so a missing key is an input error.
+  void require_present(const YAML::Node& node, const std::string& path,
+                       const std::string& expected) const {
+    if (!node.IsDefined()) fail(node, path, "missing; expected " + expected);
+  }
+
   // The text of a mapping key (keys must be plain scalars).
   std::string key_name(const YAML::Node& key, const std::string& path) const {
     if (!key.IsScalar()) fail(key, path, "a key must be a plain name, not a list or a mapping");
@@ -70,6 +77,7 @@ class Reader {
   void check_keys(const YAML::Node& node, const std::string& path,
                   const std::vector<std::string>& allowed,
                   const std::vector<std::string>& required = {}) const {
+    require_present(node, path, "a mapping (key: value pairs) with keys " + join(allowed));
     if (!node.IsMap())
       fail(node, path, "expected a mapping (key: value pairs) with keys " + join(allowed));
     std::vector<std::string> seen;
@@ -95,6 +103,7 @@ class Reader {
   }
 
   double number(const YAML::Node& node, const std::string& path) const {
+    require_present(node, path, "a number");
     if (!node.IsScalar()) fail(node, path, "expected a number");
     try {
       const double value = node.as<double>();
@@ -120,6 +129,7 @@ class Reader {
   }
 
   int integer(const YAML::Node& node, const std::string& path) const {
+    require_present(node, path, "an integer");
     if (!node.IsScalar()) fail(node, path, "expected an integer");
     try {
       return node.as<int>();
@@ -129,6 +139,7 @@ class Reader {
   }
 
   std::int64_t integer64(const YAML::Node& node, const std::string& path) const {
+    require_present(node, path, "an integer");
     if (!node.IsScalar()) fail(node, path, "expected an integer");
     try {
       return node.as<std::int64_t>();
@@ -138,6 +149,7 @@ class Reader {
   }
 
   bool boolean(const YAML::Node& node, const std::string& path) const {
+    require_present(node, path, "true or false");
     if (!node.IsScalar()) fail(node, path, "expected true or false");
     try {
       return node.as<bool>();
@@ -147,6 +159,7 @@ class Reader {
   }
 
   std::string string(const YAML::Node& node, const std::string& path) const {
+    require_present(node, path, "a text value");
     if (!node.IsScalar()) fail(node, path, "expected a text value");
     return node.Scalar();
   }
@@ -164,6 +177,7 @@ class Reader {
   }
 
   Vec3 vec3(const YAML::Node& node, const std::string& path) const {
+    require_present(node, path, "three numbers [x, y, z]");
     if (!node.IsSequence() || node.size() != 3)
       fail(node, path, "expected three numbers [x, y, z]");
     return {number(node[0], path + "[0]"), number(node[1], path + "[1]"),
@@ -171,7 +185,9 @@ class Reader {
   }
 
   // "auto" or a number.
-  bool is_auto(const YAML::Node& node) const { return node.IsScalar() && node.Scalar() == "auto"; }
+  bool is_auto(const YAML::Node& node) const {
+    return node.IsDefined() && node.IsScalar() && node.Scalar() == "auto";
+  }
 
   static std::string format(double v) {
     std::ostringstream s;

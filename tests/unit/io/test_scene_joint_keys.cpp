@@ -125,6 +125,9 @@ TEST_CASE("joint keys out of range: the key, the value and what is valid", "[io]
   CHECK_THAT(error(", strength_distribution: {type: normal, cov: 0.1, seed: -3}"),
              Contains("strength_distribution.seed: -3 is impossible: the seed is an integer >= 0 "
                       "and < 2^53"));
+  // A mapping without 'type' (a missing key, not a yaml-cpp exception; found by fuzzing).
+  CHECK_THAT(error(", strength_distribution: {modulus: 3, seed: 1}"),
+             Contains("strength_distribution.type: missing; expected a text value"));
   CHECK_THAT(error(", strength_distribution: weibull"),
              Contains("strength_distribution: expected {type: weibull, modulus: m, seed: s}"));
 }
