@@ -32,6 +32,8 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
     any_damping_ = any_damping_ || m.contact.damping > 0.0;
   }
   x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
+  skip_enclosed_ = settings.skip_enclosed;
+  body_cracked_.assign(static_cast<std::size_t>(std::max(model.pieces.bodies(), 0)), 0);
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
     std::vector<double> size = tet_sizes(model);
@@ -182,7 +184,18 @@ void ContactStage::run_detection(const Model& model, const double* x) {
   compute_boxes(model, x);
   const TetArrays& tets = model.tets;
   const bool all_active = tets.active.empty();
+  // Enclosed tets of bodies whose joints all hold take no part (TetJointState::enclosed).
+  left_out_.assign(static_cast<std::size_t>(tets.size()), 0);
+  left_out_count_ = 0;
+  if (skip_enclosed_ && !joint_state_.empty())
+    for (LocalIndex t = 0; t < tets.size(); ++t)
+      if (joint_state_[t] == JointState::enclosed &&
+          !body_cracked_[static_cast<std::size_t>(model.pieces.body_of(tets.piece[t]))]) {
+        left_out_[t] = 1;
+        ++left_out_count_;
+      }
   const auto eligible = [&](LocalIndex a, LocalIndex b) {
+    if (left_out_[a] || left_out_[b]) return false;
     // A pair between two tets this rank does not compute is left to the ranks that do.
     if (!all_active && !tets.active[a] && !tets.active[b]) return false;
     if (tets.group_of(a) == tets.group_of(b) ||
@@ -194,8 +207,10 @@ void ContactStage::run_detection(const Model& model, const double* x) {
     // Tets of one jointed continuum that met at a mesh node at t = 0 (their nodes were split
     // from one) cannot overlap while all their joints hold: the joints carry that compression,
     // and leaving them out keeps contact to the pairs around cracks.
-    if (joint_state_[a] == JointState::intact && joint_state_[b] == JointState::intact)
-      return !share_reference_node(model, a, b);
+    const auto holds = [&](LocalIndex t) {
+      return joint_state_[t] == JointState::intact || joint_state_[t] == JointState::enclosed;
+    };
+    if (holds(a) && holds(b)) return !share_reference_node(model, a, b);
     return true;
   };
   // Narrowed as the boxes are tested, so that only kept pairs are ever stored (box overlaps of
@@ -295,6 +310,20 @@ void ContactStage::set_bonds(LocalIndex n_tets,
     }
   }
   detected_ = false;
+}
+
+void ContactStage::enclose(const std::vector<std::uint8_t>& enclosed) {
+  if (enclosed.empty() || joint_state_.empty()) return;
+  FDEM_VERIFY(enclosed.size() == joint_state_.size(), "an enclosed flag per tet");
+  for (std::size_t t = 0; t < enclosed.size(); ++t)
+    if (enclosed[t] && joint_state_[t] == JointState::intact)
+      joint_state_[t] = JointState::enclosed;
+}
+
+void ContactStage::crack_body(std::int32_t body) {
+  FDEM_VERIFY(body >= 0 && static_cast<std::size_t>(body) < body_cracked_.size(), "body index");
+  if (!body_cracked_[static_cast<std::size_t>(body)]) detected_ = false;
+  body_cracked_[static_cast<std::size_t>(body)] = 1;
 }
 
 void ContactStage::release_bond(LocalIndex a, LocalIndex b) {

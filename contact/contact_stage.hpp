@@ -17,7 +17,16 @@ namespace fdem {
 
 struct ContactSettings {
   double buffer = -1.0;  // m; < 0: automatic (0.25 × median tet box size)
+  // Leave enclosed tets out of contact while their body's joints hold (scene key
+  // contact.skip_enclosed; false keeps them in, the previous algorithm, for benchmarks).
+  bool skip_enclosed = true;
 };
+
+// What a tet's joints allow in contact; one byte that travels with the tet.  `enclosed`: bonded
+// on all four faces, in a `joints: all` body, with no corner on the body mesh's boundary
+// (TetArrays::enclosed): while no joint of its body has broken, nothing can overlap it without
+// first crossing a whole layer of the body's tets, so it takes no part in contact.
+enum class TetJointState : std::uint8_t { none, intact, cracked, enclosed };
 
 // Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with
 // the pair when the model is redistributed or checkpointed.
@@ -101,6 +110,14 @@ class ContactStage {
   // detection (the pair is already inside the buffer, so the buffer rule would not notice).
   // An index of −1 is a tet not held by this rank.
   void release_bond(LocalIndex a, LocalIndex b);
+  // Bonded tets flagged in `enclosed` (per model tet, TetArrays::enclosed; empty: none) become
+  // enclosed; call after set_bonds.
+  void enclose(const std::vector<std::uint8_t>& enclosed);
+  // A joint of body `body` broke (anywhere, on any rank): its enclosed tets take part in contact
+  // from the next detection on.
+  void crack_body(std::int32_t body);
+  // Enclosed tets left out of the last detection.
+  std::int64_t left_out() const { return left_out_count_; }
 
   // Penalty (Pa) of each material as resolved (auto → 10 × Young's modulus).
   const std::vector<double>& material_penalty() const { return penalty_; }
@@ -154,8 +171,12 @@ class ContactStage {
   std::vector<double> friction_force_, damping_force_;
   bool any_friction_ = false, any_damping_ = false;
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
-  enum class JointState : std::uint8_t { none, intact, cracked };  // of a tet's joints
+  using JointState = TetJointState;
   std::vector<JointState> joint_state_;
+  bool skip_enclosed_ = true;
+  std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
+  std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
+  std::int64_t left_out_count_ = 0;
   long detections_ = 0;
   bool detected_ = false;
 };

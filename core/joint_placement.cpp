@@ -223,12 +223,24 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
         throw InputError(no_touching_pieces_message(scene, b, meshes[b].source));
     }
     if (!jointed) continue;
-    for (std::size_t i = 0; i + 1 < f.size(); ++i)
-      if (f[i].key == f[i + 1].key) {
+    std::vector<std::uint8_t> on_boundary(meshes[b].coords.size() / 3, 0);  // per mesh node
+    for (std::size_t i = 0; i < f.size(); ++i)
+      if (i + 1 < f.size() && f[i].key == f[i + 1].key) {
         const LocalIndex m[3] = {f[i].key[0], f[i].key[1], f[i].key[2]};
         add(b, f[i].tet, m, b, f[i + 1].tet, m, scene.bodies[b].material);
         ++i;
+      } else {  // a face of one tet: the mesh boundary
+        for (LocalIndex n : f[i].key) on_boundary[static_cast<std::size_t>(n)] = 1;
       }
+    // Enclosed tets: no corner on the boundary (parallel/enclosed_tets finds the same without
+    // a whole mesh).
+    model.tets.enclosed.resize(static_cast<std::size_t>(tets.size()), 0);
+    for (std::size_t t = 0; t < model_tet[b].size(); ++t) {
+      bool enclosed = true;
+      for (int c = 0; c < 4; ++c)
+        enclosed = enclosed && !on_boundary[static_cast<std::size_t>(meshes[b].tets[4 * t + c])];
+      model.tets.enclosed[static_cast<std::size_t>(model_tet[b][t])] = enclosed ? 1 : 0;
+    }
   }
 
   // Interfaces: match boundary nodes by position (within tol), then faces.

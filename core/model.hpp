@@ -55,6 +55,12 @@ struct TetArrays {
   // held by joints, and become contact partners when those break).  Empty: the piece is the group
   // (models assembled by hand).  Not touched by resize().
   std::vector<std::int32_t> contact_group;
+  // Start-up only (build_model): 1 for a tet of a `joints: all` body none of whose corners lies on
+  // the body mesh's boundary — while that body's joints hold nothing can reach it, so the contact
+  // stage leaves it out (docs/contact-detection.md, "Enclosed tets").  The contact stage's joint
+  // state carries it from then on.  Empty: none (models assembled by hand).  Not touched by
+  // resize().
+  std::vector<std::uint8_t> enclosed;
   // Parallel roles (docs/parallel.md).  Local tets are always in ascending gid.  `owned`: this
   // rank owns the tet (reports its energies, writes it in frames and checkpoints); `active`: the
   // tet touches a node this rank owns, or is owned, so this rank computes its forces.  Empty: every

@@ -293,7 +293,8 @@ struct Scene {
   std::vector<AbsorbingSpec> absorbing;  // viscous absorbing boundaries
   std::vector<InitialStressSpec> initial_stress;
   OutputSpec output;
-  double contact_buffer = -1.0;  // m; < 0: automatic
+  double contact_buffer = -1.0;       // m; < 0: automatic
+  bool contact_skip_enclosed = true;  // contact.skip_enclosed (ContactSettings::skip_enclosed)
   ParallelSpec parallel;
   LimitsSpec limits;
 };

@@ -156,7 +156,8 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   energy_floor_ = global_sum(energy_floor_);
   if (plan_.contact) {
     contact_ = std::make_unique<ContactStage>(
-        model_, ContactSettings{distributed ? contact_buffer : scene_.contact_buffer});
+        model_, ContactSettings{distributed ? contact_buffer : scene_.contact_buffer,
+                                scene_.contact_skip_enclosed});
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
     const double dt_contact = global_min(contact_->critical_time_step(model_));
     // Tunnelling guard (check_tunnelling): the thinnest element a node could cross unseen.
@@ -188,7 +189,9 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
         if (!model_.joints.broken[j])
           bonds.emplace_back(model_.joints.tets[2 * j], model_.joints.tets[2 * j + 1]);
       contact_->set_bonds(model_.tets.size(), bonds);
+      contact_->enclose(model_.tets.enclosed);
     }
+    model_.tets.enclosed = {};  // start-up only: the contact stage's joint state carries it
   }
   if (!scene_.initial_stress.empty()) {
     plan_.initial_stress = true;
@@ -373,13 +376,16 @@ bool Simulation::share_broken_joints(bool detection_due) {
   struct Broken {
     GlobalId joint, tet_a, tet_b;
     double time;
-    std::int32_t mode;
+    std::int32_t mode, body_a, body_b;
   };
   std::vector<Broken> mine;
-  for (LocalIndex b : joints_->newly_broken())
-    mine.push_back({model_.joints.gid[b], model_.tets.gid[model_.joints.tets[2 * b]],
-                    model_.tets.gid[model_.joints.tets[2 * b + 1]], model_.joints.failure_time[b],
-                    model_.joints.mode[b]});
+  for (LocalIndex b : joints_->newly_broken()) {
+    const LocalIndex a = model_.joints.tets[2 * b], c = model_.joints.tets[2 * b + 1];
+    mine.push_back({model_.joints.gid[b], model_.tets.gid[a], model_.tets.gid[c],
+                    model_.joints.failure_time[b], model_.joints.mode[b],
+                    model_.pieces.body_of(model_.tets.piece[a]),
+                    model_.pieces.body_of(model_.tets.piece[c])});
+  }
   // One reduction: joints broken anywhere, and ranks whose nodes call for contact detection.
   std::vector<std::int64_t>& counts = reduced_counts_;  // kept: no allocation per step
   counts.assign({static_cast<std::int64_t>(mine.size()), detection_due});
@@ -397,7 +403,11 @@ bool Simulation::share_broken_joints(bool detection_due) {
     if (it != model_.joints.gid.end() && *it == b.joint)
       joints_->mark_broken(model_, static_cast<LocalIndex>(it - model_.joints.gid.begin()), b.time,
                            static_cast<std::uint8_t>(b.mode));
-    if (contact_) contact_->release_bond(local_tet(b.tet_a), local_tet(b.tet_b));
+    if (contact_) {
+      contact_->release_bond(local_tet(b.tet_a), local_tet(b.tet_b));
+      contact_->crack_body(b.body_a);
+      contact_->crack_body(b.body_b);
+    }
   }
   return true;  // released bonds: every rank re-detects, as one rank does
 }
@@ -482,7 +492,11 @@ void Simulation::step() {
       detection_due = share_broken_joints(travel_detection);
     else if (j.newly_broken > 0 && contact_)
       for (LocalIndex b : joints_->newly_broken())
-        contact_->release_bond(model_.joints.tets[2 * b], model_.joints.tets[2 * b + 1]);
+        for (int side = 0; side < 2; ++side) {
+          const LocalIndex t = model_.joints.tets[2 * b + side];
+          if (side == 0) contact_->release_bond(t, model_.joints.tets[2 * b + 1]);
+          contact_->crack_body(model_.pieces.body_of(model_.tets.piece[t]));
+        }
   }
 
   // 4 contact detection: only when a node has moved more than buffer/2 since the last one

@@ -206,9 +206,18 @@ void Simulation::restore_checkpoint(const std::string& path) {
   if (contact_) {
     // A tet's joint state: cracked once one of its joints broke, intact while it has joints.
     std::vector<std::uint8_t> joint_state = contact_->tet_joint_states();
+    // A body with a broken joint anywhere (on any rank) has no enclosed tets left out.
+    std::vector<std::int32_t> cracked(static_cast<std::size_t>(model_.pieces.bodies()), 0);
     for (LocalIndex j = 0; j < joint_rows.size(); ++j)
       if (joint_rows.broken[j])
-        for (int side = 0; side < 2; ++side) joint_state[joint_rows.tets[2 * j + side]] = 2;
+        for (int side = 0; side < 2; ++side) {
+          const LocalIndex t = joint_rows.tets[2 * j + side];
+          joint_state[t] = static_cast<std::uint8_t>(TetJointState::cracked);
+          cracked[static_cast<std::size_t>(model_.pieces.body_of(model_.tets.piece[t]))] = 1;
+        }
+    comm_->max_in_place(cracked);
+    for (std::size_t b = 0; b < cracked.size(); ++b)
+      if (cracked[b]) contact_->crack_body(static_cast<std::int32_t>(b));
     std::vector<FrictionEntry> friction;  // the pairs whose first tet is held here
     for (std::size_t i = 0; i < rows.friction_a.size(); ++i) {
       FrictionEntry e;

@@ -6,10 +6,12 @@
 #include <limits>
 #include <numeric>
 
+#include "contact/contact_stage.hpp"
 #include "core/error.hpp"
 #include "core/joint_placement.hpp"
 #include "parallel/boundary_matching.hpp"
 #include "parallel/directory_hash.hpp"
+#include "parallel/enclosed_tets.hpp"
 
 namespace fdem {
 
@@ -361,6 +363,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
 
   // 1b Face directory: counts, joints across blocks, boundary faces.
   std::vector<FaceRecord> boundary;  // boundary faces this rank answers for, by (body, key)
+  std::vector<BoundaryMeshNode> jointed_boundary;  // their nodes, in `joints: all` bodies
   std::vector<std::vector<BoundaryNotice>> notices(static_cast<std::size_t>(ranks));
   {
     std::vector<FaceRecord> singles = comm.exchange(face_out);
@@ -413,7 +416,10 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
         const FaceRecord &p = *here[0], &q = *here[1];
         send_draft(make_draft(p.tet, p.node, p.volume, p.extent, q.tet, q.node, q.volume, q.extent,
                               material_of(b)));
-      } else if (count == 1 && roles.matched(static_cast<std::size_t>(b))) {
+      }
+      if (count == 1 && roles.jointed[static_cast<std::size_t>(b)])
+        for (int k = 0; k < 3; ++k) jointed_boundary.push_back({b, key[k]});
+      if (count == 1 && roles.matched(static_cast<std::size_t>(b))) {
         boundary.push_back(*here[0]);
         notices[static_cast<std::size_t>(block_owner(tet_block, here[0]->tet))].push_back(
             {here[0]->tet, {key[0], key[1], key[2]}});
@@ -588,6 +594,13 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
                                       keys.begin());
     out.joints.push_back(j);
   }
+  // 8  Enclosed tets (bonded on all four faces): their joint state says so.
+  const std::vector<std::uint8_t> enclosed =
+      enclosed_face_tets(std::move(jointed_boundary), face_tets, roles.jointed, comm);
+  for (std::size_t i = 0; i < face_tets.size(); ++i)
+    if (enclosed[i])
+      out.bonded[static_cast<std::size_t>(face_tets[i].tet)] =
+          static_cast<std::uint8_t>(TetJointState::enclosed);
   return out;
 }
 

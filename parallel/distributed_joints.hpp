@@ -44,7 +44,7 @@ struct BlockJoints {
   std::vector<StartJoint> joints;      // tet A in this block, ascending gid
   std::vector<JointLawSpec> laws;      // of the whole model
   GlobalId n_joints = 0;               // of the whole model
-  std::vector<std::uint8_t> bonded;    // per local tet: 1 when a joint bonds it
+  std::vector<std::uint8_t> bonded;    // per local tet: its TetJointState (intact or enclosed)
   std::vector<double> partner_extent;  // per local tet: largest extent (m) of a tet bonded to it
 };
 

@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "contact/contact_stage.hpp"
 #include "core/error.hpp"
 #include "core/model_builder.hpp"
 #include "drivers/mesh_generators.hpp"
@@ -97,12 +98,12 @@ Scene jointed_scene() {
   brick.name = "brick";
   brick.fracture = fracture(3e5);
   scene.materials = {rock, brick};
-  BodySpec bar = builders::box_body("bar", Vec3(0, -0.05, -0.05), Vec3(0.6, 0.05, 0.05), 9, 3, 2);
+  BodySpec bar = builders::box_body("bar", Vec3(0, -0.05, -0.05), Vec3(0.6, 0.05, 0.05), 9, 3, 3);
   bar.joints = JointPlacement::all;
   bar.velocity = Vec3(2, 0, 0);
   scene.bodies.push_back(bar);
   scene.bodies.push_back(
-      builders::box_body("cap", Vec3(0.6, -0.05, -0.05), Vec3(0.7, 0.05, 0.05), 1, 3, 2, 1));
+      builders::box_body("cap", Vec3(0.6, -0.05, -0.05), Vec3(0.7, 0.05, 0.05), 1, 3, 3, 1));
   BodySpec wall;
   wall.name = "wall";
   wall.material = 1;
@@ -304,6 +305,16 @@ TEST_CASE("distributed start-up: joints, contact groups and joint states are the
     reach[a] = std::max(reach[a], extent[b]);
     reach[b] = std::max(reach[b], extent[a]);
   }
+  // Enclosed bar tets (no corner on the bar's surface): the distributed start finds the same.
+  REQUIRE(serial.tets.enclosed.size() == static_cast<std::size_t>(serial.tets.size()));
+  long enclosed = 0;
+  for (LocalIndex t = 0; t < serial.tets.size(); ++t)
+    if (serial.tets.enclosed[t]) {
+      CHECK(bonded[t] == 1);
+      bonded[t] = static_cast<char>(fdem::TetJointState::enclosed);
+      ++enclosed;
+    }
+  CHECK(enclosed > 0);
   CHECK(block.tet_joint_state.size() == static_cast<std::size_t>(local.tets.size()));
   CHECK(block.tet_reach.size() == static_cast<std::size_t>(local.tets.size()));
   long tet_mismatches = 0;

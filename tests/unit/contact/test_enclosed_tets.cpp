@@ -1,0 +1,168 @@
+// Enclosed tets (TetJointState::enclosed): tets of a `joints: all` body with no corner on the
+// body mesh's boundary are found by build_model and left out of contact while the body's joints
+// hold.  Leaving them out changes no force (no left-out pair overlaps in a body deformed within
+// its joints' reach) and a broken joint of the body brings them back.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <random>
+#include <set>
+
+#include "contact/contact_stage.hpp"
+#include "core/model_builder.hpp"
+
+using namespace fdem;
+
+namespace {
+
+// A cube [0, n·h]³ of n³ cells of 6 Kuhn tets each (diagonal 0–7, positively oriented).
+BodyMesh kuhn_cube(int n, double h) {
+  BodyMesh mesh;
+  mesh.source = "test";
+  const auto id = [&](int i, int j, int k) {
+    return static_cast<LocalIndex>(i + (n + 1) * (j + (n + 1) * k));
+  };
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) mesh.coords.insert(mesh.coords.end(), {i * h, j * h, k * h});
+  const LocalIndex kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
+                                 {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        LocalIndex corner[8];
+        for (int c = 0; c < 8; ++c) corner[c] = id(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
+        for (const auto& t : kuhn)
+          for (int c = 0; c < 4; ++c) mesh.tets.push_back(corner[t[c]]);
+      }
+  return mesh;
+}
+
+Scene jointed_scene() {
+  Scene scene;
+  scene.source_path = "test";
+  MaterialSpec rock;
+  rock.name = "rock";
+  rock.density = 2500;
+  rock.elastic.young = 1e9;
+  rock.elastic.poisson = 0.25;
+  rock.contact.friction = 0.5;
+  FractureSpec fracture;
+  fracture.tensile_strength = 1e6;
+  fracture.cohesion = 2e6;
+  fracture.friction_angle_deg = 30.0;
+  fracture.energy_I = 10.0;
+  fracture.energy_II = 50.0;
+  rock.fracture = fracture;
+  scene.materials.push_back(rock);
+  BodySpec body;
+  body.name = "cube";
+  body.material = 0;
+  body.joints = JointPlacement::all;
+  scene.bodies.push_back(body);
+  return scene;
+}
+
+std::vector<std::pair<LocalIndex, LocalIndex>> bonds(const Model& model) {
+  std::vector<std::pair<LocalIndex, LocalIndex>> out;
+  for (LocalIndex j = 0; j < model.joints.size(); ++j)
+    out.emplace_back(model.joints.tets[2 * j], model.joints.tets[2 * j + 1]);
+  return out;
+}
+
+std::set<std::pair<LocalIndex, LocalIndex>> pairs_of(const ContactStage& stage) {
+  std::set<std::pair<LocalIndex, LocalIndex>> out;
+  for (const CandidatePair& p : stage.candidates()) out.emplace(p.a, p.b);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("build_model marks the jointed tets with no corner on the mesh boundary as enclosed",
+          "[contact][enclosed]") {
+  const int n = 4;
+  const double h = 0.1;
+  const Model model = build_model(jointed_scene(), {kuhn_cube(n, h)});
+  REQUIRE(model.tets.enclosed.size() == static_cast<std::size_t>(model.tets.size()));
+  long enclosed = 0;
+  for (LocalIndex t = 0; t < model.tets.size(); ++t) {
+    bool inside = true;  // by geometry: no corner on a face of the cube
+    for (int c = 0; c < 4; ++c)
+      for (int d = 0; d < 3; ++d) {
+        const double x = model.nodes.x0[3 * model.tets.nodes[4 * t + c] + d];
+        inside = inside && x > 1e-9 && x < n * h - 1e-9;
+      }
+    CHECK(model.tets.enclosed[t] == (inside ? 1 : 0));
+    enclosed += model.tets.enclosed[t];
+  }
+  // Every Kuhn tet holds its cell's corners 0 and 7: only the 2³ inner cells' 48 tets.
+  CHECK(enclosed == 48);
+}
+
+TEST_CASE("enclosed tets stay out of contact, change no force, and return when a joint breaks",
+          "[contact][enclosed]") {
+  // The jointed cube and a plain block pressed 1 mm into its top face; the cube's nodes shaken
+  // by 0.5 % of a cell, so its tets press into each other across the joints.
+  Scene scene = jointed_scene();
+  BodySpec lid = scene.bodies[0];
+  lid.name = "lid";
+  lid.joints = JointPlacement::none;
+  scene.bodies.push_back(lid);
+  BodyMesh block = kuhn_cube(1, 0.3);
+  for (std::size_t i = 0; i < block.coords.size(); ++i) block.coords[i] += i % 3 == 2 ? 0.499 : 0.1;
+  Model model = build_model(scene, {kuhn_cube(5, 0.1), block});
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> shake(-5e-4, 5e-4);
+  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
+    if (model.pieces.body_of(model.nodes.piece[n]) == 0)
+      for (int d = 0; d < 3; ++d) model.nodes.x[3 * n + d] += shake(random);
+  const double buffer = 0.025;
+  ContactStage skipping(model, ContactSettings{buffer, true});
+  ContactStage all(model, ContactSettings{buffer, false});
+  for (ContactStage* stage : {&skipping, &all}) {
+    stage->set_bonds(model.tets.size(), bonds(model));
+    stage->enclose(model.tets.enclosed);
+    stage->detect(model);
+  }
+  const long n_enclosed = std::count(model.tets.enclosed.begin(), model.tets.enclosed.end(), 1);
+  REQUIRE(n_enclosed == 6 * 27);
+  CHECK(skipping.left_out() == n_enclosed);
+  CHECK(all.left_out() == 0);
+  // The same candidates but those with an enclosed tet.
+  std::set<std::pair<LocalIndex, LocalIndex>> expected;
+  long with_enclosed = 0;
+  for (const auto& [a, b] : pairs_of(all)) {
+    if (model.tets.enclosed[a] || model.tets.enclosed[b])
+      ++with_enclosed;
+    else
+      expected.emplace(a, b);
+  }
+  CHECK(with_enclosed > 0);
+  CHECK(pairs_of(skipping) == expected);
+  // Bit for bit the same forces: no left-out pair overlaps.
+  std::vector<double> f_skipping(model.nodes.x.size(), 0.0), f_all(model.nodes.x.size(), 0.0);
+  model.nodes.f.assign(model.nodes.x.size(), 0.0);
+  const ContactForceSummary s_all = all.add_forces(model, 1e-6);
+  f_all = model.nodes.f;
+  model.nodes.f.assign(model.nodes.x.size(), 0.0);
+  const ContactForceSummary s_skipping = skipping.add_forces(model, 1e-6);
+  f_skipping = model.nodes.f;
+  CHECK(s_all.active_pairs > 0);
+  CHECK(s_all.active_pairs == s_skipping.active_pairs);
+  CHECK(s_all.energy == s_skipping.energy);
+  CHECK(f_skipping == f_all);
+  // A broken joint anywhere in the body: its enclosed tets are candidates again.
+  skipping.crack_body(0);
+  CHECK(skipping.detection_due(model));
+  skipping.detect(model);
+  CHECK(skipping.left_out() == 0);
+  CHECK(pairs_of(skipping) == pairs_of(all));
+  // The joint state travels with the tets: enclosed, intact (the cube's other tets) or none.
+  const std::vector<std::uint8_t> states = skipping.tet_joint_states();
+  for (LocalIndex t = 0; t < model.tets.size(); ++t) {
+    const TetJointState expected = model.tets.enclosed[t] ? TetJointState::enclosed
+                                   : model.pieces.body_of(model.tets.piece[t]) == 0
+                                       ? TetJointState::intact
+                                       : TetJointState::none;
+    CHECK(states[t] == static_cast<std::uint8_t>(expected));
+  }
+}
