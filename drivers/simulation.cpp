@@ -491,12 +491,12 @@ void Simulation::step() {
     if (distribution_)
       detection_due = share_broken_joints(travel_detection);
     else if (j.newly_broken > 0 && contact_)
-      for (LocalIndex b : joints_->newly_broken())
-        for (int side = 0; side < 2; ++side) {
-          const LocalIndex t = model_.joints.tets[2 * b + side];
-          if (side == 0) contact_->release_bond(t, model_.joints.tets[2 * b + 1]);
+      for (LocalIndex b : joints_->newly_broken()) {
+        const LocalIndex tet_a = model_.joints.tets[2 * b], tet_b = model_.joints.tets[2 * b + 1];
+        contact_->release_bond(tet_a, tet_b);
+        for (LocalIndex t : {tet_a, tet_b})
           contact_->crack_body(model_.pieces.body_of(model_.tets.piece[t]));
-        }
+      }
   }
 
   // 4 contact detection: only when a node has moved more than buffer/2 since the last one

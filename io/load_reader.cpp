@@ -49,6 +49,19 @@ std::vector<int> read_body_list(const Reader& r, const YAML::Node& node, const s
   return out;
 }
 
+RegionSpec read_box_region(const Reader& r, const YAML::Node& region, const std::string& path) {
+  r.check_keys(region, path, {"box"}, {"box"});
+  r.check_keys(region["box"], path + ".box", {"min", "max"}, {"min", "max"});
+  RegionSpec reg;
+  reg.min = r.vec3(region["box"]["min"], path + ".box.min");
+  reg.max = r.vec3(region["box"]["max"], path + ".box.max");
+  for (int k = 0; k < 3; ++k)
+    if (reg.max[k] < reg.min[k])
+      r.fail(region["box"]["max"], path + ".box.max",
+             "each component of max must be at least min's (the box would hold no node)");
+  return reg;
+}
+
 namespace {
 
 // A unit vector from a non-zero [x, y, z].
@@ -124,16 +137,7 @@ void read_where(const Reader& r, const YAML::Node& l, const std::string& lp,
   if (l["bodies"]) {
     load.bodies = read_body_list(r, l["bodies"], lp + ".bodies", body_names);
   } else if (const YAML::Node region = l["region"]) {
-    r.check_keys(region, lp + ".region", {"box"}, {"box"});
-    r.check_keys(region["box"], lp + ".region.box", {"min", "max"}, {"min", "max"});
-    RegionSpec reg;
-    reg.min = r.vec3(region["box"]["min"], lp + ".region.box.min");
-    reg.max = r.vec3(region["box"]["max"], lp + ".region.box.max");
-    for (int k = 0; k < 3; ++k)
-      if (reg.max[k] < reg.min[k])
-        r.fail(region["box"]["max"], lp + ".region.box.max",
-               "each component of max must be at least min's (the box would hold no node)");
-    load.region = reg;
+    load.region = read_box_region(r, region, lp + ".region");
   } else {
     r.fail(l, lp, "a load needs 'bodies' or 'region' to say where it acts");
   }

@@ -14,6 +14,10 @@ namespace fdem {
 std::vector<int> read_body_list(const scene_yaml::Reader& r, const YAML::Node& node,
                                 const std::string& path, const std::vector<std::string>& names);
 
+// {box: {min: [x, y, z], max: [x, y, z]}}: the region of a load or an absorbing boundary.
+RegionSpec read_box_region(const scene_yaml::Reader& r, const YAML::Node& region,
+                           const std::string& path);
+
 // loads: appends each load to scene.loads (after the bodies have been read).
 void read_loads(const scene_yaml::Reader& r, const YAML::Node& loads, const std::string& scene_dir,
                 const std::vector<std::string>& body_names, Scene& scene);

@@ -3,26 +3,10 @@
 #include <string>
 #include <vector>
 
+#include "io/load_reader.hpp"
 #include "io/scene_reader_support.hpp"
 
 namespace fdem::scene_reading {
-
-namespace {
-
-RegionSpec read_box_region(const Reader& r, const YAML::Node& region, const std::string& path) {
-  r.check_keys(region, path, {"box"}, {"box"});
-  r.check_keys(region["box"], path + ".box", {"min", "max"}, {"min", "max"});
-  RegionSpec reg;
-  reg.min = r.vec3(region["box"]["min"], path + ".box.min");
-  reg.max = r.vec3(region["box"]["max"], path + ".box.max");
-  for (int k = 0; k < 3; ++k)
-    if (reg.max[k] < reg.min[k])
-      r.fail(region["box"]["max"], path + ".box.max",
-             "each component of max must be at least min's (the box would hold no node)");
-  return reg;
-}
-
-}  // namespace
 
 std::vector<AbsorbingSpec> read_absorbing(const Reader& r, const YAML::Node& node,
                                           const std::vector<std::string>& body_names) {
