@@ -143,9 +143,11 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes) {
     for (int k = 0; k < 3; ++k) nodes.f[3 * n + k] += nodes.mass[n] * gravity[k];
 }
 
-IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
+IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
+                                                double local_damping) {
   IntegrationSummary out;
   double kinetic2 = 0.0, kinetic_half2 = 0.0, max_dx2 = 0.0;
+  double damping_power_old = 0.0, damping_power_new = 0.0;  // W, Σ f_d·v⁻ and Σ f_d·v⁺
   for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
     const double m = nodes.mass[n];
     const std::uint8_t mask = nodes.constrained[n];
@@ -154,6 +156,13 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
       const std::size_t i = 3 * static_cast<std::size_t>(n) + k;
       const double v_old = nodes.v[i];
       double v_new = v_old + dt * nodes.f[i] / m;
+      if (local_damping > 0.0 && !(mask & (1u << k)) && v_old != 0.0) {
+        // The damping force opposes v⁻; v⁻ = 0 (a node at rest) gets none.
+        const double f_damping = -local_damping * std::abs(nodes.f[i]) * (v_old > 0 ? 1.0 : -1.0);
+        v_new += dt * f_damping / m;
+        damping_power_old += f_damping * v_old;
+        damping_power_new += f_damping * v_new;
+      }
       if (mask & (1u << k)) {
         v_new = nodes.prescribed_velocity[i];
         const double reaction = m * (v_new - v_old) / dt - nodes.f[i];
@@ -171,6 +180,8 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes) {
     }
     max_dx2 = std::max(max_dx2, dx2);
   }
+  out.local_damping_work_before = 0.5 * dt * damping_power_old;
+  out.local_damping_work_after = 0.5 * dt * damping_power_new;
   out.kinetic_energy = 0.5 * kinetic2;
   out.kinetic_energy_half_step = 0.5 * kinetic_half2;
   out.max_displacement_increment = std::sqrt(max_dx2);

@@ -46,16 +46,23 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes);
 struct IntegrationSummary {
   double kinetic_energy = 0.0;  // J, ½m·v⁻·v⁺ (the energy central difference conserves)
   double constraint_work_before = 0.0;  // J, reactions at prescribed components · (x_n − x_n−1)/2
-  double constraint_work_after = 0.0;     // J, reactions · (x_n+1 − x_n)/2
-  double kinetic_energy_half_step = 0.0;  // J, ½m|v_n+½|² (grows in an unstable run)
-  Vec3 momentum_before = Vec3::Zero();    // Σ m·v_n−½ (kg m/s), for the work of uniform loads
-  Vec3 momentum_after = Vec3::Zero();     // Σ m·v_n+½
+  double constraint_work_after = 0.0;      // J, reactions · (x_n+1 − x_n)/2
+  double kinetic_energy_half_step = 0.0;   // J, ½m|v_n+½|² (grows in an unstable run)
+  Vec3 momentum_before = Vec3::Zero();     // Σ m·v_n−½ (kg m/s), for the work of uniform loads
+  Vec3 momentum_after = Vec3::Zero();      // Σ m·v_n+½
+  double local_damping_work_before = 0.0;  // J, local damping forces · (x_n − x_n−1)/2 (≤ 0)
+  double local_damping_work_after = 0.0;   // J, local damping forces · (x_n+1 − x_n)/2
   double max_displacement_increment = 0.0;  // m, largest |Δx| of a node this step
   bool finite = true;                       // false if any velocity became NaN or infinite
 };
 
 // Central difference: v⁺ = v⁻ + dt·f/m (prescribed components set), x += dt·v⁺, on owned nodes.
-IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes);
+// With local_damping α > 0 (Cundall's non-viscous damping, quasi-static runs) every free component
+// is driven by f − α·|f|·sign(v⁻) instead of f: the unbalanced force is reduced by the fraction α
+// while a node moves with it and enlarged while it moves against it, whatever the mass or
+// frequency.  Its work is returned for the energy balance.
+IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
+                                                double local_damping = 0.0);
 
 // Mass-weighted position, velocity and rotation of every piece of a model held whole by one
 // process, indexed by piece id (exact sums: core/piece_moments; on N ranks

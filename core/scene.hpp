@@ -274,6 +274,14 @@ struct ParallelSpec {
   std::int64_t gid_offset = 0;
 };
 
+// Quasi-static mode: Cundall's local non-viscous damping on every free node component (the
+// dynamics are then not physical: only the equilibria and the collapse thresholds are).
+struct QuasiStaticSpec {
+  double local_damping = 0.0;  // α in [0, 1): the unbalanced force is damped by α·|f|; 0: off
+  double until = HUGE_VAL;     // s: dynamic (undamped) from this time on, e.g. after settling
+  bool active_at(double t) const { return local_damping > 0.0 && t < until; }
+};
+
 // Ceilings between a valid scene and a runnable one (drivers/run_limits): checked by `fdem check`
 // and `run` before the meshes are generated and again on the built model.
 struct LimitsSpec {
@@ -292,6 +300,7 @@ struct Scene {
   std::vector<LoadSpec> loads;
   std::vector<AbsorbingSpec> absorbing;  // viscous absorbing boundaries
   std::vector<InitialStressSpec> initial_stress;
+  QuasiStaticSpec quasi_static;
   OutputSpec output;
   double contact_buffer = -1.0;       // m; < 0: automatic
   bool contact_skip_enclosed = true;  // contact.skip_enclosed (ContactSettings::skip_enclosed)

@@ -552,7 +552,9 @@ void Simulation::step() {
     Timed timed(clocks_[integrate]);
     // The stored velocity is v(t − dt/2): at the start turn the initial v(0) into it (half kick).
     if (steps_ == 0) start_half_step(nodes);
-    motion = integrate_central_difference(dt_, nodes);
+    const double local_damping =
+        scene_.quasi_static.active_at(time_) ? scene_.quasi_static.local_damping : 0.0;
+    motion = integrate_central_difference(dt_, nodes, local_damping);
     if (absorbing_) boundary_after = absorbing_->dissipation_after(dt_, model_);
     moved_since_distribution_ = true;
     // The surface loads' work goes with the reactions' (external_work), by the same trapezoid.
@@ -623,7 +625,9 @@ void Simulation::step() {
                   tunnel_ranks,
                   contact_after.damping,
                   boundary_before,
-                  boundary_after});
+                  boundary_after,
+                  motion.local_damping_work_before,
+                  motion.local_damping_work_after});
     comm_->sum_in_place(terms);
     int i = 0;
     for (double* v :
@@ -645,6 +649,8 @@ void Simulation::step() {
     contact_after.damping = terms[26];
     boundary_before = terms[27];
     boundary_after = terms[28];
+    motion.local_damping_work_before = terms[29];
+    motion.local_damping_work_after = terms[30];
     reduction_seconds_ +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -673,8 +679,10 @@ void Simulation::step() {
     energy.gravity = -ledger_.gravity.add(0.5 * dt_ * model_.gravity.dot(motion.momentum_before),
                                           0.5 * dt_ * model_.gravity.dot(motion.momentum_after));
   const double viscous_step = forces.damping_power * dt_;  // element damping, J
-  energy.dissipated_damping = ledger_.damping.add(0.5 * viscous_step + c.work_before.damping,
-                                                  0.5 * viscous_step + contact_after.damping);
+  // Element and contact dashpots, and the local damping of a quasi-static run (its work is ≤ 0).
+  energy.dissipated_damping = ledger_.damping.add(
+      0.5 * viscous_step + c.work_before.damping - motion.local_damping_work_before,
+      0.5 * viscous_step + contact_after.damping - motion.local_damping_work_after);
   energy.external_work =
       ledger_.external.add(motion.constraint_work_before, motion.constraint_work_after);
   if (absorbing_)

@@ -513,7 +513,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   scene.source_path = path;
   r.check_keys(root, "",
                {"name", "time", "gravity", "materials", "bodies", "interfaces", "loads", "output",
-                "contact", "parallel", "limits", "absorbing", "initial_stress"},
+                "contact", "parallel", "limits", "absorbing", "initial_stress", "quasi_static"},
                {"time", "materials", "bodies"});
   scene.name =
       root["name"] ? r.string(root["name"], "name") : std::filesystem::path(path).stem().string();
@@ -699,6 +699,8 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     }
   }
 
+  if (const YAML::Node quasi = root["quasi_static"])
+    scene.quasi_static = scene_reading::read_quasi_static(r, quasi);
   if (const YAML::Node limits = root["limits"]) read_limits(r, limits, scene.limits);
   check_intervals(r, root["output"], scene);
 

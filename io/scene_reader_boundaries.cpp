@@ -1,5 +1,6 @@
-// Scene keys of boundaries and initial state: `absorbing:` (viscous absorbing boundaries) and
-// `initial_stress:` (uniform or geostatic in-situ stress).  docs/scene-format.md.
+// Scene keys of boundaries and initial state: `absorbing:` (viscous absorbing boundaries),
+// `initial_stress:` (uniform or geostatic in-situ stress) and `quasi_static:` (local damping, for
+// settling or quasi-static runs).  docs/scene-format.md.
 #include <string>
 #include <vector>
 
@@ -77,6 +78,20 @@ std::vector<InitialStressSpec> read_initial_stress(const Reader& r, const YAML::
     out.push_back(spec);
   }
   return out;
+}
+
+QuasiStaticSpec read_quasi_static(const Reader& r, const YAML::Node& node) {
+  r.check_keys(node, "quasi_static", {"local_damping", "until"}, {"local_damping"});
+  QuasiStaticSpec spec;
+  spec.local_damping = r.number(node["local_damping"], "quasi_static.local_damping");
+  if (!(spec.local_damping > 0.0 && spec.local_damping < 1.0))
+    r.fail(node["local_damping"], "quasi_static.local_damping",
+           "must be in (0, 1): the fraction of a node's unbalanced force taken by the damping (0.8 "
+           "is usual)");
+  if (node["until"])
+    spec.until = r.positive(node["until"], "quasi_static.until",
+                            "time (s) after which the run is dynamic again");
+  return spec;
 }
 
 }  // namespace fdem::scene_reading

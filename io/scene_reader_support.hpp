@@ -38,5 +38,8 @@ std::vector<InitialStressSpec> read_initial_stress(const Reader& r, const YAML::
                                                    const std::vector<std::string>& body_names,
                                                    const Vec3& gravity);
 
+// `quasi_static:` (io/scene_reader_boundaries.cpp): {local_damping: α, until: t}.
+QuasiStaticSpec read_quasi_static(const Reader& r, const YAML::Node& node);
+
 }  // namespace scene_reading
 }  // namespace fdem

@@ -159,10 +159,10 @@ TEST_CASE("enclosed tets stay out of contact, change no force, and return when a
   // The joint state travels with the tets: enclosed, intact (the cube's other tets) or none.
   const std::vector<std::uint8_t> states = skipping.tet_joint_states();
   for (LocalIndex t = 0; t < model.tets.size(); ++t) {
-    const TetJointState expected = model.tets.enclosed[t] ? TetJointState::enclosed
-                                   : model.pieces.body_of(model.tets.piece[t]) == 0
-                                       ? TetJointState::intact
-                                       : TetJointState::none;
-    CHECK(states[t] == static_cast<std::uint8_t>(expected));
+    const TetJointState want = model.tets.enclosed[t] ? TetJointState::enclosed
+                               : model.pieces.body_of(model.tets.piece[t]) == 0
+                                   ? TetJointState::intact
+                                   : TetJointState::none;
+    CHECK(states[t] == static_cast<std::uint8_t>(want));
   }
 }

@@ -70,3 +70,26 @@ TEST_CASE("initial_stress and absorbing: errors name the key", "[io][initial_str
   CHECK_THAT(error(scene_with("absorbing:\n  - {region: {box: {min: [0, 0, 0]}}}\n")),
              Contains("absorbing[0].region.box.max: missing required key 'max'"));
 }
+
+TEST_CASE("quasi_static: local damping and the time it ends; errors name the key",
+          "[io][quasi_static]") {
+  const fdem::Scene off = fdem::parse_scene(scene_with(""), "scene.yaml");
+  CHECK_FALSE(off.quasi_static.active_at(0.0));
+  const fdem::Scene s = fdem::parse_scene(
+      scene_with("quasi_static: {local_damping: 0.8, until: 0.05}\n"), "scene.yaml");
+  CHECK(s.quasi_static.local_damping == 0.8);
+  CHECK(s.quasi_static.active_at(0.0499));
+  CHECK_FALSE(s.quasi_static.active_at(0.05));
+  const fdem::Scene whole =
+      fdem::parse_scene(scene_with("quasi_static: {local_damping: 0.7}\n"), "scene.yaml");
+  CHECK(whole.quasi_static.active_at(1e9));
+  CHECK_THAT(
+      error(scene_with("quasi_static: {local_damping: 1.0}\n")),
+      Contains("scene.yaml:8:31:") && Contains("quasi_static.local_damping: must be in (0, 1)"));
+  CHECK_THAT(error(scene_with("quasi_static: {until: 0.1}\n")),
+             Contains("quasi_static.local_damping: missing required key 'local_damping'"));
+  CHECK_THAT(error(scene_with("quasi_static: {local_damping: 0.8, until: -1}\n")),
+             Contains("quasi_static.until"));
+  CHECK_THAT(error(scene_with("quasi_static: {local_damping: 0.8, ratio: 1}\n")),
+             Contains("quasi_static") && Contains("ratio"));
+}
