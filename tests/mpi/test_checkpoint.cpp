@@ -276,7 +276,7 @@ TEST_CASE("checkpoint: interleaved rows of every rank round-trip bit-exactly",
   CHECK(back.second.friction_a.size() == static_cast<std::size_t>(3 * comm.size()));
 }
 
-TEST_CASE("checkpoint: a rank without rows takes part; empty joint and friction tables",
+TEST_CASE("checkpoint: a rank without rows takes part, empty joint and friction tables",
           "[mpi][checkpoint]") {
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());
@@ -568,7 +568,7 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
   }
 }
 
-TEST_CASE("checkpoint: written through a temporary name; other files untouched",
+TEST_CASE("checkpoint: written through a temporary name, other files untouched",
           "[mpi][checkpoint]") {
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());

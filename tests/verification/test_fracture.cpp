@@ -208,7 +208,7 @@ ShearRun rigid_shear(const FractureSpec& f, double L, double w, int cells_x, int
 
 }  // namespace
 
-TEST_CASE("interface in shear: peak c, dissipation G_II; under compression c + σ·tanφ",
+TEST_CASE("interface in shear: peak c, dissipation G_II, under compression c + σ·tanφ",
           "[verification][fracture]") {
   const FractureSpec f = rock_fracture();
   const double tan_phi = std::tan(f.friction_angle_deg * M_PI / 180);

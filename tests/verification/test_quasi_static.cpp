@@ -70,7 +70,7 @@ Scene settled(Scene scene, double settle) {
 
 }  // namespace
 
-TEST_CASE("static friction holds at τ/μσ = 0.95 for 2 s after settling; a sudden load slides",
+TEST_CASE("static friction holds at τ/μσ = 0.95 for 2 s after settling, a sudden load slides",
           "[verification][quasi_static]") {
   const double mu = 0.7, angle = std::atan(0.95 * mu);  // 33.6°
   const Slide held = hold(settled(incline(angle, mu, 2.05), 0.05), 0.05);

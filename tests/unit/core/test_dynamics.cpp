@@ -61,7 +61,7 @@ TEST_CASE("local damping: a linear oscillator's turning points shrink by √((1�
   CHECK(dissipated > 0.9 * e0);  // six half cycles keep r^12 = 2 % of it
 }
 
-TEST_CASE("local damping: nothing on prescribed components or nodes at rest; α = 0 is plain",
+TEST_CASE("local damping: nothing on prescribed components or nodes at rest, α = 0 is plain",
           "[dynamics][quasi_static]") {
   NodeArrays damped = one_node(1.0, 0.0);
   damped.v[1] = 0.5;

@@ -107,7 +107,7 @@ TEST_CASE("surface loads: boundary faces, outward, without shared or joint faces
   }
 }
 
-TEST_CASE("surface loads: a region keeps faces with three corners inside; power is F·v",
+TEST_CASE("surface loads: a region keeps faces with three corners inside, power is F·v",
           "[core][surface_loads]") {
   Model model = build_model(one_body(false), {two_pieces()});
   LoadSpec load = pressure_on({}, 2.0);

@@ -179,7 +179,7 @@ TEST_CASE("running-bond wall: half units at the ends of alternate courses, joint
   CHECK(interface_joints(mesh) == 2 * (4 + 5) * 2 + 3 * 20 * 2);
 }
 
-TEST_CASE("a mortar gap separates the units; joints: interfaces then has nothing to bond",
+TEST_CASE("a mortar gap separates the units, joints: interfaces then has nothing to bond",
           "[drivers][generators]") {
   WallMeshSpec w;
   w.bond = WallMeshSpec::Bond::running;

@@ -132,7 +132,7 @@ TEST_CASE("fdem check and fdem run refuse a snapping penalty alike", "[joints][c
   CHECK(fdem_test::run_fdem(dir, "check ok.yaml").exit_code == 0);
 }
 
-TEST_CASE("a set penalty reaches every law; auto stays 50 E", "[joints]") {
+TEST_CASE("a set penalty reaches every law, auto stays 50 E", "[joints]") {
   const Model automatic = model_of(rock_scene(", penalty: {tangential: 3e12}"));
   REQUIRE(!automatic.joint_laws.empty());
   for (const JointLawSpec& law : automatic.joint_laws) {

@@ -136,7 +136,7 @@ TEST_CASE("a run needing more steps than limits.max_steps is refused with what s
   }
 }
 
-TEST_CASE("output intervals that cannot advance time are refused; short ones do not loop",
+TEST_CASE("output intervals that cannot advance time are refused, short ones do not loop",
           "[cli][limits]") {
   for (const char* key : {"every", "energy_every", "checkpoint_every"}) {
     const Outcome o =

@@ -128,7 +128,7 @@ TEST_CASE("acceleration records: header, comments, and a clear message with the 
                     Contains("/nonexistent/record.csv: cannot open"));
 }
 
-TEST_CASE("tilt angle grows at its rate from its start up to its maximum; ramps add to gravity",
+TEST_CASE("tilt angle grows at its rate from its start up to its maximum, ramps add to gravity",
           "[drivers][loads]") {
   Scene s;
   s.gravity = Vec3(0, 0, -10);
@@ -264,7 +264,7 @@ TEST_CASE(
   CHECK(m.centroid.y() - y0 == Approx(9.81 * 5.0 / 3.0 * T * T * T).epsilon(1e-3));
 }
 
-TEST_CASE("a prescribed velocity follows its time history; a later constant load keeps its nodes",
+TEST_CASE("a prescribed velocity follows its time history, a later constant load keeps its nodes",
           "[drivers][loads]") {
   // The block's top nodes move along z with v·h(t), h a quintic step over [0, T]: their
   // displacement after t_end > T is v·(T/2 + t_end − T) (the step is symmetric about T/2); the

@@ -87,7 +87,7 @@ TEST_CASE("plain progress: every 1 %, at most one line per 10 s, at least one pe
   }
 }
 
-TEST_CASE("progress in a log has no carriage return; on a terminal it rewrites one line",
+TEST_CASE("progress in a log has no carriage return, on a terminal it rewrites one line",
           "[progress]") {
   const std::string log = drive(false, 200000, 3600.0);
   CHECK(count(log, '\r') == 0);

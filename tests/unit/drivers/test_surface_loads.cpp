@@ -27,7 +27,7 @@ LoadSpec pressure_on_region(const Vec3& lo, const Vec3& hi, double p) {
 
 }  // namespace
 
-TEST_CASE("surface loads: a bar under end pressure shortens by p·L/E; the support holds p·A",
+TEST_CASE("surface loads: a bar under end pressure shortens by p·L/E, the support holds p·A",
           "[drivers][surface_loads]") {
   // Bar [0, 1] × [0, 0.1]² m, E = 1 GPa, ν = 0.25, held along x at x = 0 (free laterally: a
   // uniaxial stress).  The end pressure rises as a quintic step over 20 ms (20 P-wave transits),
@@ -46,10 +46,15 @@ TEST_CASE("surface loads: a bar under end pressure shortens by p·L/E; the suppo
   scene.loads.push_back(end);
   auto sim = builders::quiet_simulation(scene);
   CHECK(sim->plan().surface_loads);
-  double worst_balance = 0;
+  double worst_balance = 0, worst_time = 0;
   while (sim->time() < 0.03) {
     sim->step();
-    worst_balance = std::max(worst_balance, sim->energy().balance_error());
+    // From 5 ms on (the load at 10 % of p): before, every energy is round-off sized (~1e-20 J
+    // at 0.2 ms) and the relative balance error means nothing.
+    if (sim->time() >= 0.005 && sim->energy().balance_error() > worst_balance) {
+      worst_balance = sim->energy().balance_error();
+      worst_time = sim->time();
+    }
   }
   const Model& model = sim->model();
   double tip = 0, reaction = 0;  // m (mean ux at x = L), N (Σ −f at x = 0)
@@ -74,6 +79,8 @@ TEST_CASE("surface loads: a bar under end pressure shortens by p·L/E; the suppo
   // Strain energy ½·p·A·|u| = 0.05 J, all of it the pressure's work.
   CHECK(sim->energy().current().external_work ==
         Approx(0.5 * p * area * p * length / young).epsilon(1e-2));
+  INFO("balance at the end " << sim->energy().balance_error() << ", worst " << worst_balance
+                             << " at " << worst_time << " s");
   CHECK(worst_balance < 1e-6);
 }
 

@@ -98,7 +98,7 @@ TEST_CASE("rigid rotation (to 180°) and translation: no opening, no force, no d
   CHECK(worst_rotated <= 1e-8);  // round-off of gaps ~1e-5 m measured from coordinates ~0.3 m
 }
 
-TEST_CASE("forces and moments balance for arbitrary deformations; forces = −∂ψ/∂x",
+TEST_CASE("forces and moments balance for arbitrary deformations, forces = −∂ψ/∂x",
           "[fracture][joint]") {
   const CohesiveLaw law(rock_parameters());
   const Face face;
@@ -169,7 +169,7 @@ TEST_CASE("forces and moments balance for arbitrary deformations; forces = −�
 }
 
 TEST_CASE(
-    "damaged, slipped joint: forces = −∂ψ/∂x in elastic unloading; intact fast path "
+    "damaged, slipped joint: forces = −∂ψ/∂x in elastic unloading, intact fast path "
     "agrees with the general path",
     "[fracture][joint]") {
   const CohesiveLaw law(rock_parameters());

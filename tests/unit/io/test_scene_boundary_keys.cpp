@@ -71,7 +71,7 @@ TEST_CASE("initial_stress and absorbing: errors name the key", "[io][initial_str
              Contains("absorbing[0].region.box.max: missing required key 'max'"));
 }
 
-TEST_CASE("quasi_static: local damping and the time it ends; errors name the key",
+TEST_CASE("quasi_static: local damping and the time it ends, errors name the key",
           "[io][quasi_static]") {
   const fdem::Scene off = fdem::parse_scene(scene_with(""), "scene.yaml");
   CHECK_FALSE(off.quasi_static.active_at(0.0));
