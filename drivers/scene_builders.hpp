@@ -75,6 +75,18 @@ inline LoadSpec load_on_region(const Vec3& lo, const Vec3& hi, const Vec3& v, un
   return l;
 }
 
+// Tilting table: gravity turned about `axis` at `rate` (rad/s) from `start` (s) until it has
+// turned `max` (rad).
+inline LoadSpec tilt_load(const Vec3& axis, double rate, double max, double start) {
+  LoadSpec l;
+  l.kind = LoadSpec::Kind::tilt;
+  l.tilt.axis = axis;
+  l.tilt.rate = rate;
+  l.tilt.max = max;
+  l.tilt.start = start;
+  return l;
+}
+
 // Σ −f over the prescribed nodes of one body: the force the loading device applies (N).  Valid
 // after step() while the prescribed velocity is constant (reaction = −f).
 inline Vec3 reaction_on_body(const Model& model, int body) {

@@ -49,37 +49,6 @@ Scene block_on_base(double b, double h, double friction, double end_time, double
   return scene;
 }
 
-// What a block did while a load was held: slid along x (m) and turned (rad) during the hold.
-struct HoldResult {
-  double slid = 0;
-  double turned = 0;
-  double wall = 0;  // s
-  double balance = 0;
-};
-
-// Steps `sim` to its end; the hold starts at `hold_start`.  Piece 1 is the block.
-HoldResult run_hold(Simulation& sim, double hold_start) {
-  HoldResult r;
-  const auto clock = std::chrono::steady_clock::now();
-  Vec3 x0 = Vec3::Zero(), turn0 = Vec3::Zero();
-  bool held = false;
-  while (sim.time() < sim.scene().time.end - 1e-12) {
-    sim.step();
-    if (!held && sim.time() >= hold_start) {
-      const PieceMotion m = piece_motions(sim.model())[1];
-      x0 = m.centroid;
-      turn0 = m.rotation;
-      held = true;
-    }
-  }
-  const PieceMotion m = piece_motions(sim.model())[1];
-  r.slid = std::abs(m.centroid.x() - x0.x());
-  r.turned = (m.rotation - turn0).norm();
-  r.balance = sim.energy().balance_error();
-  r.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
-  return r;
-}
-
 // Tilting table (gravity turned about +y, towards −x): the block settles 0.2 s on the table
 // tilted `first` degrees below `angle`, which then tilts at 30°/s to 2° below `angle` and at
 // 4°/s on to `angle`, held 0.4 s.  (A start far from tipping saves steps; a block that may slide
@@ -92,15 +61,10 @@ HoldResult tilt_and_hold(double b, double h, double friction, double angle, doub
   Scene scene = block_on_base(b, h, friction, end, young);
   const double from = angle - first;
   scene.gravity = g * Vec3(-std::sin(from * deg), 0, -std::cos(from * deg));
-  for (int k = 0; k < 2; ++k) {  // two tilts about one axis add up
-    LoadSpec tilt;
-    tilt.kind = LoadSpec::Kind::tilt;
-    tilt.tilt.axis = Vec3(0, 1, 0);
-    tilt.tilt.rate = (k == 0 ? fast : slow) * deg;
-    tilt.tilt.max = (k == 0 ? first - pre : pre) * deg;
-    tilt.tilt.start = k == 0 ? start : slow_start;
-    scene.loads.push_back(tilt);
-  }
+  for (int k = 0; k < 2; ++k)  // two tilts about one axis add up
+    scene.loads.push_back(tilt_load(Vec3(0, 1, 0), (k == 0 ? fast : slow) * deg,
+                                    (k == 0 ? first - pre : pre) * deg,
+                                    k == 0 ? start : slow_start));
   auto sim = quiet_simulation(scene);
   REQUIRE(std::abs(gravity_at(scene, end).x() + g * std::sin(angle * deg)) < 1e-9);
   return run_hold(*sim, hold_start + 0.1);  // measured over the last 0.3 s

@@ -3,10 +3,8 @@
 // with 2 % contact damping, sliding starts between 0.995 and 1.005 tanθ = μ, and the same block
 // loaded suddenly without settling creeps (the vibration of the sudden load, docs/verification.md).
 #include <catch2/catch.hpp>
-#include <chrono>
 #include <cmath>
 
-#include "core/dynamics.hpp"
 #include "scene_helpers.hpp"
 
 using namespace fdem;
@@ -37,28 +35,10 @@ Scene incline(double angle, double mu, double end, double mesh_shift = 0.0) {
   return scene;
 }
 
-struct Slide {
-  double largest = 0.0;  // m, how far the block moved along x during the hold
-  double balance = 0.0;
-  double wall = 0.0;  // s
-};
-
-// Runs to the end; the hold starts at `hold_start`.  Piece 1 is the block.
-Slide hold(const Scene& scene, double hold_start) {
+// Runs `scene` to its end; what the block (piece 1) did from `hold_start` on.
+HoldResult hold(const Scene& scene, double hold_start) {
   auto sim = quiet_simulation(scene);
-  const auto clock = std::chrono::steady_clock::now();
-  std::vector<PieceMotion> start;
-  while (sim->time() < scene.time.end - 1e-12) {
-    sim->step();
-    if (start.empty() && sim->time() >= hold_start) start = piece_motions(sim->model());
-  }
-  const std::vector<PieceMotion> end = piece_motions(sim->model());
-  Slide s;
-  for (std::size_t p = 1; p < end.size(); ++p)
-    s.largest = std::max(s.largest, std::abs(end[p].centroid.x() - start[p].centroid.x()));
-  s.balance = sim->energy().balance_error();
-  s.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
-  return s;
+  return run_hold(*sim, hold_start);
 }
 
 // Settled under local damping 0.8 for `settle` seconds, then undamped until `end`.
@@ -73,14 +53,14 @@ Scene settled(Scene scene, double settle) {
 TEST_CASE("static friction holds at τ/μσ = 0.95 for 2 s after settling, a sudden load slides",
           "[verification][quasi_static]") {
   const double mu = 0.7, angle = std::atan(0.95 * mu);  // 33.6°
-  const Slide held = hold(settled(incline(angle, mu, 2.05), 0.05), 0.05);
+  const HoldResult held = hold(settled(incline(angle, mu, 2.05), 0.05), 0.05);
   // The same block without settling: the sudden load sets it rattling on the penalty springs and
   // it slides while the normal force swings low.
-  const Slide sudden = hold(incline(angle, mu, 0.25), 0.05);
-  INFO("settled: moved " << held.largest << " m in 2 s (wall " << held.wall
-                         << " s); sudden: " << sudden.largest << " m in 0.2 s");
-  CHECK(held.largest < 1e-4);
-  CHECK(sudden.largest > 5e-4);
+  const HoldResult sudden = hold(incline(angle, mu, 0.25), 0.05);
+  INFO("settled: moved " << held.slid << " m in 2 s (wall " << held.wall
+                         << " s); sudden: " << sudden.slid << " m in 0.2 s");
+  CHECK(held.slid < 1e-4);
+  CHECK(sudden.slid > 5e-4);
   CHECK(held.balance < 1e-3);
 }
 
@@ -96,15 +76,9 @@ TEST_CASE("sliding on a tilting table starts between 0.995 and 1.005 tanθ = μ"
       const double ratio = k == 0 ? 0.995 : 1.005, target = std::atan(ratio * mu);
       const double from = slide - 2 * deg, rate = 10 * deg, tilted = 0.05 + (target - from) / rate;
       Scene scene = settled(incline(from, mu, tilted + 0.35, shift), tilted + 0.05);
-      LoadSpec tilt;
-      tilt.kind = LoadSpec::Kind::tilt;
-      tilt.tilt.axis = Vec3(0, 1, 0);
-      tilt.tilt.rate = rate;
-      tilt.tilt.max = target - from;
-      tilt.tilt.start = 0.05;
-      scene.loads.push_back(tilt);
-      const Slide s = hold(scene, tilted + 0.05);
-      moved[k] = s.largest;
+      scene.loads.push_back(tilt_load(Vec3(0, 1, 0), rate, target - from, 0.05));
+      const HoldResult s = hold(scene, tilted + 0.05);
+      moved[k] = s.slid;
       CHECK(s.balance < 1e-3);
     }
     INFO("mesh shift " << shift << " m: at 0.995 μ moved " << moved[0] << " m, at 1.005 μ "
