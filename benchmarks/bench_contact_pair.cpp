@@ -4,10 +4,14 @@
 //   shallow      overlapping pairs 0.5 % of a tet size past first touch (typical in a run),
 //   mixed        every candidate pair of a random cloud (centres closer than one tet size, as a
 //                cell-based broad phase would hand over),
-// plus the rejection test alone (with and without edge-edge axes) on the mixed set.
+//   face_on_face pairs of tets resting face on face (masonry), pressed 0.1 % of the size,
+// each with the kernel and with the previous implementation (potential_contact_baseline), the
+// per-pair cost distribution of both, plus the rejection test alone (with and without edge-edge
+// axes) on the mixed set.
 // Usage: bench_contact_pair [out.csv] [cpu_seconds_per_case]  (default bench_contact_pair.csv, 1 s)
 // Rates are per second of thread CPU time.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -67,6 +71,49 @@ double throughput(const std::vector<Pair>& pairs, double seconds, Body body, dou
   return static_cast<double>(evaluations) / cpu;
 }
 
+// Per-pair cost distribution: each pair timed alone (best of 3 batches of 8 evaluations, steady
+// clock), kernel and baseline alternating pair by pair; percentiles in ns, also written to
+// <csv>.distribution.csv.
+void print_cost_distribution(
+    const std::vector<std::pair<const char*, const std::vector<Pair>*>>& sets, double penalty,
+    const std::string& csv_path) {
+  using clock = std::chrono::steady_clock;
+  std::ofstream csv(csv_path + ".distribution.csv");
+  csv << "case,kernel,p10_ns,p50_ns,p90_ns,p99_ns,mean_ns\n";
+  std::printf("per-pair cost (ns)                 p10      p50      p90      p99     mean\n");
+  double sink = 0.0;
+  for (const auto& [name, set] : sets) {
+    std::vector<double> cost[2];
+    for (const Pair& p : *set) {
+      for (int k = 0; k < 2; ++k) {
+        double best = 1e30;
+        for (int batch = 0; batch < 3; ++batch) {
+          const auto start = clock::now();
+          for (int rep = 0; rep < 8; ++rep)
+            sink += (k == 0 ? potential_contact(p.a, p.b, penalty)
+                            : potential_contact_baseline(p.a, p.b, penalty))
+                        .energy;
+          best = std::min(best, std::chrono::duration<double>(clock::now() - start).count() / 8);
+        }
+        cost[k].push_back(1e9 * best);
+      }
+    }
+    for (int k = 0; k < 2; ++k) {
+      std::vector<double>& c = cost[k];
+      std::sort(c.begin(), c.end());
+      double mean = 0.0;
+      for (double x : c) mean += x / static_cast<double>(c.size());
+      const auto at = [&](double q) { return c[static_cast<std::size_t>(q * (c.size() - 1))]; };
+      const char* kernel = k == 0 ? "kernel" : "baseline";
+      std::printf("%-18s %-9s %8.0f %8.0f %8.0f %8.0f %8.0f\n", name, kernel, at(0.1), at(0.5),
+                  at(0.9), at(0.99), mean);
+      csv << name << ',' << kernel << ',' << at(0.1) << ',' << at(0.5) << ',' << at(0.9) << ','
+          << at(0.99) << ',' << mean << '\n';
+    }
+  }
+  if (sink == 42.0) std::printf(" ");  // keep the evaluations
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -121,6 +168,25 @@ int main(int argc, char** argv) {
     const Pair q = moved(hi - 0.005);
     if (potential_contact(q.a, q.b, penalty).overlapping) shallow.push_back(q);
   }
+  // Face on face (masonry: blocks resting on each other): the bottom face of the upper tet lies
+  // in the top face plane of the lower one, pressed 0.1 % of the size into it, with a random
+  // in-plane shift and turn and random apexes (the meshes of the two blocks need not match).
+  std::vector<Pair> face_on_face;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  while (face_on_face.size() < 5000) {
+    const double depth = 1e-3, turn = 2.0 * M_PI * unit(rng);
+    const Mat3 spin = Eigen::AngleAxisd(turn, Vec3::UnitZ()).toRotationMatrix();
+    const Vec3 shift(0.6 * offset(rng), 0.6 * offset(rng), -depth);
+    Pair p;
+    p.a.x[0] = Vec3(0, 0, 0);
+    p.a.x[1] = Vec3(1, 0, 0);
+    p.a.x[2] = Vec3(0, 1, 0);
+    p.a.x[3] = Vec3(0.3 + 0.4 * unit(rng), 0.3 + 0.4 * unit(rng), -0.5 - 0.5 * unit(rng));
+    for (int v = 0; v < 3; ++v) p.b.x[v] = spin * p.a.x[v] + shift;
+    p.b.x[3] =
+        spin * Vec3(0.3 + 0.4 * unit(rng), 0.3 + 0.4 * unit(rng), 0.5 + 0.5 * unit(rng)) + shift;
+    if (potential_contact(p.a, p.b, penalty).overlapping) face_on_face.push_back(p);
+  }
   int mixed_overlapping = 0, mixed_face_pass = 0, mixed_edge_reject = 0;
   for (const Pair& p : mixed) {
     mixed_overlapping += potential_contact(p.a, p.b, penalty).overlapping;
@@ -131,6 +197,9 @@ int main(int argc, char** argv) {
 
   double sink = 0.0;
   auto contact = [&](const Pair& p) { return potential_contact(p.a, p.b, penalty).energy; };
+  auto baseline = [&](const Pair& p) {
+    return potential_contact_baseline(p.a, p.b, penalty).energy;
+  };
   auto contact_edge = [&](const Pair& p) {
     if (!tets_may_overlap(p.a, p.b) || separated_by_edge_axis(p.a, p.b)) return 0.0;
     return potential_contact(p.a, p.b, penalty).energy;
@@ -146,12 +215,19 @@ int main(int argc, char** argv) {
     double rate;
   };
   std::vector<Row> rows;
-  rows.push_back({"rejected_pairs", rejected.size(), throughput(rejected, seconds, contact, sink)});
-  rows.push_back(
-      {"overlapping_pairs", overlapping.size(), throughput(overlapping, seconds, contact, sink)});
-  rows.push_back(
-      {"shallow_overlapping_pairs", shallow.size(), throughput(shallow, seconds, contact, sink)});
-  rows.push_back({"mixed_cloud", mixed.size(), throughput(mixed, seconds, contact, sink)});
+  // Each case with the kernel and with the previous implementation (baseline), interleaved so
+  // that both see the same machine load.
+  const std::pair<const char*, const std::vector<Pair>*> cases[] = {
+      {"rejected_pairs", &rejected},
+      {"overlapping_pairs", &overlapping},
+      {"shallow_overlapping_pairs", &shallow},
+      {"face_on_face_pairs", &face_on_face},
+      {"mixed_cloud", &mixed}};
+  for (const auto& [name, set] : cases) {
+    rows.push_back({name, set->size(), throughput(*set, seconds, contact, sink)});
+    rows.push_back(
+        {std::string(name) + "_baseline", set->size(), throughput(*set, seconds, baseline, sink)});
+  }
   rows.push_back(
       {"mixed_cloud_with_edge_axes", mixed.size(), throughput(mixed, seconds, contact_edge, sink)});
   rows.push_back({"rejection_only_mixed", mixed.size(), throughput(mixed, seconds, reject, sink)});
@@ -170,6 +246,14 @@ int main(int argc, char** argv) {
     std::printf("%-32s %10zu %16.4e %12.1f\n", r.name.c_str(), r.pairs, r.rate, 1e9 / r.rate);
     csv << r.name << ',' << r.pairs << ',' << r.rate << ',' << 1e9 / r.rate << '\n';
   }
+  std::printf("speed-up over the baseline (same run):");
+  for (std::size_t r = 0; r + 1 < rows.size(); ++r)
+    if (rows[r + 1].name == rows[r].name + "_baseline")
+      std::printf(" %s %.2fx", rows[r].name.c_str(), rows[r].rate / rows[r + 1].rate);
+  std::printf("\n");
+  print_cost_distribution(
+      {{"overlapping_pairs", &overlapping}, {"shallow", &shallow}, {"face_on_face", &face_on_face}},
+      penalty, csv_path);
   std::printf("(checksum %.6e) wrote %s\n", sink, csv_path.c_str());
   return 0;
 }

@@ -121,17 +121,26 @@ struct SideIntegrals {
 // Accumulates one piece (sub-tet `own_sub` clipped): cone sums over all faces from an apex at the
 // piece's first vertex (a point of the piece: no cancellation between remote cones, so slivers
 // of overlap keep full relative precision), and the surface integrals on the faces that lie on
-// the other tet's faces.
+// the other tet's faces.  Both sums are linear in the vertex values, so each fan triangle only
+// adds scalar weights to its three vertices; the values (8 per vertex) are weighted once at the
+// end.  `moments`: how many carried values need their moment (4: own only, 8: own and other).
 // area_weight[j]: maps a barycentric-space doubled area vector to the doubled physical area
 // projected on face j's outward unit normal.
-void integrate_piece(const Piece& piece, int own_sub, const Vec3 (&area_weight)[4],
-                     SideIntegrals& out) {
-  bool used[kMaxVertices][3] = {};
-  const double* apex_values = piece.v[0].lam;  // apex: the first vertex of the piece
-  const Vec3 apex(apex_values[1], apex_values[2], apex_values[3]);
+void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight)[4][3],
+                     int moments, SideIntegrals& out) {
+  const int n = piece.count;
+  bool used[kMaxVertices][3];
+  double volume_weight[kMaxVertices];      // Σ vol6 of the cones having the vertex on their base
+  double surface_weight[4][kMaxVertices];  // per other face: Σ area × (f_k + Σf) of its triangles
+  bool on_face[4] = {false, false, false, false};
+  for (int v = 0; v < n; ++v) {
+    used[v][0] = used[v][1] = used[v][2] = false;
+    volume_weight[v] = 0.0;
+  }
+  const double* apex = piece.v[0].lam;  // apex: the first vertex of the piece
   double piece_vol6 = 0.0;
   int face[kMaxVertices];
-  for (int vs = 0; vs < piece.count; ++vs) {
+  for (int vs = 0; vs < n; ++vs) {
     for (int es = 0; es < 3; ++es) {
       if (used[vs][es]) continue;
       // Walk one face.
@@ -143,57 +152,77 @@ void integrate_piece(const Piece& piece, int own_sub, const Vec3 (&area_weight)[
         if (nf < kMaxVertices) face[nf++] = vc;
         face_planes &= piece.v[vc].planes;
         const int vn = piece.v[vc].next[e];
-        int back = 0;
-        while (back < 3 && piece.v[vn].next[back] != vc) ++back;
-        if (back == 3) return;  // corrupted graph: cannot happen
+        const int* back = piece.v[vn].next;
+        const int b = back[0] == vc ? 0 : back[1] == vc ? 1 : back[2] == vc ? 2 : 3;
+        if (b == 3) return;  // corrupted graph: cannot happen
         vc = vn;
-        e = (back + 1) % 3;
+        e = b == 2 ? 0 : b + 1;
       } while (vc != vs && nf < kMaxVertices);
       if (nf < 3) continue;
-      const bool on_other = (face_planes & kOtherFaceBits) != 0;
       int other_face = -1;
-      if (on_other) {
+      if (face_planes & kOtherFaceBits) {
         const unsigned bits = (face_planes & kOtherFaceBits) >> kOtherFaceShift;
         other_face = (bits & 1u) ? 0 : (bits & 2u) ? 1 : (bits & 4u) ? 2 : 3;
+        if (!on_face[other_face]) {
+          on_face[other_face] = true;
+          for (int v = 0; v < n; ++v) surface_weight[other_face][v] = 0.0;
+        }
       }
       // Fan from the face's first vertex.
-      const PieceVertex& p0 = piece.v[face[0]];
-      const Vec3 x0(p0.lam[1], p0.lam[2], p0.lam[3]);
-      const Vec3 h0 = x0 - apex;
+      const double* x0 = piece.v[face[0]].lam;
+      const double h0[3] = {x0[1] - apex[1], x0[2] - apex[2], x0[3] - apex[3]};
       for (int k = 1; k + 1 < nf; ++k) {
-        const PieceVertex& p1 = piece.v[face[k]];
-        const PieceVertex& p2 = piece.v[face[k + 1]];
-        const Vec3 area2 = (Vec3(p1.lam[1], p1.lam[2], p1.lam[3]) - x0)
-                               .cross(Vec3(p2.lam[1], p2.lam[2], p2.lam[3]) - x0);
-        const double vol6 = h0.dot(area2);
+        const double* x1 = piece.v[face[k]].lam;
+        const double* x2 = piece.v[face[k + 1]].lam;
+        const double u[3] = {x1[1] - x0[1], x1[2] - x0[2], x1[3] - x0[3]};
+        const double w[3] = {x2[1] - x0[1], x2[2] - x0[2], x2[3] - x0[3]};
+        const double area2[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                                 u[0] * w[1] - u[1] * w[0]};
+        const double vol6 = h0[0] * area2[0] + h0[1] * area2[1] + h0[2] * area2[2];
         piece_vol6 += vol6;
-        for (int c = 0; c < 8; ++c)
-          out.moment[own_sub][c] += vol6 * (p0.lam[c] + p1.lam[c] + p2.lam[c]);
+        volume_weight[face[0]] += vol6;
+        volume_weight[face[k]] += vol6;
+        volume_weight[face[k + 1]] += vol6;
         if (other_face >= 0) {
           // ∫_tri f g dS = A/12 (sum f_k g_k + (sum f)(sum g)), f = 4 lambda_own, g =
-          // lambda_other_b.
-          const double area_phys2 = area2.dot(area_weight[other_face]);
-          const double f0 = 4.0 * p0.lam[own_sub], f1 = 4.0 * p1.lam[own_sub],
-                       f2 = 4.0 * p2.lam[own_sub];
+          // lambda_other_b: vertex k carries A (f_k + sum f).
+          const double* aw = area_weight[other_face];
+          const double area_phys2 = area2[0] * aw[0] + area2[1] * aw[1] + area2[2] * aw[2];
+          const double f0 = 4.0 * x0[own_sub], f1 = 4.0 * x1[own_sub], f2 = 4.0 * x2[own_sub];
           const double fsum = f0 + f1 + f2;
-          for (int b = 0; b < 4; ++b) {
-            const double g0 = p0.lam[4 + b], g1 = p1.lam[4 + b], g2 = p2.lam[4 + b];
-            out.surface[other_face][b] +=
-                area_phys2 * (f0 * g0 + f1 * g1 + f2 * g2 + fsum * (g0 + g1 + g2));
-          }
+          double* sw = surface_weight[other_face];
+          sw[face[0]] += area_phys2 * (f0 + fsum);
+          sw[face[k]] += area_phys2 * (f1 + fsum);
+          sw[face[k + 1]] += area_phys2 * (f2 + fsum);
         }
       }
     }
   }
+  volume_weight[0] += piece_vol6;  // the apex term: vol6 of the piece times the apex's values
   out.vol6[own_sub] += piece_vol6;
-  for (int c = 0; c < 8; ++c) out.moment[own_sub][c] += piece_vol6 * apex_values[c];
+  double* moment = out.moment[own_sub];
+  for (int v = 0; v < n; ++v) {
+    const double wv = volume_weight[v];
+    const double* lam = piece.v[v].lam;
+    for (int c = 0; c < moments; ++c) moment[c] += wv * lam[c];
+  }
+  for (int j = 0; j < 4; ++j) {
+    if (!on_face[j]) continue;
+    double* surface = out.surface[j];
+    for (int v = 0; v < n; ++v) {
+      const double sv = surface_weight[j][v];
+      const double* lam = piece.v[v].lam + 4;
+      for (int b = 0; b < 4; ++b) surface[b] += sv * lam[b];
+    }
+  }
 }
 
 // Integrates the four pieces (sub-tet i of `own`) ∩ other.
-void integrate_side(const TetPairFrame& frame, int own, SideIntegrals& out) {
+void integrate_side(const TetPairFrame& frame, int own, int moments, SideIntegrals& out) {
   const BarycentricMap& own_map = frame.map[own];
   const BarycentricMap& other_map = frame.map[1 - own];
   const double(&other_at_corner)[4][4] = frame.lambda_other[own];
+  const double(&own_at_other_corner)[4][4] = frame.lambda_other[1 - own];
   // Other tet's barycentrics at the own centroid: the corner average (so that a corner set
   // outside a face plane keeps the centroid outside too, consistent with the rejection test).
   double other_at_centroid[4];
@@ -203,12 +232,11 @@ void integrate_side(const TetPairFrame& frame, int own, SideIntegrals& out) {
   // Doubled area vector in own-barycentric space -> doubled physical area along the outward unit
   // normal n_j of the other tet's face j: Nanson, n dS = |det D| D^-T N dS_lambda (the absolute
   // value keeps "outward" outward for either orientation); rows of D^-1 are grad lambda_1..3.
-  Vec3 area_weight[4];
+  double area_weight[4][3];
   for (int j = 0; j < 4; ++j) {
     const Vec3 normal = -other_map.gradient[j].normalized();
-    area_weight[j] = std::abs(own_map.edge_det) * Vec3(own_map.gradient[1].dot(normal),
-                                                       own_map.gradient[2].dot(normal),
-                                                       own_map.gradient[3].dot(normal));
+    for (int k = 0; k < 3; ++k)
+      area_weight[j][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
   }
   Piece piece;
   for (int i = 0; i < 4; ++i) {
@@ -217,11 +245,18 @@ void integrate_side(const TetPairFrame& frame, int own, SideIntegrals& out) {
     // the orientation, so kTetNeighbours applies unchanged.
     const double* slot_other[4];
     for (int s = 0; s < 4; ++s) slot_other[s] = (s == i) ? other_at_centroid : other_at_corner[s];
-    // Quick rejection: the four vertices strictly outside one plane of the other tet.
+    // Quick rejection: the four vertices strictly outside one plane of the other tet, or the
+    // other tet's four corners strictly outside one side plane of the sub-tet (lambda_i <=
+    // lambda_k inside it).  Either way the piece has no volume.
     bool empty = false;
     for (int b = 0; b < 4 && !empty; ++b)
       empty = slot_other[0][b] < 0.0 && slot_other[1][b] < 0.0 && slot_other[2][b] < 0.0 &&
               slot_other[3][b] < 0.0;
+    for (int k = 0; k < 4 && !empty; ++k)
+      empty = k != i && own_at_other_corner[0][i] > own_at_other_corner[0][k] &&
+              own_at_other_corner[1][i] > own_at_other_corner[1][k] &&
+              own_at_other_corner[2][i] > own_at_other_corner[2][k] &&
+              own_at_other_corner[3][i] > own_at_other_corner[3][k];
     if (empty) continue;
     piece.count = 4;
     for (int s = 0; s < 4; ++s) {
@@ -239,7 +274,7 @@ void integrate_side(const TetPairFrame& frame, int own, SideIntegrals& out) {
     bool alive = true;
     for (int b = 0; b < 4 && alive; ++b)
       alive = clip_piece(piece, 4 + b, 1u << (kOtherFaceShift + b));
-    if (alive) integrate_piece(piece, i, area_weight, out);
+    if (alive) integrate_piece(piece, i, area_weight, moments, out);
   }
 }
 
@@ -258,8 +293,8 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   ContactPairResult r = zero_result();
 
   SideIntegrals side[2];
-  integrate_side(frame, 0, side[0]);
-  integrate_side(frame, 1, side[1]);
+  integrate_side(frame, 0, 8, side[0]);  // the other tet's moments give the centroid's weights
+  integrate_side(frame, 1, 4, side[1]);
 
   // Physical volume integrals: ∫_{piece i} lam_c dV = |det| * moment / 24 (moment includes the
   // apex term vol6 * lam_c(apex)).
@@ -280,13 +315,15 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
     const BarycentricMap& own = frame.map[s];
     const SideIntegrals& other_side = side[1 - s];  // its surfaces lie on this tet's faces
     for (int i = 0; i < 4; ++i) energy += vol_integral[s][i][i];
+    Vec3 inward_normal[4];  // of own face i: grad lambda_i / |grad lambda_i|
+    for (int i = 0; i < 4; ++i) inward_normal[i] = own.gradient[i].normalized();
     for (int a = 0; a < 4; ++a) {
       Vec3 f = Vec3::Zero();
       for (int i = 0; i < 4; ++i) {
         // volume term: grad phi = 4 grad lambda_i on sub-tet i
         f += (4.0 * vol_integral[s][i][a]) * own.gradient[i];
         // surface term on own face i: - ∫ phi_other lambda_a n dS, n = outward unit normal
-        f += (other_side.surface[i][a] * (1.0 / 24.0)) * own.gradient[i].normalized();
+        f += (other_side.surface[i][a] * (1.0 / 24.0)) * inward_normal[i];
       }
       force[s][a] = penalty * f;
     }

@@ -53,6 +53,11 @@ ContactPairResult potential_contact(const TetCorners& contactor, const TetCorner
 ContactPairResult potential_contact_unculled(const TetCorners& contactor, const TetCorners& target,
                                              double penalty);
 
+// The previous implementation (contact/potential_contact_baseline.cpp), kept as the baseline the
+// benchmarks measure against; same results to round-off.
+ContactPairResult potential_contact_baseline(const TetCorners& contactor, const TetCorners& target,
+                                             double penalty);
+
 // Exact integral over one tet of its own potential: ∫ 4 min(lambda) dV = V/4 (m^3).
 inline double tet_potential_integral(double volume) {
   return 0.25 * volume;
