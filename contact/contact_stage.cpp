@@ -222,6 +222,7 @@ void ContactStage::run_detection(const Model& model, const double* x) {
     return eligible(a, b) && !tets_farther_than(model, x, a, b, buffer_);
   };
   detector_.detect(lo_.data(), hi_.data(), tets.size(), buffer_, pairs_, keep);
+  may_hold_friction_.assign(pairs_.size(), 1);
 }
 
 void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection,
@@ -260,6 +261,7 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
 void ContactStage::release_until_rebind() {
   pairs_ = {};
   overlapping_ = {};
+  may_hold_friction_ = {};
   records_ = {};
   lo_ = {};
   hi_ = {};
@@ -346,6 +348,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   records_.clear();
   out.candidate_pairs = static_cast<std::int64_t>(pairs_.size());  // held here, not unique
   overlapping_.assign(pairs_.size(), 0);
+  may_hold_friction_.resize(pairs_.size(), 1);
   if (any_friction_) friction_force_.assign(3 * static_cast<std::size_t>(nodes.size()), 0.0);
   if (any_damping_) damping_force_.assign(3 * static_cast<std::size_t>(nodes.size()), 0.0);
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
@@ -363,10 +366,13 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
     if (!r.overlapping) {
-      if (mu > 0.0) friction_.erase(key);  // contact lost: the stick spring is released
+      if (mu > 0.0 && may_hold_friction_[index])
+        friction_.erase(key);  // contact lost: the stick spring is released
+      may_hold_friction_[index] = 0;
       continue;
     }
     overlapping_[index] = 1;
+    may_hold_friction_[index] = 1;
     out.active_pairs += share > 0.0 ? 1 : 0;
     out.energy += share * r.energy;
     for (int c = 0; c < 4; ++c) {

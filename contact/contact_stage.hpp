@@ -144,6 +144,9 @@ class ContactStage {
   std::vector<double> lo_, hi_, x_at_detection_;
   std::vector<CandidatePair> pairs_;
   std::vector<std::uint8_t> overlapping_;
+  // Per candidate pair: it may hold a friction history (it overlapped at the last add_forces, or
+  // the list is new since): only those pay a map lookup when they do not overlap.
+  std::vector<std::uint8_t> may_hold_friction_;
   std::vector<ContactRecord> records_;
   // Friction history per pair, keyed by the two tets' global ids; kept across re-detection.
   struct PairFriction {
