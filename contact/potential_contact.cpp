@@ -1,122 +1,13 @@
 // Exact potential contact between two tets; see potential_contact_kernels.hpp for the formulas.
 #include <cmath>
 
+#include "contact/piece_clipper.hpp"
 #include "contact/potential_contact_kernels.hpp"
 
 namespace fdem {
 namespace {
 
-// A tet clipped by four planes has at most 12 vertices (simple polyhedron, <= 8 faces); the
-// headroom covers degenerate (noisy) classifications, which can split a face in two.
-constexpr int kMaxVertices = 48;
-
-// Plane tags carried by every vertex (bit set = the vertex lies on that plane).
-constexpr unsigned kOuterFaceBit = 1u;  // the sub-tet's base = a face of its own tet
-// bits 1..4: the sub-tet's sides (planes through the own centroid)
-constexpr unsigned kOtherFaceShift = 8;  // bits 8..11: faces 0..3 of the other tet
-constexpr unsigned kOtherFaceBits = 0xFu << kOtherFaceShift;
-
-struct PieceVertex {
-  double lam[8];  // [0..3] barycentric coords in the own tet, [4..7] in the other tet
-  int next[3];    // neighbours, ordered so the face walk runs counter-clockwise from outside
-  unsigned planes;
-};
-
-struct Piece {
-  int count = 0;
-  PieceVertex v[kMaxVertices];
-};
-
-// Neighbours of a positively oriented tet (corners 0..3 at the origin and unit axes).  Walking
-// "arrive from next[k], leave by next[k+1]" traverses each face counter-clockwise seen from
-// outside.  In own-barycentric space every sub-tet is positively oriented (see build_piece).
-constexpr int kTetNeighbours[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
-// Keeps the part of the piece where lam[k] >= 0 (Powell & Abel's r3d clip on a degree-3 vertex
-// graph).  New vertices get lam[k] = 0 exactly and the plane bit.  False when nothing is left.
-bool clip_piece(Piece& piece, int k, unsigned plane_bit) {
-  const int n = piece.count;
-  double dist[kMaxVertices];
-  bool outside[kMaxVertices];
-  int n_outside = 0;
-  for (int i = 0; i < n; ++i) {
-    dist[i] = piece.v[i].lam[k];
-    outside[i] = dist[i] < 0.0;
-    n_outside += outside[i];
-  }
-  if (n_outside == 0) return true;
-  if (n_outside == n) {
-    piece.count = 0;
-    return false;
-  }
-  // One new vertex on every edge from a kept vertex to a clipped one.  Always interpolate from
-  // the kept end so that a shared edge gives the same point in every piece that holds it.
-  int m = n;
-  for (int vc = 0; vc < n; ++vc) {
-    if (outside[vc]) continue;
-    for (int e = 0; e < 3; ++e) {
-      const int vn = piece.v[vc].next[e];
-      if (!outside[vn]) continue;
-      if (m == kMaxVertices) {  // unreachable for tet ∩ half-spaces; stay finite regardless
-        piece.count = 0;
-        return false;
-      }
-      PieceVertex& w = piece.v[m];
-      const PieceVertex& a = piece.v[vc];
-      const PieceVertex& b = piece.v[vn];
-      const double t = dist[vc] / (dist[vc] - dist[vn]);  // in [0, 1): dist[vc] >= 0 > dist[vn]
-      for (int c = 0; c < 8; ++c) w.lam[c] = a.lam[c] + t * (b.lam[c] - a.lam[c]);
-      w.lam[k] = 0.0;
-      w.planes = (a.planes & b.planes) | plane_bit;
-      w.next[0] = vc;
-      w.next[1] = -1;
-      w.next[2] = -1;
-      outside[m] = false;
-      piece.v[vc].next[e] = m;
-      ++m;
-    }
-  }
-  // Close the cap: from each new vertex walk its face until the next new vertex.
-  for (int vs = n; vs < m; ++vs) {
-    int vc = vs;
-    int vn = piece.v[vc].next[0];
-    int guard = 0;
-    do {
-      int e = 0;
-      while (e < 3 && piece.v[vn].next[e] != vc) ++e;
-      if (e == 3 || ++guard > 3 * kMaxVertices) {  // corrupted graph: cannot happen
-        piece.count = 0;
-        return false;
-      }
-      vc = vn;
-      vn = piece.v[vc].next[(e + 1) % 3];
-    } while (vc < n);
-    piece.v[vs].next[2] = vc;
-    piece.v[vc].next[1] = vs;
-  }
-  // Drop the clipped vertices and renumber.
-  int remap[kMaxVertices];
-  int kept = 0;
-  for (int i = 0; i < m; ++i) {
-    if (outside[i]) continue;
-    remap[i] = kept;
-    if (kept != i) piece.v[kept] = piece.v[i];
-    ++kept;
-  }
-  for (int i = 0; i < kept; ++i)
-    for (int e = 0; e < 3; ++e) piece.v[i].next[e] = remap[piece.v[i].next[e]];
-  piece.count = kept;
-  return kept > 0;
-}
-
-// Integrals over the pieces of one side, in own-barycentric space (lambda_1..3 as coordinates;
-// physical volume = |edge_det| * that volume).
-struct SideIntegrals {
-  double vol6[4] = {0, 0, 0, 0};  // per sub-tet i: 6 * volume in barycentric space
-  double moment[4][8] = {};       // per sub-tet i: sum vol6_tet * (sum of its 4 vertex values)
-  double surface[4][4] = {};  // [other face j][other node b]: ∫ 4 lambda_i^own lambda_b^other dS
-                              // * 24 (physical area), over the pieces' faces on face j
-};
+using namespace piece_clip;
 
 // Accumulates one piece (sub-tet `own_sub` clipped): cone sums over all faces from an apex at the
 // piece's first vertex (a point of the piece: no cancellation between remote cones, so slivers
@@ -278,17 +169,6 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, SideIntegra
   }
 }
 
-ContactPairResult zero_result() {
-  ContactPairResult r;
-  for (int v = 0; v < 4; ++v) {
-    r.force_contactor[v].setZero();
-    r.force_target[v].setZero();
-  }
-  r.normal.setZero();
-  r.centroid.setZero();
-  return r;
-}
-
 ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   ContactPairResult r = zero_result();
 
@@ -333,31 +213,7 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   r.overlapping = true;
   r.energy = energy;
   r.overlap_volume = volume[0];
-  double weight_c[4] = {0, 0, 0, 0}, weight_t[4] = {0, 0, 0, 0};
-  for (int i = 0; i < 4; ++i)
-    for (int a = 0; a < 4; ++a) {
-      weight_c[a] += vol_integral[0][i][a];
-      weight_t[a] += vol_integral[0][i][4 + a];
-    }
-  // The overlap lies inside both tets, so its centroid's barycentric weights are in [0, 1] and
-  // sum to 1.  For a round-off sliver (touching coplanar faces, overlap ~1e-50 m^3) the moment
-  // ratios are noise (seen: weights ~3e14, a "centroid" 5e13 m away); clamping keeps the
-  // velocity interpolation and the force spreading of friction and dashpot bounded.  Exact
-  // overlaps are unchanged.
-  const auto clamp_weights = [](const double(&raw)[4], double(&out)[4]) {
-    double sum = 0.0;
-    for (int a = 0; a < 4; ++a) sum += (out[a] = std::max(raw[a], 0.0));
-    for (int a = 0; a < 4; ++a) out[a] = sum > 0.0 ? out[a] / sum : 0.25;
-  };
-  clamp_weights(weight_c, r.centroid_weights_contactor);
-  clamp_weights(weight_t, r.centroid_weights_target);
-  Vec3 centroid = Vec3::Zero();
-  for (int a = 0; a < 4; ++a) centroid += r.centroid_weights_contactor[a] * frame.local[0][a];
-  r.centroid = frame.origin + centroid;
-  const Vec3 resultant =
-      r.force_contactor[0] + r.force_contactor[1] + r.force_contactor[2] + r.force_contactor[3];
-  r.normal_force = resultant.norm();
-  if (r.normal_force > 0.0) r.normal = resultant / r.normal_force;
+  finish_pair_result(frame, vol_integral, r);
   return r;
 }
 
