@@ -14,6 +14,7 @@
 #include "core/energy.hpp"
 #include "core/model.hpp"
 #include "core/scene.hpp"
+#include "drivers/stage_timer.hpp"
 
 namespace fdem {
 
@@ -26,6 +27,8 @@ class ContactStage;
 class JointStage;
 class LoadSchedule;
 class HistoryRecorder;
+class StepDomain;
+struct StepRecord;
 
 struct RunOptions {
   std::string output_dir = "out";
@@ -45,12 +48,6 @@ struct StagePlan {
   bool initial_stress = false;  // scene `initial_stress:` (core/initial_stress)
   bool surface_loads = false;   // pressure or traction on boundary faces
   std::vector<std::string> describe() const;
-};
-
-struct StageClock {
-  std::string name;
-  double seconds = 0.0;
-  long calls = 0;
 };
 
 struct RunReport {
@@ -114,7 +111,7 @@ class Simulation {
   // (when checkpoints are enabled) and the status "interrupted".
   RunReport run();
 
-  // One time step (stages 1–8).  Throws NumericalFailure on blow-up.
+  // One time step (stages 0–8, drivers/simulation_step.cpp).  Throws NumericalFailure on blow-up.
   void step();
 
   const Model& model() const { return model_; }
@@ -140,7 +137,7 @@ class Simulation {
     detection,
     contact,
     external,
-    integrate,
+    integration,
     halo,
     migration,
     output,
@@ -158,12 +155,29 @@ class Simulation {
   void check_stable_step(const struct CriticalStep& deformed) const;
   void check_tunnelling(const struct NodeTravel& travel) const;
   std::string step_origin() const;
+  // The stages of step(), in its order (drivers/simulation_step.cpp).
+  void share_broken_joints();
+  bool detection_due();
+  bool redistribution_due(bool detecting) const;
   // `detecting`: a detection at the current positions follows at once (the halo is built for it,
   // and the last detection is not repeated).
-  void redistribute(bool detecting = false);
+  void redistribute(bool detecting);
+  void apply_loads();
+  void add_internal_forces(StepRecord& r);
+  void add_joint_forces(StepRecord& r);
+  void detect_contacts();
+  void add_contact_forces(StepRecord& r);
+  void add_external_forces(StepRecord& r);
+  void record_histories();
+  void integrate(StepRecord& r);
+  void start_halo_exchange();
+  void finish_halo_exchange();
+  void check_deformed_step(StepRecord& r);
+  void sum_over_ranks(StepRecord& r);
+  void book_energy(const StepRecord& r);
+  void check_step(const StepRecord& r);
   TravellingState travelling_state() const;
   void rebind_stages(TravellingState& state, bool detected);
-  bool share_broken_joints(bool detection_due);
   void write_checkpoint();
   void restore_checkpoint(const std::string& path);
   bool is_root() const;
@@ -196,17 +210,24 @@ class Simulation {
   WorkAccumulator joint_friction_;  // Coulomb slip inside joints (part of dissipated_friction)
   const Communicator* comm_ = nullptr;
   std::unique_ptr<Distribution> distribution_;  // N ranks only
-  bool redistribute_pending_ = false;           // a detection ran: redistribute at the next step
-  // N ranks: whether the step ahead detects because a node went more than buffer/2 (from the last
-  // step's reduction, the same on every rank; −1 unknown: before the first step, after a restart).
+  std::unique_ptr<StepDomain> domain_;          // the ranks the step runs on (one or N)
+  // Whether the step ahead detects because a node went more than buffer/2 (from the last step's
+  // reduction, the same on every rank; −1 unknown: before the first step, after a restart).
   int detection_due_ = -1;
+  // A joint broken in the last step, reported by this rank: what every rank needs to know of it.
+  struct BrokenJoint {
+    GlobalId joint, tet_a, tet_b;
+    double time;  // s
+    std::int32_t mode, body_a, body_b;
+  };
+  std::vector<BrokenJoint> own_breaks_;    // this rank's, since the last step's reduction
+  bool breaks_pending_ = false;            // some rank broke a joint in the last step
+  bool bonds_released_ = false;            // a broken joint freed two tets since the last detection
   bool moved_since_distribution_ = false;  // positions changed since the halo was built
   double tunnel_size_ = 0.0;               // m, smallest tet altitude at the start (contact scenes)
-  bool halo_in_flight_ = false;            // ghost exchange posted, not yet completed
   double reduction_seconds_ = 0.0;
-  std::vector<double> reduced_terms_;         // scratch of the per-step energy reduction
-  std::vector<std::int64_t> reduced_counts_;  // scratch of the broken-joint/detection reduction
-  InternalForceSplit split_;  // N ranks: interior tets computed while the ghost exchange travels
+  std::vector<double> reduced_;  // scratch of the step's reduction
+  InternalForceSplit split_;     // interior tets computed while the ghost exchange travels
   double next_checkpoint_time_ = 0.0;
   std::vector<std::string> checkpoints_;  // written so far; the last two are kept
   long checkpoint_step_ = -1;             // step of the newest checkpoint written
