@@ -459,4 +459,25 @@ ContactWork ContactStage::work_against(const Model& model, double dt) const {
   return w;
 }
 
+std::vector<PairRecord> friction_records(const std::vector<FrictionEntry>& entries) {
+  std::vector<PairRecord> records(entries.size());
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const FrictionEntry& e = entries[i];
+    records[i] = {e.a, e.b, {e.spring.x(), e.spring.y(), e.spring.z(), e.stiffness}};
+  }
+  return records;
+}
+
+std::vector<FrictionEntry> friction_entries(const std::vector<PairRecord>& records) {
+  std::vector<FrictionEntry> entries(records.size());
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const PairRecord& r = records[i];
+    entries[i].a = r.a;
+    entries[i].b = r.b;
+    entries[i].spring = Vec3(r.value[0], r.value[1], r.value[2]);
+    entries[i].stiffness = r.value[3];
+  }
+  return entries;
+}
+
 }  // namespace fdem

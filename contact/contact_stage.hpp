@@ -12,6 +12,7 @@
 #include "contact/friction_kernels.hpp"
 #include "contact/nbs.hpp"
 #include "core/model.hpp"
+#include "core/travelling_state.hpp"
 
 namespace fdem {
 
@@ -22,12 +23,6 @@ struct ContactSettings {
   bool skip_enclosed = true;
 };
 
-// What a tet's joints allow in contact; one byte that travels with the tet.  `enclosed`: bonded
-// on all four faces, in a `joints: all` body, with no corner on the body mesh's boundary
-// (TetArrays::enclosed): while no joint of its body has broken, nothing can overlap it without
-// first crossing a whole layer of the body's tets, so it takes no part in contact.
-enum class TetJointState : std::uint8_t { none, intact, cracked, enclosed };
-
 // Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with
 // the pair when the model is redistributed or checkpointed.
 struct FrictionEntry {
@@ -35,6 +30,11 @@ struct FrictionEntry {
   Vec3 spring = Vec3::Zero();  // stick spring (m)
   double stiffness = 0.0;      // N/m
 };
+
+// Friction entries as the pair records that travel with their first tet (TravellingState), and
+// back: spring (m) in values 0–2, stiffness (N/m) in value 3.
+std::vector<PairRecord> friction_records(const std::vector<FrictionEntry>& entries);
+std::vector<FrictionEntry> friction_entries(const std::vector<PairRecord>& records);
 
 // Energy taken from the bodies by friction and by the contact dashpots (J): minus the work of
 // those forces on the owned nodes, with the integrator's trapezoid rule.  Step n gives

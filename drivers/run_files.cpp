@@ -8,7 +8,7 @@
 
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
-#include "drivers/simulation.hpp"
+#include "drivers/run_report.hpp"
 #include "fracture/joint_kernels.hpp"
 
 namespace fdem {

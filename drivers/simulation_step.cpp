@@ -313,19 +313,22 @@ TravellingState Simulation::travelling_state() const {
   if (contact_) {
     state.x_at_detection = contact_->x_at_detection();
     state.tet_joint_state = contact_->tet_joint_states();
-    state.friction = contact_->friction_entries();
+    state.pairs = friction_records(contact_->friction_entries());
   } else {
     state.x_at_detection = model_.nodes.x;
   }
-  if (joints_) state.joint_history = joints_->history();
+  if (joints_) {
+    state.joint_record_bytes = sizeof(JointHistory);
+    state.joint_records = joint_records(joints_->history());
+  }
   return state;
 }
 
 void Simulation::rebind_stages(TravellingState& state, bool detected) {
   if (contact_)
     contact_->rebind(model_, std::move(state.x_at_detection), std::move(state.tet_joint_state),
-                     state.friction, detected);
-  if (joints_) joints_->rebind(model_, std::move(state.joint_history));
+                     friction_entries(state.pairs), detected);
+  if (joints_) joints_->rebind(model_, joint_histories(state.joint_records));
   loads_->rebind(model_);
   if (absorbing_) absorbing_->rebind(model_);
   if (plan_.initial_stress)

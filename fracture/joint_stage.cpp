@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "core/error.hpp"
 #include "fracture/joint_law_advice.hpp"
@@ -120,6 +122,21 @@ double JointStage::critical_time_step(const Model& model) const {
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
     if (stiffness[n] > 0.0) omega2 = std::max(omega2, stiffness[n] / model.nodes.mass[n]);
   return omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
+}
+
+static_assert(std::is_trivially_copyable_v<JointHistory>, "joint histories travel as bytes");
+
+std::vector<std::uint8_t> joint_records(const std::vector<JointHistory>& history) {
+  std::vector<std::uint8_t> records(history.size() * sizeof(JointHistory));
+  if (!records.empty()) std::memcpy(records.data(), history.data(), records.size());
+  return records;
+}
+
+std::vector<JointHistory> joint_histories(const std::vector<std::uint8_t>& records) {
+  FDEM_VERIFY(records.size() % sizeof(JointHistory) == 0, "whole joint history records");
+  std::vector<JointHistory> history(records.size() / sizeof(JointHistory));
+  if (!history.empty()) std::memcpy(history.data(), records.data(), records.size());
+  return history;
 }
 
 }  // namespace fdem

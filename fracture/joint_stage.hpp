@@ -21,6 +21,10 @@ struct JointStepSummary {
   LocalIndex broken = 0;             // broken joints in total
 };
 
+// The joints' histories as the opaque records that travel with them (TravellingState), and back.
+std::vector<std::uint8_t> joint_records(const std::vector<JointHistory>& history);
+std::vector<JointHistory> joint_histories(const std::vector<std::uint8_t>& records);
+
 class JointStage {
  public:
   // Builds one CohesiveLaw per model.joint_laws entry; throws InputError (naming the material or

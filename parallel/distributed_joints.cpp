@@ -6,7 +6,7 @@
 #include <limits>
 #include <numeric>
 
-#include "contact/contact_stage.hpp"
+#include "core/travelling_state.hpp"
 #include "core/error.hpp"
 #include "core/joint_placement.hpp"
 #include "parallel/boundary_matching.hpp"

@@ -299,7 +299,6 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   std::vector<TetRow>& tet_rows = parsed.tets;
   std::vector<NodeRow>& node_rows = parsed.nodes;
   std::vector<JointRow>& joint_rows = parsed.joints;
-  std::vector<FrictionRow>& friction_rows = parsed.friction;
   const auto by_gid = [](const auto& a, const auto& b) { return a.gid < b.gid; };
   const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
   std::sort(tet_rows.begin(), tet_rows.end(), by_gid);
@@ -359,7 +358,9 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   const LocalIndex n_joints = local_count(joint_rows.size(), "joints");
   joints = JointArrays{};
   joints.resize(n_joints);
-  state.joint_history.assign(static_cast<std::size_t>(n_joints), JointHistory{});
+  const std::size_t record_bytes = parsed.joint_record_bytes;
+  state.joint_record_bytes = record_bytes;
+  state.joint_records.assign(static_cast<std::size_t>(n_joints) * record_bytes, 0);
   for (LocalIndex j = 0; j < n_joints; ++j) {
     const JointRow& r = joint_rows[j];
     joints.gid[j] = r.gid;
@@ -375,23 +376,15 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
     joints.law[j] = r.law;
     joints.broken[j] = r.broken;
     joints.mode[j] = r.mode;
-    state.joint_history[j] = r.history;
+    std::copy_n(parsed.joint_records.data() + r.record * record_bytes, record_bytes,
+                state.joint_records.data() + static_cast<std::size_t>(j) * record_bytes);
   }
+  parsed.joint_records = std::vector<std::uint8_t>{};
 
-  state.friction.clear();
-  state.friction.reserve(friction_rows.size());
-  for (const FrictionRow& r : friction_rows) {
-    FrictionEntry e;
-    e.a = r.a;
-    e.b = r.b;
-    e.spring = Vec3(r.spring[0], r.spring[1], r.spring[2]);
-    e.stiffness = r.stiffness;
-    state.friction.push_back(e);
-  }
-  std::sort(state.friction.begin(), state.friction.end(),
-            [](const FrictionEntry& p, const FrictionEntry& q) {
-              return p.a != q.a ? p.a < q.a : p.b < q.b;
-            });
+  state.pairs = std::move(parsed.pairs);
+  std::sort(state.pairs.begin(), state.pairs.end(), [](const PairRecord& p, const PairRecord& q) {
+    return p.a != q.a ? p.a < q.a : p.b < q.b;
+  });
 }
 
 std::vector<std::vector<LocalIndex>> Distribution::destinations(

@@ -12,30 +12,21 @@
 // Redistribution happens at contact-detection cycles: the owned cost (tets, joints, contact
 // pairs) is compared across ranks, a weighted recursive coordinate bisection re-partitions when
 // the imbalance exceeds a threshold, and every owner sends each of its tets — with its nodes, the
-// joints whose first tet it is, its friction pairs and contact state — to the new owner and to
-// every rank whose margin box it meets.
+// joints whose first tet it is, the stages' records of its pairs and its contact state — to the new
+// owner and to every rank whose margin box it meets.
 #pragma once
 
 #include <cstdint>
 #include <initializer_list>
 #include <vector>
 
-#include "contact/contact_stage.hpp"
 #include "core/model.hpp"
-#include "fracture/joint_kernels.hpp"
+#include "core/travelling_state.hpp"
 #include "parallel/communicator.hpp"
 #include "parallel/distributed_build.hpp"
 #include "parallel/zoltan_partition.hpp"
 
 namespace fdem {
-
-// Stage state outside Model that moves with the local entries.
-struct TravellingState {
-  std::vector<double> x_at_detection;         // 3 per local node (m)
-  std::vector<std::uint8_t> tet_joint_state;  // per local tet (empty: scene without joints)
-  std::vector<JointHistory> joint_history;    // per local joint
-  std::vector<FrictionEntry> friction;        // friction pairs held here
-};
 
 struct DistributionSettings {
   double rebalance_threshold = 1.10;  // re-partition when max/mean owned cost exceeds this

@@ -1,5 +1,5 @@
-// The rows that carry tets, nodes, joints and friction pairs between ranks when the model is
-// (re)distributed, and the packer that writes them (parallel/distribution*.cpp).  Internal to
+// The rows that carry tets, nodes, joints and the stages' pair records between ranks when the model
+// is (re)distributed, and the packer that writes them (parallel/distribution*.cpp).  Internal to
 // parallel/.
 #pragma once
 
@@ -43,20 +43,22 @@ struct JointRow {
   double area0, failure_time, damage;
   std::int32_t law;
   std::uint8_t broken, mode;
-  JointHistory history;
+  // Where its stage record is: sent, 0; parsed, its index in ParsedRows::joint_records.  The
+  // record itself follows the row (BlockHeader::joint_record_bytes, padded to 8 bytes).
+  std::int64_t record;
 };
-struct FrictionRow {
-  GlobalId a, b;
-  double spring[3];
-  double stiffness;
-};
+using PairRow = PairRecord;  // stage state of a pair of tets, sent with its first tet
 struct BlockHeader {
-  std::int64_t tets = 0, nodes = 0, joints = 0, friction = 0;
+  std::int64_t tets = 0, nodes = 0, joints = 0, pairs = 0;
+  std::int64_t joint_record_bytes = 0;  // of each joint's stage record (0: none)
 };
-static_assert(std::is_trivially_copyable_v<JointHistory>, "joint history travels as bytes");
 static_assert(sizeof(TetRow) % 8 == 0 && sizeof(NodeRow) % 8 == 0 && sizeof(JointRow) % 8 == 0 &&
-                  sizeof(FrictionRow) % 8 == 0 && sizeof(BlockHeader) % 8 == 0,
+                  sizeof(PairRow) % 8 == 0 && sizeof(BlockHeader) % 8 == 0,
               "rows travel as 8-byte words");
+// A joint record's bytes on the wire: padded to whole 8-byte words.
+inline std::size_t padded_record_bytes(std::size_t bytes) {
+  return (bytes + 7) / 8 * 8;
+}
 
 template <class T>
 inline void append(std::vector<char>& out, const T& value) {
@@ -75,7 +77,8 @@ inline T take(const char*& p) {
 }
 
 // Packs the rows that travel with a set of tets: the tets, their nodes (once per block), the
-// joints whose first tet they are, and their friction pairs (pairs keyed by their first tet).
+// joints whose first tet they are, and the stages' records of their pairs (keyed by their first
+// tet).
 class RowPacker {
  public:
   // `tet_owner`, `node_owner`, `node_first_tet`: per local tet and node, their owners after the
@@ -109,7 +112,7 @@ class RowPacker {
     const JointArrays& joints = model_.joints;
     std::vector<LocalIndex> node_list, joint_list;
     std::vector<const StartJoint*> start_list;
-    std::vector<const FrictionEntry*> friction_list;
+    std::vector<const PairRecord*> pair_list;
     for (LocalIndex t : tet_list) {
       if (start_joints_) {
         auto it =
@@ -128,20 +131,22 @@ class RowPacker {
       for (std::int64_t k = joint_offsets_[t]; k < joint_offsets_[t + 1]; ++k)
         joint_list.push_back(joint_list_[k]);
       const GlobalId g = tets.gid[t];
-      auto it =
-          std::lower_bound(state_.friction.begin(), state_.friction.end(), g,
-                           [](const FrictionEntry& e, GlobalId value) { return e.a < value; });
-      for (; it != state_.friction.end() && it->a == g; ++it) friction_list.push_back(&*it);
+      auto it = std::lower_bound(state_.pairs.begin(), state_.pairs.end(), g,
+                                 [](const PairRecord& e, GlobalId value) { return e.a < value; });
+      for (; it != state_.pairs.end() && it->a == g; ++it) pair_list.push_back(&*it);
     }
     BlockHeader header;
     header.tets = static_cast<std::int64_t>(tet_list.size());
     header.nodes = static_cast<std::int64_t>(node_list.size());
     header.joints = static_cast<std::int64_t>(joint_list.size() + start_list.size());
-    header.friction = static_cast<std::int64_t>(friction_list.size());
+    header.pairs = static_cast<std::int64_t>(pair_list.size());
+    const std::size_t record_bytes = state_.joint_record_bytes;
+    header.joint_record_bytes = static_cast<std::int64_t>(record_bytes);
     out.reserve(out.size() + sizeof(header) + tet_list.size() * sizeof(TetRow) +
                 node_list.size() * sizeof(NodeRow) +
-                (joint_list.size() + start_list.size()) * sizeof(JointRow) +
-                friction_list.size() * sizeof(FrictionRow));
+                (joint_list.size() + start_list.size()) *
+                    (sizeof(JointRow) + padded_record_bytes(record_bytes)) +
+                pair_list.size() * sizeof(PairRow));
     append(out, header);
     for (LocalIndex t : tet_list) {
       TetRow row{};
@@ -185,8 +190,8 @@ class RowPacker {
       row.law = joints.law[j];
       row.broken = joints.broken[j];
       row.mode = joints.mode[j];
-      row.history = state_.joint_history[j];
       append(out, row);
+      append_record(out, state_.joint_records.data() + j * record_bytes, record_bytes);
     }
     for (const StartJoint* j : start_list) {  // intact, as JointArrays::resize leaves a joint
       JointRow row{};
@@ -199,17 +204,10 @@ class RowPacker {
       row.law = j->law;
       row.broken = 0;
       row.mode = 0;
-      row.history = JointHistory{};
       append(out, row);
+      append_record(out, nullptr, record_bytes);  // made at the start: the stage makes its own
     }
-    for (const FrictionEntry* e : friction_list) {
-      FrictionRow row{};
-      row.a = e->a;
-      row.b = e->b;
-      for (int k = 0; k < 3; ++k) row.spring[k] = e->spring[k];
-      row.stiffness = e->stiffness;
-      append(out, row);
-    }
+    for (const PairRecord* e : pair_list) append(out, *e);
   }
 
  private:
@@ -223,6 +221,13 @@ class RowPacker {
   int mark_ = 0;
   std::vector<std::int64_t> joint_offsets_;
   std::vector<LocalIndex> joint_list_;
+
+  // `bytes` of `record` (zeros when null), padded to whole words.
+  static void append_record(std::vector<char>& out, const std::uint8_t* record, std::size_t bytes) {
+    const std::size_t at = out.size();
+    out.resize(at + padded_record_bytes(bytes), 0);
+    if (record && bytes > 0) std::memcpy(out.data() + at, record, bytes);
+  }
 };
 
 // Writes node row `r` into entry n of the arrays (its force zeroed).
@@ -273,40 +278,51 @@ inline bool store_tet_row(const TetRow& r, std::size_t t, TetArrays& tets,
 struct ParsedRows {
   std::vector<TetRow> tets;
   std::vector<NodeRow> nodes;
-  std::vector<JointRow> joints;
-  std::vector<FrictionRow> friction;
+  std::vector<JointRow> joints;  // JointRow::record: the index of its record
+  std::size_t joint_record_bytes = 0;
+  std::vector<std::uint8_t> joint_records;  // joint_record_bytes per joint row, in row order
+  std::vector<PairRow> pairs;
 };
 inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) {
   ParsedRows parsed;
-  std::vector<TetRow>& tet_rows = parsed.tets;
-  std::vector<NodeRow>& node_rows = parsed.nodes;
-  std::vector<JointRow>& joint_rows = parsed.joints;
-  std::vector<FrictionRow>& friction_rows = parsed.friction;
-  {  // exact sizes first: growing the row arrays would hold up to three copies at once
-    std::int64_t counts[4] = {0, 0, 0, 0};
-    for (std::vector<char>* rows : buffers)
-      for (const char* p = rows->data(); p < rows->data() + rows->size();) {
-        const BlockHeader header = take<BlockHeader>(p);
-        counts[0] += header.tets;
-        counts[1] += header.nodes;
-        counts[2] += header.joints;
-        counts[3] += header.friction;
-        p += header.tets * sizeof(TetRow) + header.nodes * sizeof(NodeRow) +
-             header.joints * sizeof(JointRow) + header.friction * sizeof(FrictionRow);
+  std::int64_t counts[4] = {0, 0, 0, 0};
+  // Exact sizes first: growing the row arrays would hold up to three copies at once.
+  for (std::vector<char>* rows : buffers)
+    for (const char* p = rows->data(); p < rows->data() + rows->size();) {
+      const BlockHeader header = take<BlockHeader>(p);
+      counts[0] += header.tets;
+      counts[1] += header.nodes;
+      counts[2] += header.joints;
+      counts[3] += header.pairs;
+      const auto record_bytes = static_cast<std::size_t>(header.joint_record_bytes);
+      if (header.joints > 0) {
+        FDEM_VERIFY(parsed.joint_record_bytes == 0 || parsed.joint_record_bytes == record_bytes,
+                    "every rank sends joint records of one size");
+        parsed.joint_record_bytes = record_bytes;
       }
-    tet_rows.reserve(static_cast<std::size_t>(counts[0]));
-    node_rows.reserve(static_cast<std::size_t>(counts[1]));
-    joint_rows.reserve(static_cast<std::size_t>(counts[2]));
-    friction_rows.reserve(static_cast<std::size_t>(counts[3]));
-  }
+      p += header.tets * sizeof(TetRow) + header.nodes * sizeof(NodeRow) +
+           header.joints * (sizeof(JointRow) + padded_record_bytes(record_bytes)) +
+           header.pairs * sizeof(PairRow);
+    }
+  parsed.tets.reserve(static_cast<std::size_t>(counts[0]));
+  parsed.nodes.reserve(static_cast<std::size_t>(counts[1]));
+  parsed.joints.reserve(static_cast<std::size_t>(counts[2]));
+  parsed.joint_records.reserve(static_cast<std::size_t>(counts[2]) * parsed.joint_record_bytes);
+  parsed.pairs.reserve(static_cast<std::size_t>(counts[3]));
   for (std::vector<char>* rows : buffers) {
     for (const char* p = rows->data(); p < rows->data() + rows->size();) {
       const BlockHeader header = take<BlockHeader>(p);
-      for (std::int64_t i = 0; i < header.tets; ++i) tet_rows.push_back(take<TetRow>(p));
-      for (std::int64_t i = 0; i < header.nodes; ++i) node_rows.push_back(take<NodeRow>(p));
-      for (std::int64_t i = 0; i < header.joints; ++i) joint_rows.push_back(take<JointRow>(p));
-      for (std::int64_t i = 0; i < header.friction; ++i)
-        friction_rows.push_back(take<FrictionRow>(p));
+      for (std::int64_t i = 0; i < header.tets; ++i) parsed.tets.push_back(take<TetRow>(p));
+      for (std::int64_t i = 0; i < header.nodes; ++i) parsed.nodes.push_back(take<NodeRow>(p));
+      const auto record_bytes = static_cast<std::size_t>(header.joint_record_bytes);
+      for (std::int64_t i = 0; i < header.joints; ++i) {
+        JointRow row = take<JointRow>(p);
+        row.record = static_cast<std::int64_t>(parsed.joints.size());
+        parsed.joints.push_back(row);
+        parsed.joint_records.insert(parsed.joint_records.end(), p, p + record_bytes);
+        p += padded_record_bytes(record_bytes);
+      }
+      for (std::int64_t i = 0; i < header.pairs; ++i) parsed.pairs.push_back(take<PairRow>(p));
     }
     *rows = std::vector<char>{};  // parsed: its memory goes back before the arrays are built
   }

@@ -73,14 +73,14 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
 
 void Distribution::append_halo(Model& model, TravellingState& state,
                                const std::vector<double>* start_reach) {
-  FDEM_VERIFY(model.joints.size() == 0 && state.friction.empty() && !has_joint_state_,
+  FDEM_VERIFY(model.joints.size() == 0 && state.pairs.empty() && !has_joint_state_,
               "append_halo: a model without joints or friction history");
   std::vector<char> send;
   std::vector<std::size_t> send_counts;
   pack_rows(model, state, destinations(model, false, start_reach), send, send_counts, nullptr);
   std::vector<char> receive = exchange_rows(send, send_counts);
   ParsedRows rows = parse_rows({&receive});
-  FDEM_VERIFY(rows.joints.empty() && rows.friction.empty(), "halo rows without joints");
+  FDEM_VERIFY(rows.joints.empty() && rows.pairs.empty(), "halo rows without joints");
   const auto by_gid = [](const auto& a, const auto& b) { return a.gid < b.gid; };
   const auto same_gid = [](const auto& a, const auto& b) { return a.gid == b.gid; };
   NodeArrays& nodes = model.nodes;

@@ -2,6 +2,7 @@
 // lie above 2^32 (a model of more than four billion tets, or ids offset for a test) keeps and
 // hands back each pair's history under its own ids.
 #include <catch2/catch.hpp>
+#include <cstring>
 
 #include "contact/contact_stage.hpp"
 #include "core/model_builder.hpp"
@@ -76,6 +77,25 @@ TEST_CASE("friction history keyed by global ids above 2^32 survives re-detection
     CHECK(back[i].b == entries[i].b);
     CHECK(back[i].a >= offset);
     CHECK(back[i].spring == entries[i].spring);
+    CHECK(back[i].stiffness == entries[i].stiffness);
+  }
+}
+
+TEST_CASE("friction entries travel as pair records and come back bit for bit", "[contact][state]") {
+  std::vector<FrictionEntry> entries(3);
+  entries[0] = {1, 2, Vec3(1e-7, -2e-9, 3.5e-12), 4.2e8};
+  entries[1] = {(GlobalId{1} << 33) + 5, (GlobalId{1} << 34), Vec3(-0.0, 1.0 / 3.0, 2e-300), 1.0};
+  entries[2] = {9, 10, Vec3::Zero(), 0.0};
+  const std::vector<PairRecord> records = friction_records(entries);
+  REQUIRE(records.size() == 3);
+  CHECK(records[1].a == entries[1].a);
+  CHECK(records[0].value[3] == 4.2e8);
+  const std::vector<FrictionEntry> back = friction_entries(records);
+  REQUIRE(back.size() == 3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    CHECK(back[i].a == entries[i].a);
+    CHECK(back[i].b == entries[i].b);
+    CHECK(std::memcmp(back[i].spring.data(), entries[i].spring.data(), 3 * sizeof(double)) == 0);
     CHECK(back[i].stiffness == entries[i].stiffness);
   }
 }
