@@ -1,11 +1,16 @@
 // The central-difference update with Cundall's local damping: the closed-form decay of a linear
-// oscillator, an exact energy balance, and no effect on prescribed components or nodes at rest.
+// oscillator, an exact energy balance, and no effect on prescribed components or nodes at rest;
+// the split-phase internal forces of N ranks against the one-pass gather.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
+#include <random>
 #include <vector>
 
 #include "core/dynamics.hpp"
 #include "core/energy.hpp"
+#include "core/model_builder.hpp"
+#include "one_body_scene.hpp"
 
 using namespace fdem;
 
@@ -82,28 +87,11 @@ TEST_CASE("local damping: nothing on prescribed components or nodes at rest, α 
   CHECK(p.local_damping_work_after == 0.0);
 }
 
-#include <cstring>
-#include <random>
-
-#include "core/model_builder.hpp"
-
 namespace {
 
 // A block of n³ cubes of 0.1 m, six tets each (Kuhn split), rock.
 Model cube_block(int n) {
-  Scene scene;
-  scene.source_path = "test.yaml";
-  MaterialSpec rock;
-  rock.name = "rock";
-  rock.density = 2500;
-  rock.elastic.young = 3e10;
-  rock.elastic.poisson = 0.25;
-  rock.damping = 0.05;
-  scene.materials.push_back(rock);
-  BodySpec body;
-  body.name = "block";
-  body.material = 0;
-  scene.bodies.push_back(body);
+  const Scene scene = test::one_rock_body("block", 0.05);
   BodyMesh mesh;
   mesh.source = "test";
   const auto node = [&](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };

@@ -8,6 +8,7 @@
 #include "core/dynamics.hpp"
 #include "core/model_builder.hpp"
 #include "core/time_step.hpp"
+#include "one_body_scene.hpp"
 
 using namespace fdem;
 
@@ -15,18 +16,7 @@ namespace {
 
 // One irregular tet of rock, free in space.
 Model one_tet() {
-  Scene scene;
-  scene.source_path = "test.yaml";
-  MaterialSpec rock;
-  rock.name = "rock";
-  rock.density = 2500;
-  rock.elastic.young = 3e10;
-  rock.elastic.poisson = 0.25;
-  scene.materials.push_back(rock);
-  BodySpec body;
-  body.name = "tet";
-  body.material = 0;
-  scene.bodies.push_back(body);
+  const Scene scene = test::one_rock_body("tet");
   BodyMesh mesh;
   mesh.source = "test";
   mesh.coords = {0.0, 0.0, 0.0, 0.11, 0.01, 0.0, 0.02, 0.09, 0.01, 0.03, 0.02, 0.13};
