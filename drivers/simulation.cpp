@@ -214,7 +214,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   if (!options_.restart_path.empty()) {
     mark_phase(CommPhase::restart);
     restore_checkpoint(options_.restart_path);
-    moved_since_distribution_ = true;  // the halo was made for the start positions
+    moved_since_halo_ = true;  // the halo was made for the start positions
     mark_phase(CommPhase::startup);
   }
   // Every rank decides alike; collectively, so that all leave with the message and exit code 2.

@@ -117,7 +117,7 @@ class Simulation {
   // The stages of step(), in its order (drivers/simulation_step.cpp).
   void share_broken_joints();
   bool detection_due();
-  bool redistribution_due(bool detecting) const;
+  bool migration_due(bool detecting) const;
   // `detecting`: a detection at the current positions follows at once (the halo is built for it,
   // and the last detection is not repeated).
   void redistribute(bool detecting);
@@ -182,7 +182,7 @@ class Simulation {
   std::vector<BrokenJoint> own_breaks_;    // this rank's, since the last step's reduction
   bool breaks_pending_ = false;            // some rank broke a joint in the last step
   bool bonds_released_ = false;            // a broken joint freed two tets since the last detection
-  bool moved_since_distribution_ = false;  // positions changed since the halo was built
+  bool moved_since_halo_ = false;  // positions changed since the halo was built
   double tunnel_size_ = 0.0;               // m, smallest tet altitude at the start (contact scenes)
   double reduction_seconds_ = 0.0;
   std::vector<double> reduced_;  // scratch of the step's reduction

@@ -52,7 +52,7 @@ void Simulation::step() {
   StepRecord r;
   share_broken_joints();                // 3b last step's broken joints: every copy, every bond
   const bool detect = detection_due();  // 4a a node went buffer/2, or a bond was released
-  if (redistribution_due(detect))       // 4b before a detection cycle: re-balance, migrate,
+  if (migration_due(detect))       // 4b before a detection cycle: re-balance, migrate,
     redistribute(detect);               //    rebuild the halo
   apply_loads();                        // 0  gravity (tilt, ramp) and base velocities at t_n
   add_internal_forces(r);               // 1  F = Ds·Dm⁻¹, stress, nodal forces in tet gid order
@@ -110,10 +110,10 @@ bool Simulation::detection_due() {
   return detection_due_ > 0 || !contact_->detected() || bonds_released_;
 }
 
-bool Simulation::redistribution_due(bool detecting) const {
+bool Simulation::migration_due(bool detecting) const {
   if (!domain_->redistributes()) return false;
   const long every = scene_.parallel.redistribute_every;
-  return (detecting && moved_since_distribution_) ||
+  return (detecting && moved_since_halo_) ||
          (every > 0 && steps_ > 0 && steps_ % every == 0);
 }
 
@@ -190,7 +190,7 @@ void Simulation::integrate(StepRecord& r) {
       scene_.quasi_static.active_at(time_) ? scene_.quasi_static.local_damping : 0.0;
   r.motion = integrate_central_difference(dt_, nodes, local_damping);
   if (absorbing_) r.boundary_after = absorbing_->dissipation_after(dt_, model_);
-  moved_since_distribution_ = true;
+  moved_since_halo_ = true;
   // The surface loads' work goes with the reactions' (external_work), by the same trapezoid.
   if (plan_.surface_loads) {
     r.motion.constraint_work_before += 0.5 * dt_ * r.surface_power_before;
@@ -358,7 +358,7 @@ void Simulation::redistribute(bool detecting) {
   }
   domain_->redistribute(model_, state, contact_cost);
   rebind_stages(state, contact_ && contact_->detected() && !detecting);
-  moved_since_distribution_ = false;
+  moved_since_halo_ = false;
 }
 
 void Simulation::start_half_step(NodeArrays& nodes) const {
