@@ -179,11 +179,11 @@ class Simulation {
     double time;  // s
     std::int32_t mode, body_a, body_b;
   };
-  std::vector<BrokenJoint> own_breaks_;    // this rank's, since the last step's reduction
-  bool breaks_pending_ = false;            // some rank broke a joint in the last step
-  bool bonds_released_ = false;            // a broken joint freed two tets since the last detection
-  bool moved_since_halo_ = false;  // positions changed since the halo was built
-  double tunnel_size_ = 0.0;               // m, smallest tet altitude at the start (contact scenes)
+  std::vector<BrokenJoint> own_breaks_;  // this rank's, since the last step's reduction
+  bool breaks_pending_ = false;          // some rank broke a joint in the last step
+  bool bonds_released_ = false;          // a broken joint freed two tets since the last detection
+  bool moved_since_halo_ = false;        // positions changed since the halo was built
+  double tunnel_size_ = 0.0;             // m, smallest tet altitude at the start (contact scenes)
   double reduction_seconds_ = 0.0;
   std::vector<double> reduced_;  // scratch of the step's reduction
   InternalForceSplit split_;     // interior tets computed while the ghost exchange travels

@@ -52,7 +52,7 @@ void Simulation::step() {
   StepRecord r;
   share_broken_joints();                // 3b last step's broken joints: every copy, every bond
   const bool detect = detection_due();  // 4a a node went buffer/2, or a bond was released
-  if (migration_due(detect))       // 4b before a detection cycle: re-balance, migrate,
+  if (migration_due(detect))            // 4b before a detection cycle: re-balance, migrate,
     redistribute(detect);               //    rebuild the halo
   apply_loads();                        // 0  gravity (tilt, ramp) and base velocities at t_n
   add_internal_forces(r);               // 1  F = Ds·Dm⁻¹, stress, nodal forces in tet gid order
@@ -113,8 +113,7 @@ bool Simulation::detection_due() {
 bool Simulation::migration_due(bool detecting) const {
   if (!domain_->redistributes()) return false;
   const long every = scene_.parallel.redistribute_every;
-  return (detecting && moved_since_halo_) ||
-         (every > 0 && steps_ > 0 && steps_ % every == 0);
+  return (detecting && moved_since_halo_) || (every > 0 && steps_ > 0 && steps_ % every == 0);
 }
 
 void Simulation::apply_loads() {

@@ -6,9 +6,9 @@
 #include <limits>
 #include <numeric>
 
-#include "core/travelling_state.hpp"
 #include "core/error.hpp"
 #include "core/joint_placement.hpp"
+#include "core/travelling_state.hpp"
 #include "parallel/boundary_matching.hpp"
 #include "parallel/directory_hash.hpp"
 #include "parallel/enclosed_tets.hpp"
