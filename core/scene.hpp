@@ -268,6 +268,14 @@ struct ParallelSpec {
   // (Hilbert curve: least data moved while partitioning); random (a test mode: each re-partition
   // scatters the tets to ranks at random — results must not change).
   std::string partitioner = "rib";
+  // What a detection cycle sends: incremental (only the copies a rank does not hold yet; every
+  // copy afresh when owners move) or full (every copy at every cycle: the reference path).
+  std::string migration = "incremental";
+  // When to re-partition: measured (when the imbalance exceeds rebalance_threshold and the
+  // predicted gain over the next interval — the busiest rank's measured step time above the
+  // mean — exceeds the measured cost of the last re-partition) or threshold (whenever the
+  // imbalance of the cost weights exceeds rebalance_threshold).
+  std::string repartition = "measured";
   // Testing aid: every node, tet and joint gid is this plus its index 0..N−1 (0: gids are the
   // indices), so a small scene runs with gids above 2^32 through every path that handles them.
   // Results and state_hash do not depend on it.  0 <= gid_offset < 2^62.

@@ -256,6 +256,14 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
       << ", \"ghost_nodes_mean\": " << r.ghost_nodes_mean
       << ", \"neighbours_max\": " << r.neighbours_max
       << ", \"active_elements_max\": " << r.active_elements_max
+      << ", \"incremental_redistributions\": " << r.incremental_redistributions
+      << ", \"sent_elements\": " << r.sent_elements
+      << ", \"dropped_elements\": " << r.dropped_elements << ", \"sent_bytes\": " << r.sent_bytes
+      << ", \"measured_imbalance\": " << JsonNumber{r.measured_imbalance}
+      << ", \"repartition_seconds\": " << JsonNumber{r.repartition_seconds}
+      << ", \"incremental_seconds\": " << JsonNumber{r.incremental_seconds}
+      << ", \"predicted_gain_seconds\": " << JsonNumber{r.predicted_gain_seconds}
+      << ", \"repartitions_declined\": " << r.repartitions_declined
       << ", \"communication_seconds\": " << JsonNumber{r.communication_seconds} << "},\n";
   j << "  \"memory\": {\"startup_peak_rss_kib_max\": " << r.startup_peak_rss_kib_max
     << ", \"startup_peak_rss_kib_mean\": " << r.startup_peak_rss_kib_mean

@@ -54,6 +54,8 @@ DistributionSettings distribution_settings(const ParallelSpec& spec) {
                          : spec.partitioner == "hsfc" ? GeometricMethod::hsfc
                                                       : GeometricMethod::rib;
   settings.random_parts = spec.partitioner == "random";
+  settings.incremental = spec.migration == "incremental";
+  settings.measured_repartition = spec.repartition == "measured";
   return settings;
 }
 

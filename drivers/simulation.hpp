@@ -183,7 +183,8 @@ class Simulation {
   bool breaks_pending_ = false;          // some rank broke a joint in the last step
   bool bonds_released_ = false;          // a broken joint freed two tets since the last detection
   bool moved_since_halo_ = false;        // positions changed since the halo was built
-  double tunnel_size_ = 0.0;             // m, smallest tet altitude at the start (contact scenes)
+  double busy_at_last_cycle_ = 0.0;  // compute seconds (stage clocks) at the last redistribution
+  double tunnel_size_ = 0.0;         // m, smallest tet altitude at the start (contact scenes)
   double reduction_seconds_ = 0.0;
   std::vector<double> reduced_;  // scratch of the step's reduction
   InternalForceSplit split_;     // interior tets computed while the ghost exchange travels

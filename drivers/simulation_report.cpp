@@ -70,6 +70,7 @@ RunReport Simulation::report() const {
     r.joint_tensile_min = comm_->min(r.joint_tensile_min);
     r.joint_tensile_max = comm_->max(r.joint_tensile_max);
     r.fragments = global_fragment_count(model_, *comm_);
+    distribution_->close_report();
     const DistributionReport& d = distribution_->report();
     r.parallel = true;
     r.start = distributed_start_ ? "distributed" : "whole_model";
@@ -82,6 +83,15 @@ RunReport Simulation::report() const {
     r.ghost_nodes_max = d.ghost_nodes_max;
     r.ghost_nodes_mean = d.ghost_nodes_sum / comm_->size();
     r.neighbours_max = d.neighbours_max;
+    r.incremental_redistributions = d.incremental_cycles;
+    r.sent_elements = d.sent_tets;
+    r.dropped_elements = d.dropped_tets;
+    r.sent_bytes = d.sent_bytes;
+    r.measured_imbalance = d.measured_imbalance;
+    r.repartition_seconds = d.repartition_seconds;
+    r.incremental_seconds = d.incremental_seconds;
+    r.predicted_gain_seconds = d.predicted_gain_seconds;
+    r.repartitions_declined = d.repartitions_declined;
     r.active_elements_max = comm_->max(static_cast<std::int64_t>(model_.tet_force_order.size()));
     r.communication_seconds =
         clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;

@@ -355,7 +355,12 @@ void Simulation::redistribute(bool detecting) {
           candidate_cost + (i < overlapping.size() && overlapping[i] ? overlap_cost : 0.0);
     contact_->release_until_rebind();  // `state` holds what rebind needs; pairs are re-detected
   }
-  domain_->redistribute(model_, state, contact_cost);
+  // This rank's compute seconds since the last cycle: what a re-partition could even out.
+  double busy = 0.0;
+  for (const Stage s : {internal, joints, fracture, detection, contact, external, integration})
+    busy += clocks_[s].seconds;
+  domain_->redistribute(model_, state, contact_cost, busy - busy_at_last_cycle_);
+  busy_at_last_cycle_ = busy;
   rebind_stages(state, contact_ && contact_->detected() && !detecting);
   moved_since_halo_ = false;
 }

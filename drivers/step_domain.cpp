@@ -15,7 +15,7 @@ class OneRankDomain final : public StepDomain {
   bool any(bool local) const override { return local; }
   std::vector<char> gather(const std::vector<char>& mine) const override { return mine; }
   void run_collectively(const std::function<void()>& check) const override { check(); }
-  void redistribute(Model&, TravellingState&, const std::vector<double>&) override {
+  void redistribute(Model&, TravellingState&, const std::vector<double>&, double) override {
     FDEM_VERIFY(false, "one rank never redistributes");
   }
   void start_halo_exchange(const NodeArrays&) override {}
@@ -35,11 +35,11 @@ class DistributedDomain final : public StepDomain {
   void run_collectively(const std::function<void()>& check) const override {
     comm_.run_collectively(check);
   }
-  void redistribute(Model& model, TravellingState& state,
-                    const std::vector<double>& cost) override {
+  void redistribute(Model& model, TravellingState& state, const std::vector<double>& cost,
+                    double busy_seconds) override {
     finish_halo_exchange(model.nodes);  // migration moves the positions of the ghosts too
     mark_phase(CommPhase::redistribution);
-    distribution_.redistribute(model, state, cost);
+    distribution_.redistribute(model, state, cost, busy_seconds);
     mark_phase(CommPhase::step);
   }
   void start_halo_exchange(const NodeArrays& nodes) override {

@@ -33,9 +33,10 @@ class StepDomain {
   // Runs `check` on every rank; what it throws on some ranks is thrown on every rank.
   virtual void run_collectively(const std::function<void()>& check) const = 0;
   // Collective: re-balances, migrates the tets with `state`, rebuilds the halo
-  // (parallel/distribution.hpp).  `cost`: per local tet, its contact cost in tet units.
-  virtual void redistribute(Model& model, TravellingState& state,
-                            const std::vector<double>& cost) = 0;
+  // (parallel/distribution.hpp).  `cost`: per local tet, its contact cost in tet units;
+  // `busy_seconds`: this rank's compute time since the last call (what re-partitioning gains).
+  virtual void redistribute(Model& model, TravellingState& state, const std::vector<double>& cost,
+                            double busy_seconds) = 0;
   // Split-phase ghost exchange of positions and velocities; finish() does nothing when no
   // exchange is in flight.
   virtual void start_halo_exchange(const NodeArrays& nodes) = 0;

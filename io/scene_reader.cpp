@@ -669,7 +669,13 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   if (const YAML::Node parallel = root["parallel"]) {
     r.check_keys(parallel, "parallel",
                  {"rebalance_threshold", "redistribute_every", "distributed_start", "partitioner",
-                  "gid_offset"});
+                  "gid_offset", "migration", "repartition"});
+    if (parallel["migration"])
+      scene.parallel.migration =
+          r.choice(parallel["migration"], "parallel.migration", {"incremental", "full"});
+    if (parallel["repartition"])
+      scene.parallel.repartition =
+          r.choice(parallel["repartition"], "parallel.repartition", {"measured", "threshold"});
     if (parallel["partitioner"])
       scene.parallel.partitioner = r.choice(parallel["partitioner"], "parallel.partitioner",
                                             {"rib", "rcb", "hsfc", "random"});

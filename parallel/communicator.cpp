@@ -5,6 +5,8 @@
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <thread>
 
 namespace fdem {
 
@@ -12,7 +14,8 @@ namespace {
 
 std::atomic<int> g_live_collective{0};
 std::atomic<std::int64_t> g_message_limit{INT_MAX};
-constexpr int chunk_tag = 7001;  // point-to-point chunks of exchange_rows (halo uses 8)
+constexpr int chunk_tag = 7001;   // point-to-point chunks of exchange_rows (halo uses 8)
+constexpr int sparse_tag = 7010;  // exchange_rows_sparse: 7010 and 7011 in turn
 
 // A contiguous MPI type of `bytes` bytes (freed at scope exit).
 class RowType {
@@ -264,6 +267,86 @@ void Communicator::exchange_rows(const void* send, const std::vector<std::int64_
   if (!receive_in_place)
     for (int r = 0; r < size_; ++r)
       std::copy_n(receive_copy.data() + bytes(rd[r]), bytes(rc[r]), in + bytes(receive_at[r]));
+}
+
+std::vector<char> Communicator::exchange_rows_sparse(
+    const void* send, const std::vector<std::int64_t>& send_rows, std::size_t row_bytes,
+    std::vector<std::int64_t>& receive_rows) const {
+  FDEM_VERIFY(static_cast<int>(send_rows.size()) == size_, "one count per rank");
+  receive_rows.assign(static_cast<std::size_t>(size_), 0);
+  if (row_bytes == 0) return {};
+  // Two calls in a row may overlap: a rank that left call k may already send for call k + 1 to a
+  // rank still receiving in call k (it cannot send for k + 2 before that rank entered k + 1's
+  // barrier).  Alternating tags per communicator keeps them apart.
+  static std::map<MPI_Comm, unsigned> calls;
+  const int tag = sparse_tag + static_cast<int>(calls[comm_]++ % 2);
+  const std::int64_t limit = detail::message_limit();
+  const RowType row(row_bytes);
+  const auto bytes = [&](std::int64_t rows) { return static_cast<std::size_t>(rows) * row_bytes; };
+  const auto* out = static_cast<const char*>(send);
+  const std::vector<std::int64_t> send_at = exclusive_sum(send_rows);
+  // Synchronous sends: one completes only once it is matched, so when all of a rank's sends are
+  // done, everything it sent has been received.
+  std::vector<MPI_Request> sends;
+  for (int r = 0; r < size_; ++r) {
+    if (r == rank_) continue;
+    for (std::int64_t k = 0; k < send_rows[r]; k += limit) {
+      sends.emplace_back();
+      MPI_Issend(out + bytes(send_at[r] + k), static_cast<int>(std::min(limit, send_rows[r] - k)),
+                 row.get(), r, tag, comm_, &sends.back());
+    }
+  }
+  std::map<int, std::vector<char>> from;  // by source rank (messages of one source in order)
+  MPI_Request barrier = MPI_REQUEST_NULL;
+  bool in_barrier = false;
+  for (;;) {
+    int arrived = 0;
+    MPI_Status status;
+    MPI_Iprobe(MPI_ANY_SOURCE, tag, comm_, &arrived, &status);
+    if (arrived) {
+      int count = 0;
+      MPI_Get_count(&status, row.get(), &count);
+      std::vector<char>& buffer = from[status.MPI_SOURCE];
+      const std::size_t at = buffer.size();
+      buffer.resize(at + bytes(count));
+      MPI_Recv(buffer.data() + at, count, row.get(), status.MPI_SOURCE, tag, comm_,
+               MPI_STATUS_IGNORE);
+      continue;
+    }
+    // Nothing yet: let another process have the core (ranks may outnumber cores).
+    std::this_thread::yield();
+    int done = 0;
+    if (!in_barrier) {
+      MPI_Testall(static_cast<int>(sends.size()), sends.data(), &done, MPI_STATUSES_IGNORE);
+      if (done) {
+        MPI_Ibarrier(comm_, &barrier);
+        in_barrier = true;
+      }
+    } else {
+      MPI_Test(&barrier, &done, MPI_STATUS_IGNORE);
+      if (done) break;  // every rank's sends were matched: nothing more is coming
+    }
+  }
+  // What arrived, in source rank order; this rank's own rows in their place.
+  std::size_t total = bytes(send_rows[rank_]);
+  for (const auto& [source, buffer] : from) total += buffer.size();
+  std::vector<char> received;
+  received.reserve(total);
+  bool own_done = false;
+  const auto add_own = [&] {
+    received.insert(received.end(), out + bytes(send_at[rank_]),
+                    out + bytes(send_at[rank_] + send_rows[rank_]));
+    receive_rows[rank_] = send_rows[rank_];
+    own_done = true;
+  };
+  for (auto& [source, buffer] : from) {
+    if (!own_done && source > rank_) add_own();
+    received.insert(received.end(), buffer.begin(), buffer.end());
+    receive_rows[source] = static_cast<std::int64_t>(buffer.size() / row_bytes);
+    buffer = std::vector<char>{};
+  }
+  if (!own_done) add_own();
+  return received;
 }
 
 void Communicator::allgather_rows(const void* local, const std::vector<std::int64_t>& counts,

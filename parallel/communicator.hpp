@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -243,6 +244,22 @@ class Communicator {
   void exchange_rows(const void* send, const std::vector<std::int64_t>& send_rows, void* receive,
                      const std::vector<std::int64_t>& receive_rows, std::size_t row_bytes) const;
 
+  // Neighbour-only exchange (the NBX algorithm of Hoefler, Siebert and Lumsdaine, 2010): the
+  // same as exchange(), but only the ranks with something to say send (synchronous sends, then
+  // a non-blocking barrier once they are matched), so nothing of length size() travels or is
+  // waited on: the messages are what the calls cost.  For exchanges between spatial neighbours
+  // (migration, claims, ghost requests).  Returns what arrived, in source rank order.
+  template <class T>
+  std::vector<T> exchange_sparse(const std::vector<std::vector<T>>& outbox,
+                                 std::vector<int>* sources = nullptr) const;
+  // The rows underneath: `send` holds send_rows[r] rows of `row_bytes` for each rank r in rank
+  // order; returns what arrived in source rank order, with each rank's row count in
+  // `receive_rows` (size() entries).
+  std::vector<char> exchange_rows_sparse(const void* send,
+                                         const std::vector<std::int64_t>& send_rows,
+                                         std::size_t row_bytes,
+                                         std::vector<std::int64_t>& receive_rows) const;
+
   // Returns root's string on every rank.
   std::string broadcast(const std::string& text, int root = 0) const;
 
@@ -317,6 +334,32 @@ std::vector<T> Communicator::exchange(const std::vector<std::vector<T>>& outbox,
   send.reserve(total);
   for (const auto& box : outbox) send.insert(send.end(), box.begin(), box.end());
   return exchange_grouped(send, counts, sources);
+}
+
+template <class T>
+std::vector<T> Communicator::exchange_sparse(const std::vector<std::vector<T>>& outbox,
+                                             std::vector<int>* sources) const {
+  static_assert(std::is_trivially_copyable_v<T>, "exchange moves plain values only");
+  FDEM_VERIFY(static_cast<int>(outbox.size()) == size_, "one outbox per rank");
+  std::vector<std::int64_t> send_rows(static_cast<std::size_t>(size_), 0);
+  std::size_t total = 0;
+  for (int r = 0; r < size_; ++r)
+    total += static_cast<std::size_t>(send_rows[r] = outbox[r].size());
+  std::vector<T> send;
+  send.reserve(total);
+  for (const auto& box : outbox) send.insert(send.end(), box.begin(), box.end());
+  std::vector<std::int64_t> receive_rows;
+  const std::vector<char> bytes =
+      exchange_rows_sparse(send.data(), send_rows, sizeof(T), receive_rows);
+  std::vector<T> received(bytes.size() / sizeof(T));
+  if (!bytes.empty()) std::memcpy(received.data(), bytes.data(), bytes.size());
+  if (sources) {
+    sources->clear();
+    sources->reserve(received.size());
+    for (int r = 0; r < size_; ++r)
+      sources->insert(sources->end(), static_cast<std::size_t>(receive_rows[r]), r);
+  }
+  return received;
 }
 
 template <class T>

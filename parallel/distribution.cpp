@@ -1,6 +1,7 @@
 #include "parallel/distribution.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <initializer_list>
@@ -227,8 +228,9 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   local.gid_offset = global.gid_offset;
   assemble({&rows}, local, local_state);
   build_exchange(local);
+  record_holders(local);
   report_.cycles = 1;
-  update_report(local);
+  update_report(local, false);
 }
 
 // Packs lists[p] for every other rank p into `send` (grouped by rank; counts in 8-byte words),
@@ -257,12 +259,10 @@ void Distribution::pack_rows(const Model& model, const TravellingState& state,
 // (Counts and offsets are 64-bit: Communicator::exchange_rows cuts what one call cannot hold.)
 std::vector<char> Distribution::exchange_rows(std::vector<char>& send,
                                               const std::vector<std::size_t>& send_counts) const {
+  // Rows go to the owner and the ranks near a tet: a neighbour-only exchange.
   const std::vector<std::int64_t> send_words(send_counts.begin(), send_counts.end());
-  const std::vector<std::int64_t> receive_words = comm_.exchange_counts(send_counts);
-  std::size_t received = 0;  // words
-  for (std::int64_t w : receive_words) received += static_cast<std::size_t>(w);
-  std::vector<char> receive(8 * received);
-  comm_.exchange_rows(send.data(), send_words, receive.data(), receive_words, 8);
+  std::vector<std::int64_t> receive_words;
+  std::vector<char> receive = comm_.exchange_rows_sparse(send.data(), send_words, 8, receive_words);
   send = std::vector<char>{};
   return receive;
 }
@@ -281,6 +281,10 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   std::vector<char> send, own;
   std::vector<std::size_t> send_counts;
   pack_rows(model, state, lists, send, send_counts, &own, start_joints);
+  cycle_traffic_ = {};
+  for (int p = 0; p < comm_.size(); ++p)
+    if (p != comm_.rank()) cycle_traffic_.sent_tets += static_cast<long>(lists[p].size());
+  cycle_traffic_.sent_bytes = static_cast<long>(send.size());
   // The rows hold everything that travels: the source arrays can go before the new ones come.
   model.nodes = NodeArrays{};
   model.tets = TetArrays{};
@@ -290,6 +294,82 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   std::vector<char> receive = exchange_rows(send, send_counts);
   assemble({&receive, &own}, out, out_state);
   build_exchange(out);
+}
+
+void Distribution::migrate_incremental(Model& model, TravellingState& state) {
+  const int ranks = comm_.size(), me = comm_.rank();
+  const std::vector<double>* also =
+      state.x_at_detection.size() == model.nodes.x.size() ? &state.x_at_detection : nullptr;
+  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false, nullptr, also);
+  const TetArrays& tets = model.tets;
+  // The copies each owned tet needs now against those that exist: the new ones travel, the ones
+  // no longer needed are dropped where they are.
+  std::vector<std::pair<GlobalId, std::int32_t>> needed;
+  std::vector<std::vector<LocalIndex>> sends(static_cast<std::size_t>(ranks));
+  for (int p = 0; p < ranks; ++p) {
+    if (p == me) continue;
+    for (const LocalIndex t : lists[p]) {
+      needed.emplace_back(tets.gid[t], p);
+      if (!std::binary_search(held_by_.begin(), held_by_.end(), needed.back()))
+        sends[p].push_back(t);
+    }
+  }
+  std::sort(needed.begin(), needed.end());
+  std::vector<std::vector<GlobalId>> drops(static_cast<std::size_t>(ranks));
+  for (const auto& copy : held_by_)
+    if (!std::binary_search(needed.begin(), needed.end(), copy))
+      drops[copy.second].push_back(copy.first);
+  held_by_ = std::move(needed);
+  std::vector<GlobalId> dropped = comm_.exchange_sparse(drops);
+  std::sort(dropped.begin(), dropped.end());
+
+  // What stays here: the owned tets and every copy its owner did not drop.
+  std::vector<LocalIndex> kept;
+  kept.reserve(static_cast<std::size_t>(tets.size()));
+  std::size_t found = 0;
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    const bool drop =
+        !tets.is_owned(t) && std::binary_search(dropped.begin(), dropped.end(), tets.gid[t]);
+    found += drop;
+    if (!drop) kept.push_back(t);
+  }
+  FDEM_VERIFY(found == dropped.size(), "a rank drops only copies it holds");
+  // A new copy carries every joint of its tet: the receiver may hold the other side already.
+  RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_, nullptr, true);
+  std::vector<char> send, own;
+  std::vector<std::size_t> send_counts(static_cast<std::size_t>(ranks), 0);
+  cycle_traffic_ = {};
+  cycle_traffic_.dropped_tets = static_cast<long>(dropped.size());
+  for (int p = 0; p < ranks; ++p) {
+    if (sends[p].empty()) continue;
+    const std::size_t before = send.size();
+    packer.pack(sends[p], send);
+    send_counts[p] = (send.size() - before) / 8;
+    cycle_traffic_.sent_tets += static_cast<long>(sends[p].size());
+  }
+  cycle_traffic_.sent_bytes = static_cast<long>(send.size());
+  packer.pack(kept, own);  // this rank's rows, rebuilt in place: no copy through MPI
+  model.nodes = NodeArrays{};
+  model.tets = TetArrays{};
+  model.joints = JointArrays{};
+  model.tet_force_order = {};
+  state = TravellingState{};
+  std::vector<char> receive = exchange_rows(send, send_counts);
+  assemble({&receive, &own}, model, state);
+  build_exchange(model);
+}
+
+void Distribution::record_holders(const Model& model) {
+  const TetArrays& tets = model.tets;
+  std::vector<std::vector<GlobalId>> notices(static_cast<std::size_t>(comm_.size()));
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (!tets.is_owned(t)) notices[tet_owner_[t]].push_back(tets.gid[t]);
+  std::vector<int> holder;
+  const std::vector<GlobalId> held = comm_.exchange_sparse(notices, &holder);
+  held_by_.clear();
+  held_by_.reserve(held.size());
+  for (std::size_t i = 0; i < held.size(); ++i) held_by_.emplace_back(held[i], holder[i]);
+  std::sort(held_by_.begin(), held_by_.end());
 }
 
 void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
@@ -490,7 +570,7 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(
         for (int k = 0; k < 3; ++k) inside = inside && c.cell[k] >= r[k] && c.cell[k] <= r[3 + k];
         if (inside) outbox[static_cast<std::size_t>(p)].push_back(c);
       }
-    for (const CellClaim& c : comm_.exchange(outbox)) grid.add(c.cell, c.rank);
+    for (const CellClaim& c : comm_.exchange_sparse(outbox)) grid.add(c.cell, c.rank);
   }
 
   std::vector<std::vector<LocalIndex>> lists(static_cast<std::size_t>(ranks));
@@ -514,7 +594,8 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(
 }
 
 void Distribution::redistribute(Model& model, TravellingState& state,
-                                const std::vector<double>& contact_cost) {
+                                const std::vector<double>& contact_cost, double busy_seconds) {
+  const auto started = std::chrono::steady_clock::now();
   const int ranks = comm_.size();
   const TetArrays& tets = model.tets;
 
@@ -528,9 +609,28 @@ void Distribution::redistribute(Model& model, TravellingState& state,
         const LocalIndex t = model.joints.tets[2 * j + side];
         if (tets.is_owned(t)) cost[t] += 0.5 * settings_.joint_cost;
       }
+  // One allgather: each rank's cost weights, its measured busy seconds since the last cycle and
+  // the seconds its last cycle took.
+  struct RankLoad {
+    double cost, busy, last_cycle;
+  };
   double my_cost = 0.0;
   for (LocalIndex t = 0; t < tets.size(); ++t) my_cost += cost[t];
-  const std::vector<double> rank_cost = comm_.allgather(my_cost);
+  const std::vector<RankLoad> loads =
+      comm_.allgather(RankLoad{my_cost, busy_seconds, last_cycle_seconds_});
+  std::vector<double> rank_cost(loads.size());
+  double busy_max = 0.0, busy_sum = 0.0;
+  for (std::size_t r = 0; r < loads.size(); ++r) {
+    rank_cost[r] = loads[r].cost;
+    busy_max = std::max(busy_max, loads[r].busy);
+    busy_sum += loads[r].busy;
+  }
+  account_last_cycle(
+      loads.empty()
+          ? 0.0
+          : std::max_element(loads.begin(), loads.end(), [](const RankLoad& a, const RankLoad& b) {
+              return a.last_cycle < b.last_cycle;
+            })->last_cycle);
   const double total = std::accumulate(rank_cost.begin(), rank_cost.end(), 0.0);
   const double mean = total / ranks;
   const double before =
@@ -538,9 +638,25 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   report_.imbalance_before = before;
   report_.max_imbalance = std::max(report_.max_imbalance, before);
   report_.imbalance = before;
+  const double busy_mean = busy_sum / ranks;
+  report_.measured_imbalance = busy_mean > 0.0 ? busy_max / busy_mean : 1.0;
+
+  // Re-partition when the weights say the load is uneven — and, once a re-partition has been
+  // timed, only when what it would save over the next interval (the busiest rank's time above
+  // the mean, if the next interval is like the last) exceeds what the last one cost.  Every rank
+  // decides from the same gathered numbers.
+  bool repartition = ranks > 1 && before > settings_.rebalance_threshold;
+  const double gain = busy_max - busy_mean;
+  if (repartition && settings_.measured_repartition && !settings_.random_parts &&
+      report_.last_repartition_seconds >= 0.0) {
+    repartition = gain > report_.last_repartition_seconds;
+    if (!repartition) ++report_.repartitions_declined;
+  }
+  if (repartition) report_.predicted_gain_seconds += gain;
 
   long migrated = 0;
-  if (ranks > 1 && before > settings_.rebalance_threshold) {
+  const long rebalances_before = report_.rebalances;
+  if (repartition) {
     // Weighted recursive bisection over the current centroids of the owned tets (Zoltan, each
     // rank with its own points).
     std::vector<PartitionPoint> points;
@@ -572,11 +688,37 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     report_.migrated_tets += migrated;
   }
 
-  TravellingState arrived;
-  migrate(model, state, model, arrived);
-  state = std::move(arrived);
+  if (report_.rebalances > rebalances_before || !settings_.incremental) {
+    // Owners moved (or the full path was asked for): every copy is sent afresh.
+    TravellingState arrived;
+    migrate(model, state, model, arrived);
+    state = std::move(arrived);
+    if (settings_.incremental) record_holders(model);
+  } else {
+    migrate_incremental(model, state);
+    ++report_.incremental_cycles;
+  }
   ++report_.cycles;
-  update_report(model);
+  update_report(model, true);
+  last_cycle_repartitioned_ = report_.rebalances > rebalances_before;
+  last_cycle_seconds_ =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
+void Distribution::account_last_cycle(double seconds) {
+  if (last_cycle_seconds_ < 0.0) return;  // no cycle since the start, or accounted already
+  if (last_cycle_repartitioned_) {
+    report_.last_repartition_seconds = seconds;
+    report_.repartition_seconds += seconds;
+  } else {
+    report_.incremental_seconds += seconds;
+  }
+  last_cycle_seconds_ = -1.0;
+}
+
+void Distribution::close_report() {
+  const double last = comm_.max(std::max(last_cycle_seconds_, 0.0));
+  account_last_cycle(last);
 }
 
 void Distribution::update_node_owners(const Model& model) {
@@ -595,7 +737,7 @@ void Distribution::update_node_owners(const Model& model) {
   std::vector<std::vector<TetOwner>> posts(static_cast<std::size_t>(ranks));
   for (LocalIndex t = 0; t < tets.size(); ++t)
     if (tets.is_owned(t)) posts[directory(tets.gid[t])].push_back({tets.gid[t], tet_owner_[t]});
-  std::vector<TetOwner> book = comm_.exchange(posts);
+  std::vector<TetOwner> book = comm_.exchange_sparse(posts);
   std::sort(book.begin(), book.end(),
             [](const TetOwner& a, const TetOwner& b) { return a.tet < b.tet; });
   std::vector<std::uint8_t> asking(node_owner_.size(), 0);
@@ -610,7 +752,7 @@ void Distribution::update_node_owners(const Model& model) {
     q.erase(std::unique(q.begin(), q.end()), q.end());
   }
   std::vector<int> asker;
-  const std::vector<GlobalId> asked = comm_.exchange(questions, &asker);
+  const std::vector<GlobalId> asked = comm_.exchange_sparse(questions, &asker);
   std::vector<std::vector<TetOwner>> answers(static_cast<std::size_t>(ranks));
   for (std::size_t i = 0; i < asked.size(); ++i) {
     const auto it = std::lower_bound(book.begin(), book.end(), asked[i],
@@ -618,7 +760,7 @@ void Distribution::update_node_owners(const Model& model) {
     FDEM_VERIFY(it != book.end() && it->tet == asked[i], "every tet has an owner on record");
     answers[static_cast<std::size_t>(asker[i])].push_back(*it);
   }
-  std::vector<TetOwner> known = comm_.exchange(answers);
+  std::vector<TetOwner> known = comm_.exchange_sparse(answers);
   std::sort(known.begin(), known.end(),
             [](const TetOwner& a, const TetOwner& b) { return a.tet < b.tet; });
   for (std::size_t n = 0; n < asking.size(); ++n) {
@@ -643,7 +785,7 @@ void Distribution::build_exchange(const Model& model) {
     request[owner].push_back(nodes.gid[n]);
   }
   std::vector<int> asker;  // the rank of each asked gid (in rank order)
-  const std::vector<GlobalId> asked = comm_.exchange(request, &asker);
+  const std::vector<GlobalId> asked = comm_.exchange_sparse(request, &asker);
   std::unordered_map<GlobalId, LocalIndex> owned_index;
   owned_index.reserve(static_cast<std::size_t>(nodes.n_owned));
   for (LocalIndex n = 0; n < nodes.n_owned; ++n) owned_index.emplace(nodes.gid[n], n);
@@ -703,13 +845,14 @@ void Distribution::finish_halo_exchange(NodeArrays& nodes) {
   }
 }
 
-void Distribution::update_report(const Model& model) {
+void Distribution::update_report(const Model& model, bool count_traffic) {
   const long owned = model.tets.n_owned;
   const long halo = model.tets.size() - model.tets.n_owned;
   const long ghosts = model.nodes.size() - model.nodes.n_owned;
   const long neighbours = static_cast<long>(neighbours_.size());
   std::vector<std::int64_t> low = {owned, halo, ghosts}, high = {owned, halo, ghosts, neighbours},
-                            sum = {halo, ghosts};
+                            sum = {halo, ghosts, cycle_traffic_.sent_tets,
+                                   cycle_traffic_.dropped_tets, cycle_traffic_.sent_bytes};
   comm_.min_in_place(low);
   comm_.max_in_place(high);
   comm_.sum_in_place(sum);
@@ -722,6 +865,15 @@ void Distribution::update_report(const Model& model) {
   report_.ghost_nodes_max = high[2];
   report_.ghost_nodes_sum = sum[1];
   report_.neighbours_max = high[3];
+  if (count_traffic) {
+    report_.last_sent_tets = sum[2];
+    report_.last_dropped_tets = sum[3];
+    report_.last_sent_bytes = sum[4];
+    report_.sent_tets += sum[2];
+    report_.dropped_tets += sum[3];
+    report_.sent_bytes += sum[4];
+  }
+  cycle_traffic_ = {};
 }
 
 std::uint64_t global_state_hash(const Model& model, const Communicator& comm) {

@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <initializer_list>
+#include <utility>
 #include <vector>
 
 #include "core/model.hpp"
@@ -34,6 +35,13 @@ struct DistributionSettings {
   GeometricMethod partitioner = GeometricMethod::rib;  // the re-partition at detection cycles
   // Test mode: every re-partition deals the tets to ranks at random (by gid and cycle).
   bool random_parts = false;
+  // Cycles without re-partition send only the copies a rank does not hold yet (false: every
+  // copy at every cycle).
+  bool incremental = true;
+  // Re-partition only when the predicted gain (the busiest rank's measured busy seconds over
+  // the last interval above the mean) exceeds the measured seconds of the last re-partition
+  // cycle; the first re-partition, before any was measured, goes by the cost weights alone.
+  bool measured_repartition = true;
 };
 
 // What the last (re)distribution did, the same on every rank.
@@ -48,6 +56,23 @@ struct DistributionReport {
   long halo_tets_min = 0, halo_tets_max = 0, halo_tets_sum = 0;
   long ghost_nodes_min = 0, ghost_nodes_max = 0, ghost_nodes_sum = 0;
   long neighbours_max = 0;  // ranks a rank exchanges ghosts with
+  // Migration traffic, summed over ranks and cycles after the first: tet copies sent (a tet
+  // sent to its owner and two halo ranks counts 3), copies dropped by a rank that no longer
+  // needs them, and the bytes of rows sent.  Incremental cycles (no re-partition) send only the
+  // copies a rank does not hold yet.
+  long incremental_cycles = 0;
+  long sent_tets = 0, dropped_tets = 0;
+  long sent_bytes = 0;
+  long last_sent_tets = 0, last_dropped_tets = 0, last_sent_bytes = 0;  // of the last cycle
+  // Re-partitioning on measured cost: the busiest rank's busy seconds over the mean at the last
+  // cycle; seconds of the cycles (the slowest rank's), re-partitioning and incremental; the
+  // last re-partition's (−1: none timed yet); the predicted gains of the re-partitions made; the
+  // cycles whose weights called for a re-partition that the measured gain did not justify.
+  double measured_imbalance = 1.0;
+  double repartition_seconds = 0.0, incremental_seconds = 0.0;
+  double last_repartition_seconds = -1.0;
+  double predicted_gain_seconds = 0.0;
+  long repartitions_declined = 0;
 };
 
 class Distribution {
@@ -76,7 +101,12 @@ class Distribution {
   // `contact_cost`: the cost of the contact pairs whose first tet it is, in the same unit, or
   // empty), re-partitions when the
   // imbalance exceeds the threshold, migrates, and rebuilds the halo and the ghost exchange.
-  void redistribute(Model& model, TravellingState& state, const std::vector<double>& contact_cost);
+  // `busy_seconds`: this rank's compute time since the last cycle (re-partitioning on measured
+  // cost, DistributionSettings::measured_repartition).
+  void redistribute(Model& model, TravellingState& state, const std::vector<double>& contact_cost,
+                    double busy_seconds);
+  // Collective, before the report is read at the end of a run: accounts the last cycle's time.
+  void close_report();
 
   // Split-phase ghost exchange of positions and velocities: start() after integration posts the
   // sends and receives, finish() completes them and writes the ghost entries.
@@ -86,6 +116,11 @@ class Distribution {
   const DistributionReport& report() const { return report_; }
   // Per local node: the rank that owns it (xdmf frames ask ghost nodes' owners for their rows).
   const std::vector<std::int32_t>& node_owners() const { return node_owner_; }
+  // For each owned tet, the other ranks that hold a copy, as (gid, rank) sorted: what an
+  // incremental cycle sends against.
+  const std::vector<std::pair<GlobalId, std::int32_t>>& copies_elsewhere() const {
+    return held_by_;
+  }
 
  private:
   struct Neighbour {
@@ -112,6 +147,15 @@ class Distribution {
                  const std::vector<StartJoint>* start_joints = nullptr) const;
   std::vector<char> exchange_rows(std::vector<char>& send,
                                   const std::vector<std::size_t>& send_counts) const;
+  // A cycle without re-partition: owners and active tets stay, so every copy a rank holds is
+  // current (ghost positions from the completed halo exchange, the stages' state of what it
+  // computes).  Each owner sends only the copies a rank does not hold yet (`held_by_`) and tells
+  // the ranks that no longer need one to drop it; each rank rebuilds from what it kept and what
+  // arrived.  Bytes on the wire ∝ the tets that entered or left a halo.
+  void migrate_incremental(Model& model, TravellingState& state);
+  // After a full migration: every rank tells the owners of the tets it holds (not owned) that it
+  // holds them, so that the next incremental cycle knows where copies are.
+  void record_holders(const Model& model);
   // Builds `model` from packed rows; empties each buffer once parsed.
   void assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
                 TravellingState& state);
@@ -129,7 +173,10 @@ class Distribution {
   std::vector<std::vector<LocalIndex>> destinations(
       const Model& model, bool whole, const std::vector<double>* start_reach = nullptr,
       const std::vector<double>* x_also = nullptr) const;
-  void update_report(const Model& model);
+  // The slowest rank's seconds of the last cycle, once known (at the next cycle or the end).
+  void account_last_cycle(double seconds);
+  // `count_traffic`: add this cycle's migration traffic (not the initial distribution's).
+  void update_report(const Model& model, bool count_traffic);
 
   Communicator comm_;
   DistributionSettings settings_;
@@ -142,9 +189,16 @@ class Distribution {
   std::vector<GlobalId> node_first_tet_;
   GlobalId n_tets_ = 0;      // tets of the whole model
   GlobalId gid_offset_ = 0;  // Model::gid_offset: tet gids are gid_offset_ + 0..n_tets_−1
+  // For each owned tet, the other ranks that hold a copy: (gid, rank), sorted.
+  std::vector<std::pair<GlobalId, std::int32_t>> held_by_;
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
   DistributionReport report_;
+  struct Traffic {
+    long sent_tets = 0, dropped_tets = 0, sent_bytes = 0;
+  } cycle_traffic_;                   // this rank's, of the cycle under way
+  double last_cycle_seconds_ = -1.0;  // this rank's, of the last cycle (−1: accounted)
+  bool last_cycle_repartitioned_ = false;
   bool has_joint_state_ = false;  // the scene has joints: tets carry their joint state
 };
 

@@ -85,24 +85,30 @@ class RowPacker {
   // redistribution and the nodes' first tets.
   // `start_joints` (distributed start, model.joints empty): the joints whose tet A is local, by
   // gid, with global references.
+  // `both_sides`: a tet carries every joint it is a side of (incremental migration: a rank that
+  // already holds one side gets the joint with the other), not only those whose tet A it is.
   RowPacker(const Model& model, const TravellingState& state,
             const std::vector<std::int32_t>& tet_owner, const std::vector<std::int32_t>& node_owner,
             const std::vector<GlobalId>& node_first_tet,
-            const std::vector<StartJoint>* start_joints = nullptr)
+            const std::vector<StartJoint>* start_joints = nullptr, bool both_sides = false)
       : model_(model),
         state_(state),
         tet_owner_(tet_owner),
         node_owner_(node_owner),
         node_first_tet_(node_first_tet),
         start_joints_(start_joints),
-        stamp_(model.nodes.size(), -1) {
+        stamp_(model.nodes.size(), -1),
+        joint_stamp_(model.joints.size(), -1) {
     const JointArrays& joints = model.joints;
+    const int sides = both_sides ? 2 : 1;
     joint_offsets_.assign(static_cast<std::size_t>(model.tets.size()) + 1, 0);
-    for (LocalIndex j = 0; j < joints.size(); ++j) ++joint_offsets_[joints.tets[2 * j] + 1];
+    for (LocalIndex j = 0; j < joints.size(); ++j)
+      for (int s = 0; s < sides; ++s) ++joint_offsets_[joints.tets[2 * j + s] + 1];
     std::partial_sum(joint_offsets_.begin(), joint_offsets_.end(), joint_offsets_.begin());
-    joint_list_.resize(static_cast<std::size_t>(joints.size()));
+    joint_list_.resize(static_cast<std::size_t>(joint_offsets_.back()));
     std::vector<std::int64_t> fill(joint_offsets_.begin(), joint_offsets_.end() - 1);
-    for (LocalIndex j = 0; j < joints.size(); ++j) joint_list_[fill[joints.tets[2 * j]]++] = j;
+    for (LocalIndex j = 0; j < joints.size(); ++j)
+      for (int s = 0; s < sides; ++s) joint_list_[fill[joints.tets[2 * j + s]]++] = j;
   }
 
   void pack(const std::vector<LocalIndex>& tet_list, std::vector<char>& out) {
@@ -128,8 +134,13 @@ class RowPacker {
           node_list.push_back(n);
         }
       }
-      for (std::int64_t k = joint_offsets_[t]; k < joint_offsets_[t + 1]; ++k)
-        joint_list.push_back(joint_list_[k]);
+      for (std::int64_t k = joint_offsets_[t]; k < joint_offsets_[t + 1]; ++k) {
+        const LocalIndex j = joint_list_[k];
+        if (joint_stamp_[j] != mark_) {  // once per block, though both its tets may be listed
+          joint_stamp_[j] = mark_;
+          joint_list.push_back(j);
+        }
+      }
       const GlobalId g = tets.gid[t];
       auto it = std::lower_bound(state_.pairs.begin(), state_.pairs.end(), g,
                                  [](const PairRecord& e, GlobalId value) { return e.a < value; });
@@ -217,7 +228,7 @@ class RowPacker {
   const std::vector<std::int32_t>& node_owner_;
   const std::vector<GlobalId>& node_first_tet_;
   const std::vector<StartJoint>* start_joints_;
-  std::vector<int> stamp_;
+  std::vector<int> stamp_, joint_stamp_;
   int mark_ = 0;
   std::vector<std::int64_t> joint_offsets_;
   std::vector<LocalIndex> joint_list_;

@@ -67,8 +67,9 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     local.gid_offset = start.model.gid_offset;
     migrate(start.model, state, local, local_state, &start.joints, &start.tet_reach);
   }
+  record_holders(local);
   report_.cycles = 1;
-  update_report(local);
+  update_report(local, false);
 }
 
 void Distribution::append_halo(Model& model, TravellingState& state,

@@ -303,6 +303,48 @@ TEST_CASE("64-bit counts: exchanges cut into pieces give what one message gives"
   CHECK(gathered.size() == static_cast<std::size_t>(7 * n * (n - 1) / 2 + 3 * n));
 }
 
+TEST_CASE("sparse exchange gives what the all-to-all exchange gives, calls back to back", "[mpi]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank());
+  const int n = comm.size(), me = comm.rank();
+  // Patterns: every rank to every rank; only to the next rank (a ring of neighbours); to nobody;
+  // only rank 0 to the last rank.
+  const auto outbox_of = [&](int pattern) {
+    std::vector<std::vector<Row>> outbox(static_cast<std::size_t>(n));
+    for (int to = 0; to < n; ++to) {
+      const bool sends = pattern == 0   ? true
+                         : pattern == 1 ? to == (me + 1) % n
+                         : pattern == 2 ? false
+                                        : me == 0 && to == n - 1;
+      if (sends) outbox[static_cast<std::size_t>(to)] = rows_for(me, to);
+    }
+    return outbox;
+  };
+  for (std::int64_t limit : {1, 3, 1000}) {
+    INFO("message limit " << limit);
+    const MessageLimit scope(limit);
+    // Several calls in a row with no other communication between them: a rank that finished
+    // one call may already send for the next.
+    for (int round = 0; round < 3; ++round)
+      for (int pattern = 0; pattern < 4; ++pattern) {
+        INFO("pattern " << pattern << ", round " << round);
+        const std::vector<std::vector<Row>> outbox = outbox_of(pattern);
+        std::vector<int> sources, sparse_sources;
+        const std::vector<Row> expected = comm.exchange(outbox, &sources);
+        const std::vector<Row> got = comm.exchange_sparse(outbox, &sparse_sources);
+        bool same = got.size() == expected.size() && sparse_sources == sources;
+        for (std::size_t i = 0; same && i < got.size(); ++i)
+          same = got[i].from == expected[i].from && got[i].to == me && got[i].k == expected[i].k &&
+                 got[i].x == expected[i].x;
+        CHECK(same);
+      }
+    const std::vector<std::vector<Row>> ring = outbox_of(1);
+    std::vector<Row> first = comm.exchange_sparse(ring), second = comm.exchange_sparse(ring);
+    CHECK(first.size() == rows_for((me + n - 1) % n, me).size());
+    CHECK(second.size() == first.size());
+  }
+}
+
 TEST_CASE("64-bit counts: rows of any width, own rows included, exchanged in pieces", "[mpi]") {
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank());

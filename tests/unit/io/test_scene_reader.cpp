@@ -324,6 +324,20 @@ TEST_CASE("the parallel block reads its two keys and rejects others", "[io]") {
   CHECK_THAT(negative, Contains("parallel.redistribute_every") && Contains(">= 0"));
 }
 
+TEST_CASE("parallel.migration and parallel.repartition: defaults, choices, clear errors", "[io]") {
+  const fdem::Scene defaults = fdem::parse_scene(minimal_plus(""), "scene.yaml");
+  CHECK(defaults.parallel.migration == "incremental");
+  CHECK(defaults.parallel.repartition == "measured");
+  const fdem::Scene s = fdem::parse_scene(
+      minimal_plus("parallel: {migration: full, repartition: threshold}\n"), "scene.yaml");
+  CHECK(s.parallel.migration == "full");
+  CHECK(s.parallel.repartition == "threshold");
+  const std::string bad = input_error(minimal_plus("parallel: {migration: partial}\n"));
+  CHECK_THAT(bad, Contains("parallel.migration") && Contains("incremental") && Contains("full"));
+  const std::string worse = input_error(minimal_plus("parallel: {repartition: always}\n"));
+  CHECK_THAT(worse, Contains("parallel.repartition") && Contains("measured"));
+}
+
 TEST_CASE("parallel.gid_offset: a 64-bit integer from 0 to below 2^62", "[io]") {
   CHECK(fdem::parse_scene(minimal_plus(""), "scene.yaml").parallel.gid_offset == 0);
   for (const std::string value : {"4294979641", "1099511627775", "4611686018427387903"})

@@ -1,0 +1,208 @@
+// The distribution's invariants on N ranks, checked against the whole model every rank builds
+// here: each tet owned once, every tet that touches an owned node held, ghost nodes owned by the
+// owner of their first tet, and each owner's list of where its tets have copies — the list an
+// incremental migration sends against — true.  After nodes move, an incremental cycle gives the
+// rank the same arrays, bit for bit, as a full one.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "core/model_builder.hpp"
+#include "drivers/scene_builders.hpp"
+#include "parallel/communicator.hpp"
+#include "parallel/distribution.hpp"
+
+using namespace fdem;
+
+namespace {
+
+// A long slab with a post standing on it, nodes displaced a little off the mesh.
+Model slab_and_post() {
+  Scene scene = builders::basic_scene(1.0);
+  scene.materials = {builders::elastic_material(1000, 1e6, 0.3)};
+  scene.bodies = {builders::box_body("slab", {0, 0, 0}, {4, 0.6, 0.2}, 32, 5, 2, 0),
+                  builders::box_body("post", {0.2, 0.2, 0.21}, {0.4, 0.4, 1.0}, 2, 2, 6, 0)};
+  Model model = build_model(scene, load_body_meshes(scene));
+  for (LocalIndex i = 0; i < model.nodes.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      model.nodes.x[3 * i + k] +=
+          1e-3 * std::sin(0.7 * static_cast<double>(model.nodes.gid[i]) + k);
+  return model;
+}
+
+// Moves every node of `model` (owned and ghost: as the halo exchange leaves them) by a function
+// of its gid and of `shift`: the post (above z = 0.205) slides along x by `shift`.
+void move(Model& model, double shift) {
+  NodeArrays& n = model.nodes;
+  for (LocalIndex i = 0; i < n.size(); ++i) {
+    const double g = static_cast<double>(n.gid[i]);
+    if (n.x0[3 * i + 2] > 0.205) n.x[3 * i] += shift;
+    for (int k = 0; k < 3; ++k) n.x[3 * i + k] += 1e-4 * std::cos(0.3 * g + k);
+  }
+}
+
+// The invariants of `local` (this rank's part of `global`) under `d`.
+void check_invariants(const Communicator& comm, const Model& global, const Model& local,
+                      const Distribution& d) {
+  const int me = comm.rank();
+  const TetArrays& tets = local.tets;
+  const NodeArrays& nodes = local.nodes;
+  // Each tet owned by exactly one rank.
+  std::vector<GlobalId> owned;
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (tets.is_owned(t)) owned.push_back(tets.gid[t]);
+  CHECK(static_cast<LocalIndex>(owned.size()) == tets.n_owned);
+  struct TetOwner {
+    GlobalId gid;
+    std::int32_t rank;
+  };
+  std::vector<TetOwner> mine;
+  for (GlobalId g : owned) mine.push_back({g, me});
+  std::vector<TetOwner> all = comm.allgatherv(mine);
+  std::sort(all.begin(), all.end(),
+            [](const TetOwner& a, const TetOwner& b) { return a.gid < b.gid; });
+  REQUIRE(static_cast<LocalIndex>(all.size()) == global.tets.size());
+  std::map<GlobalId, int> owner_of;
+  for (LocalIndex t = 0; t < global.tets.size(); ++t) {
+    CHECK(all[t].gid == global.tets.gid[t]);  // every gid once
+    owner_of[all[t].gid] = all[t].rank;
+  }
+  // Local tets in ascending gid; owned nodes first, each range in ascending gid.
+  CHECK(std::is_sorted(tets.gid.begin(), tets.gid.end()));
+  CHECK(std::is_sorted(nodes.gid.begin(), nodes.gid.begin() + nodes.n_owned));
+  CHECK(std::is_sorted(nodes.gid.begin() + nodes.n_owned, nodes.gid.end()));
+  // Each node's first tet (smallest gid that uses it) owns it.
+  std::map<GlobalId, GlobalId> first_tet;
+  std::map<GlobalId, std::vector<GlobalId>> tets_of_node;
+  for (LocalIndex t = 0; t < global.tets.size(); ++t)
+    for (int c = 0; c < 4; ++c) {
+      const GlobalId n = global.nodes.gid[global.tets.nodes[4 * t + c]];
+      tets_of_node[n].push_back(global.tets.gid[t]);
+      if (!first_tet.count(n)) first_tet[n] = global.tets.gid[t];  // global tets in gid order
+    }
+  const std::vector<std::int32_t>& node_owner = d.node_owners();
+  REQUIRE(static_cast<LocalIndex>(node_owner.size()) == nodes.size());
+  long wrong_owner = 0, missing_neighbour = 0;
+  for (LocalIndex n = 0; n < nodes.size(); ++n) {
+    const int expected = owner_of[first_tet[nodes.gid[n]]];
+    if (node_owner[n] != expected || (n < nodes.n_owned) != (expected == me)) ++wrong_owner;
+    // Held neighbours: every tet touching an owned node is here (its force on the node).
+    if (n < nodes.n_owned)
+      for (GlobalId t : tets_of_node[nodes.gid[n]])
+        if (tets.find(t) < 0) ++missing_neighbour;
+  }
+  CHECK(wrong_owner == 0);
+  CHECK(missing_neighbour == 0);
+  // Active tets: owned or touching an owned node.
+  long wrong_active = 0;
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    bool touches = false;
+    for (int c = 0; c < 4; ++c) touches = touches || tets.nodes[4 * t + c] < nodes.n_owned;
+    if (static_cast<bool>(tets.active[t]) != (tets.is_owned(t) || touches)) ++wrong_active;
+  }
+  CHECK(wrong_active == 0);
+  // Each owner knows where its tets have copies: the same list as the copies every rank holds.
+  struct Copy {
+    GlobalId gid;
+    std::int32_t rank;
+  };
+  std::vector<Copy> held;
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (!tets.is_owned(t)) held.push_back({tets.gid[t], me});
+  std::vector<std::pair<GlobalId, std::int32_t>> copies;
+  for (const Copy& c : comm.allgatherv(held))
+    if (owner_of[c.gid] == me) copies.emplace_back(c.gid, c.rank);
+  std::sort(copies.begin(), copies.end());
+  CHECK(copies == d.copies_elsewhere());
+}
+
+// The arrays a migration rebuilds, as bytes.
+std::vector<char> local_bytes(const Model& m) {
+  std::vector<char> out;
+  const auto add = [&](const auto& v) {
+    const auto* p = reinterpret_cast<const char*>(v.data());
+    out.insert(out.end(), p, p + v.size() * sizeof(v[0]));
+  };
+  add(m.tets.gid);
+  add(m.tets.nodes);
+  add(m.tets.owned);
+  add(m.tets.active);
+  add(m.nodes.gid);
+  add(m.nodes.x);
+  add(m.nodes.v);
+  add(m.nodes.mass);
+  add(m.tet_force_order);
+  out.push_back(static_cast<char>(m.nodes.n_owned % 127));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("distribution invariants: tets owned once, neighbours held, ghost owners, copies known",
+          "[mpi][distribution]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const Model global = slab_and_post();
+  const double buffer = 0.02;  // m
+  const auto start = [&](bool incremental, Model& local, TravellingState& state) {
+    DistributionSettings settings;
+    settings.incremental = incremental;
+    TravellingState whole;
+    whole.x_at_detection = global.nodes.x;
+    return Distribution(comm, settings, global, whole, buffer, {}, local, state);
+  };
+  Model a_model, b_model;
+  TravellingState a_state, b_state;
+  Distribution incremental = start(true, a_model, a_state);
+  Distribution full = start(false, b_model, b_state);
+  check_invariants(comm, global, a_model, incremental);
+  CHECK(local_bytes(a_model) == local_bytes(b_model));
+
+  // The post slides over the slab in three cycles: copies enter and leave halos.
+  for (int cycle = 0; cycle < 3; ++cycle) {
+    INFO("cycle " << cycle);
+    for (Model* m : {&a_model, &b_model}) move(*m, 0.9);
+    a_state.x_at_detection = a_model.nodes.x;  // a detection at these positions follows
+    b_state.x_at_detection = b_model.nodes.x;
+    incremental.redistribute(a_model, a_state, {}, 0.0);
+    full.redistribute(b_model, b_state, {}, 0.0);
+    check_invariants(comm, global, a_model, incremental);
+    CHECK(local_bytes(a_model) == local_bytes(b_model));
+    CHECK(incremental.report().rebalances == 0);  // the weights stay balanced: no re-partition
+  }
+  const DistributionReport& inc = incremental.report();
+  const DistributionReport& ref = full.report();
+  CHECK(inc.incremental_cycles == 3);
+  CHECK(ref.incremental_cycles == 0);
+  if (comm.size() > 1) {
+    CHECK(inc.sent_tets + inc.dropped_tets > 0);  // the halos changed
+    CHECK(inc.sent_tets < ref.sent_tets);         // and only the changes travelled
+    CHECK(inc.sent_bytes < ref.sent_bytes);
+  }
+}
+
+TEST_CASE("distribution invariants hold after re-partitions at random", "[mpi][distribution]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const Model global = slab_and_post();
+  DistributionSettings settings;
+  settings.random_parts = true;
+  settings.rebalance_threshold = 0.0;  // re-partition at every cycle
+  TravellingState whole, state;
+  whole.x_at_detection = global.nodes.x;
+  Model local;
+  Distribution d(comm, settings, global, whole, 0.02, {}, local, state);
+  for (int cycle = 0; cycle < 2; ++cycle) {
+    INFO("cycle " << cycle);
+    move(local, 0.1);
+    state.x_at_detection = local.nodes.x;
+    d.redistribute(local, state, {}, 0.0);
+    check_invariants(comm, global, local, d);
+  }
+  if (comm.size() > 1) CHECK(d.report().rebalances == 2);
+}
