@@ -27,8 +27,9 @@ fdem overlaps the halo with interior tets, so the halo term is an upper bound):
   T = t_tet * (n + redundant(n)) + m * alpha + bytes(n) / beta + c * allreduce(P) + r * R(P)
   halo(n), ghosts(n) = 4-rank figure * (n / n4)^(2/3) * faces(P) / faces(4) (block: 3-D grid of
   parts; wall, one stone thick: a 2-D grid, exponent 1/2); m = neighbours (26 in 3-D, 8 in 2-D
-  beyond 4 ranks); R(P) = redistribution: collectives * allreduce(P) + alltoalls * alpha * P +
-  gather bytes scaled with N - n (a whole-model term) / beta + migration bytes scaled with halo / beta.
+  beyond 4 ranks); R(P) = redistribution: (collectives + non-blocking barriers) * allreduce(P) +
+  alltoalls * alpha * P + messages (scaled to the neighbours) * alpha + gather bytes scaled with
+  P (--gather-scaling model: with N - n) / beta + rows moved scaled with the halo / beta.
 Strong: E = N t_tet / (P T(N/P)); weak (n fixed = the target model / 1024): E = t_tet n / T(n).
 """
 import argparse
@@ -67,8 +68,12 @@ def budget(run_dir):
         "halo_bytes": halo_bytes, "p2p_messages": step["p2p_messages"],
         "collectives": step["blocking_collectives"],
         "red_gather_bytes": pick(["MPI_Allgather", "MPI_Allgatherv"], "bytes"),
-        "red_alltoall_bytes": pick(["MPI_Alltoall", "MPI_Alltoallv"], "bytes"),
+        # rows moved: all-to-all (before neighbour-only exchanges) or point-to-point (after)
+        "red_alltoall_bytes": pick(["MPI_Alltoall", "MPI_Alltoallv", "MPI_Recv", "MPI_Irecv"],
+                                   "bytes"),
         "red_alltoalls": pick(["MPI_Alltoall", "MPI_Alltoallv"], "calls"),
+        "red_messages": red.get("p2p_messages", 0),
+        "red_ibarriers": pick(["MPI_Ibarrier"], "calls"),
         "red_collectives": red.get("blocking_collectives", 0),
     }
 
@@ -95,6 +100,8 @@ def measured(d):
             "red_gather_bytes": b["red_gather_bytes"] / r,
             "red_alltoall_bytes": b["red_alltoall_bytes"] / r,
             "red_alltoalls": b["red_alltoalls"] / r,
+            "red_messages": b["red_messages"] / r,
+            "red_ibarriers": b["red_ibarriers"] / r,
             "red_collectives": b["red_collectives"] / r,
             "N4": four["elements"],
         }
@@ -137,8 +144,15 @@ def step_time(m, dims, p, n, N, a):
     t = {"compute": m["t_tet"] * (n + redundant)}
     t["halo"] = messages * a.alpha + ghosts * m["bytes_per_ghost"] / a.beta
     t["allreduce"] = m["collectives_per_step"] * allreduce
-    red = (m["red_collectives"] * allreduce + m["red_alltoalls"] * a.alpha * p
-           + m["red_gather_bytes"] * (N - n) / (m["N4"] * 3 / 4) / a.beta
+    # Collectives and the neighbour-only exchanges' non-blocking barriers at a tree's depth;
+    # all-to-alls at alpha * P; point-to-point messages with the neighbours; gathered bytes
+    # (O(P) numbers per rank since the re-partition runs on each rank's own tets, or whole-model
+    # before: --gather-scaling) and rows moved, which scale with a part's surface.
+    gathered = ((p - 1) / 3 if a.gather_scaling == "ranks" else (N - n) / (m["N4"] * 3 / 4))
+    messages_red = m["red_messages"] * (1 if p <= 4 else (26 if dims == 3 else 8) / m["neighbours4"])
+    red = ((m["red_collectives"] + m["red_ibarriers"]) * allreduce
+           + m["red_alltoalls"] * a.alpha * p + messages_red * a.alpha
+           + m["red_gather_bytes"] * gathered / a.beta
            + m["red_alltoall_bytes"] * shape / a.beta)
     t["redistribution"] = m["redistributions_per_step"] * red
     return t
@@ -154,6 +168,10 @@ def main():
     ap.add_argument("--redistribution-every", type=float, default=0,
                     help="wall: one redistribution every this many steps instead of the measured "
                          "rate (a settling wall detects rarely; a shaken one every few tens of steps)")
+    ap.add_argument("--gather-scaling", choices=["ranks", "model"], default="ranks",
+                    help="how the bytes gathered at a redistribution grow: with the rank count "
+                         "(O(P) numbers per rank, the code since the re-partition runs on each "
+                         "rank's own tets) or with the whole model (the centroid gather before)")
     ap.add_argument("--csv", help="write the predictions here")
     a = ap.parse_args()
     m, mpi = measured(a.measured)
@@ -168,8 +186,9 @@ def main():
               f"{x['bytes_per_ghost']:.1f} B per ghost node-step, "
               f"{x['messages_per_step']:.2f} messages and {x['collectives_per_step']:.2f} blocking "
               f"collectives per step, {x['redistributions_per_step']:.4f} redistributions per step "
-              f"({x['red_collectives']:.0f} collectives, {x['red_gather_bytes']:.0f} B gathered, "
-              f"{x['red_alltoall_bytes']:.0f} B all-to-all each)")
+              f"({x['red_collectives']:.0f} collectives, {x['red_alltoalls']:.0f} all-to-alls, "
+              f"{x['red_ibarriers']:.0f} non-blocking barriers, {x['red_messages']:.0f} messages, "
+              f"{x['red_gather_bytes']:.0f} B gathered, {x['red_alltoall_bytes']:.0f} B moved each)")
     for (kind, size), s in sorted(mpi.items()):
         print(f"  mpi {kind} {size} B: {1e6 * s:.2f} us (2 ranks, shared machine)")
     print(f"MODELLED cluster: alpha {a.alpha * 1e6:.1f} us, beta {a.beta / 1e9:.0f} GB/s, allreduce "

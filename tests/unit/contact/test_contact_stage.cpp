@@ -1,8 +1,11 @@
 // The contact stage keys friction history by the two tets' 64-bit global ids: a model whose ids
 // lie above 2^32 (a model of more than four billion tets, or ids offset for a test) keeps and
 // hands back each pair's history under its own ids.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstring>
+#include <utility>
+#include <vector>
 
 #include "contact/contact_stage.hpp"
 #include "core/model_builder.hpp"
@@ -98,4 +101,48 @@ TEST_CASE("friction entries travel as pair records and come back bit for bit", "
     CHECK(std::memcmp(back[i].spring.data(), entries[i].spring.data(), 3 * sizeof(double)) == 0);
     CHECK(back[i].stiffness == entries[i].stiffness);
   }
+}
+
+TEST_CASE("a bonded pair never pairs, and pairs again at the detection after its bond is released",
+          "[contact][stage]") {
+  Scene scene;
+  scene.source_path = "test";
+  MaterialSpec stone;
+  stone.name = "stone";
+  stone.density = 2500;
+  stone.elastic.young = 1e8;
+  stone.elastic.poisson = 0.2;
+  scene.materials.push_back(stone);
+  scene.bodies = {body("base"), body("block")};
+  const Model model = build_model(scene, {cell(Vec3(0, 0, 0), Vec3(1, 1, 0.2)),
+                                          cell(Vec3(0.2, 0.2, 0.199), Vec3(0.7, 0.7, 0.5))});
+  const auto pairs_of = [](const ContactStage& stage) {
+    std::vector<std::pair<LocalIndex, LocalIndex>> out;
+    for (const CandidatePair& p : stage.candidates()) out.emplace_back(p.a, p.b);
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  ContactStage free_stage(model, ContactSettings{0.02});
+  free_stage.detect(model);
+  const auto all = pairs_of(free_stage);
+  REQUIRE(all.size() >= 2);
+
+  ContactStage stage(model, ContactSettings{0.02});
+  const std::pair<LocalIndex, LocalIndex> bonded = all[1];
+  stage.set_bonds(model.tets.size(), {bonded});
+  CHECK(stage.detect_if_needed(model));  // never detected: runs
+  auto expected = all;
+  expected.erase(std::find(expected.begin(), expected.end(), bonded));
+  CHECK(pairs_of(stage) == expected);          // every pair but the bonded one
+  CHECK_FALSE(stage.detect_if_needed(model));  // nothing moved: no detection due
+  const std::vector<std::uint8_t> states = stage.tet_joint_states();
+  CHECK(states[bonded.first] == static_cast<std::uint8_t>(TetJointState::intact));
+
+  stage.release_bond(bonded.first, -1);  // the other tet held on another rank: a no-op for it
+  stage.release_bond(bonded.first, bonded.second);
+  CHECK(stage.detection_due(model));  // nothing moved, yet the freed faces must be found
+  CHECK(stage.detect_if_needed(model));
+  CHECK(pairs_of(stage) == all);
+  CHECK(stage.tet_joint_states()[bonded.second] ==
+        static_cast<std::uint8_t>(TetJointState::cracked));
 }
