@@ -2,7 +2,8 @@
 """Cost model of fdem's step on P ranks, fed with figures measured by scripts/cost-model-measure.sh.
 
   python3 scripts/cost-model.py [MEASURED_DIR] [--alpha S] [--beta B/S] [--alpha-coll S]
-        [--active-halo F] [--redistribution-every STEPS] [--csv FILE]
+        [--active-halo F] [--redistribution-every STEPS] [--redistribution-collectives N]
+        [--gather-scaling ranks|model] [--csv FILE]
 
 MEASURED on this machine (MEASURED_DIR, default out/cost-model):
   t_tet      seconds per tet-step on 1 rank, all stages but output (summary.json "stages")
@@ -168,6 +169,9 @@ def main():
     ap.add_argument("--redistribution-every", type=float, default=0,
                     help="wall: one redistribution every this many steps instead of the measured "
                          "rate (a settling wall detects rarely; a shaken one every few tens of steps)")
+    ap.add_argument("--redistribution-collectives", type=float, default=None,
+                    help="wall: blocking collectives per redistribution instead of the measured "
+                         "figure (e.g. a re-partition at every cycle: Zoltan's RIB adds ~60)")
     ap.add_argument("--gather-scaling", choices=["ranks", "model"], default="ranks",
                     help="how the bytes gathered at a redistribution grow: with the rank count "
                          "(O(P) numbers per rank, the code since the re-partition runs on each "
@@ -177,6 +181,8 @@ def main():
     m, mpi = measured(a.measured)
     if a.redistribution_every > 0:
         m["wall"]["redistributions_per_step"] = 1.0 / a.redistribution_every
+    if a.redistribution_collectives is not None:
+        m["wall"]["red_collectives"] = a.redistribution_collectives
 
     print("MEASURED here (1 rank; busiest of 4 ranks under the PMPI interposer):")
     for scene, x in m.items():
