@@ -256,6 +256,8 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
       << ", \"ghost_nodes_mean\": " << r.ghost_nodes_mean
       << ", \"neighbours_max\": " << r.neighbours_max
       << ", \"active_elements_max\": " << r.active_elements_max
+      << ", \"ghost_nodes_exchanged_max\": " << r.exchanged_ghosts_max
+      << ", \"ghost_nodes_exchanged_mean\": " << r.exchanged_ghosts_mean
       << ", \"incremental_redistributions\": " << r.incremental_redistributions
       << ", \"sent_elements\": " << r.sent_elements
       << ", \"dropped_elements\": " << r.dropped_elements << ", \"sent_bytes\": " << r.sent_bytes

@@ -47,6 +47,7 @@ struct RunReport {
   long redistributions = 0, rebalances = 0, migrated_elements = 0;
   long halo_elements_max = 0, ghost_nodes_max = 0, ghost_nodes_mean = 0, neighbours_max = 0;
   long active_elements_max = 0;  // tets a rank computes internal forces for (owned + halo)
+  long exchanged_ghosts_max = 0, exchanged_ghosts_mean = 0;  // ghost nodes the step exchanges
   // Migration (parallel/distribution.hpp, DistributionReport): incremental cycles, tet copies
   // sent and dropped and bytes of rows sent (all ranks, cycles after the first); re-partitioning
   // on measured cost: seconds of the cycles, predicted gains, declined re-partitions.

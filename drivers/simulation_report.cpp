@@ -84,6 +84,8 @@ RunReport Simulation::report() const {
     r.ghost_nodes_mean = d.ghost_nodes_sum / comm_->size();
     r.neighbours_max = d.neighbours_max;
     r.incremental_redistributions = d.incremental_cycles;
+    r.exchanged_ghosts_max = d.exchanged_ghosts_max;
+    r.exchanged_ghosts_mean = d.exchanged_ghosts_sum / comm_->size();
     r.sent_elements = d.sent_tets;
     r.dropped_elements = d.dropped_tets;
     r.sent_bytes = d.sent_bytes;

@@ -7,13 +7,16 @@
 // shares a node with an owned node, every contact partner such a tet can meet before the next
 // detection, and every joint between them; it computes the forces of the tets that touch a node it
 // owns (`TetArrays::active`), adds them in ascending gid, and so sums every owned node's force in
-// the order one rank does.  Only positions and velocities of ghost nodes travel each step.
+// the order one rank does.  Only positions and velocities of ghost nodes travel each step
+// (without contact, only of the ghosts the step reads).
 //
 // Redistribution happens at contact-detection cycles: the owned cost (tets, joints, contact
-// pairs) is compared across ranks, a weighted recursive coordinate bisection re-partitions when
-// the imbalance exceeds a threshold, and every owner sends each of its tets — with its nodes, the
+// pairs) is compared across ranks; Zoltan re-partitions when the imbalance exceeds a threshold and
+// the measured gain pays for it, and every owner sends each of its tets — with its nodes, the
 // joints whose first tet it is, the stages' records of its pairs and its contact state — to the new
-// owner and to every rank whose margin box it meets.
+// owner and to every rank whose margin box it meets.  A cycle without re-partition is incremental:
+// only the copies a rank does not hold yet travel, and copies no longer needed are dropped.  Every
+// exchange is neighbour-only (Communicator::exchange_sparse).
 #pragma once
 
 #include <cstdint>
@@ -56,6 +59,8 @@ struct DistributionReport {
   long halo_tets_min = 0, halo_tets_max = 0, halo_tets_sum = 0;
   long ghost_nodes_min = 0, ghost_nodes_max = 0, ghost_nodes_sum = 0;
   long neighbours_max = 0;  // ranks a rank exchanges ghosts with
+  // Ghost nodes the step's exchange brings (without contact only those the forces read).
+  long exchanged_ghosts_max = 0, exchanged_ghosts_sum = 0;
   // Migration traffic, summed over ranks and cycles after the first: tet copies sent (a tet
   // sent to its owner and two halo ranks counts 3), copies dropped by a rank that no longer
   // needs them, and the bytes of rows sent.  Incremental cycles (no re-partition) send only the
@@ -160,6 +165,10 @@ class Distribution {
   void assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
                 TravellingState& state);
   void build_exchange(const Model& model);
+  void start_exchange(std::vector<Neighbour>& plan, const NodeArrays& nodes);
+  void finish_exchange(const std::vector<Neighbour>& plan, NodeArrays& nodes);
+  // Blocking exchange of every ghost's position and velocity (when the step's is trimmed).
+  void refresh_all_ghosts(NodeArrays& nodes);
   // After a re-partition: the new owner of each node of an owned tet (the new owner of its first
   // tet), through a directory of tet owners keyed by gid.
   void update_node_owners(const Model& model);
@@ -191,7 +200,11 @@ class Distribution {
   GlobalId gid_offset_ = 0;  // Model::gid_offset: tet gids are gid_offset_ + 0..n_tets_−1
   // For each owned tet, the other ranks that hold a copy: (gid, rank), sorted.
   std::vector<std::pair<GlobalId, std::int32_t>> held_by_;
-  std::vector<Neighbour> neighbours_;
+  // The step's ghost exchange (without contact: only the ghosts the forces and the stable-step
+  // guard read, `trimmed_`), and every ghost (filled when trimmed), brought up to date before a
+  // redistribution.
+  std::vector<Neighbour> neighbours_, all_ghosts_;
+  bool trimmed_ = false;
   std::vector<MPI_Request> requests_;
   DistributionReport report_;
   struct Traffic {
