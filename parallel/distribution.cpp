@@ -495,9 +495,12 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(
   }
   double joint_gap = largest_joint_gap(model);
   if (!whole) {
-    comm_.min_in_place(origin);
+    // One max-reduction for the origin (as minus its minimum) and the widest joint gap, one sum.
+    std::vector<double> highest = {-origin[0], -origin[1], -origin[2], joint_gap};
+    comm_.max_in_place(highest);
+    for (int k = 0; k < 3; ++k) origin[k] = -highest[k];
+    joint_gap = highest[3];
     comm_.sum_in_place(sums);
-    joint_gap = comm_.max(joint_gap);
   }
   std::vector<double> reach = tet_reach(model, tet_boxes);
   if (start_reach)  // the distributed start: neighbours in other blocks count too
@@ -543,7 +546,10 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(
     // Each rank needs the claims on the cells its senders' grown boxes touch: the cell range of
     // every rank (O(P) numbers) says where to send each claim, so no rank receives the claims of
     // the whole domain.
-    std::vector<std::int64_t> range(6, 0);  // first xyz, last xyz (last < first: sends nothing)
+    struct CellRange {
+      std::int64_t r[6];  // first xyz, last xyz (last < first: sends nothing)
+    };
+    CellRange range{};
     double box[6] = {
         std::numeric_limits<double>::infinity(),  std::numeric_limits<double>::infinity(),
         std::numeric_limits<double>::infinity(),  -std::numeric_limits<double>::infinity(),
@@ -558,14 +564,14 @@ std::vector<std::vector<LocalIndex>> Distribution::destinations(
       }
     }
     if (any)
-      grid.cell_range(box, grow, range.data());
+      grid.cell_range(box, grow, range.r);
     else
-      range = {0, 0, 0, -1, -1, -1};
-    const std::vector<std::int64_t> ranges = comm_.allgatherv(range);
+      range = {{0, 0, 0, -1, -1, -1}};
+    const std::vector<CellRange> ranges = comm_.allgather(range);
     std::vector<std::vector<CellClaim>> outbox(static_cast<std::size_t>(ranks));
     for (const CellClaim& c : claims)
       for (int p = 0; p < ranks; ++p) {
-        const std::int64_t* r = &ranges[6 * static_cast<std::size_t>(p)];
+        const std::int64_t* r = ranges[static_cast<std::size_t>(p)].r;
         bool inside = true;
         for (int k = 0; k < 3; ++k) inside = inside && c.cell[k] >= r[k] && c.cell[k] <= r[3 + k];
         if (inside) outbox[static_cast<std::size_t>(p)].push_back(c);
@@ -913,17 +919,18 @@ void Distribution::update_report(const Model& model, bool count_traffic) {
   const long neighbours = static_cast<long>(neighbours_.size());
   long exchanged = 0;  // ghosts the step's exchange brings
   for (const Neighbour& nb : neighbours_) exchanged += static_cast<long>(nb.receive.size());
-  std::vector<std::int64_t> low = {owned, halo, ghosts},
-                            high = {owned, halo, ghosts, neighbours, exchanged},
+  // Minima as maxima of the negated values: one max-reduction and one sum.
+  std::vector<std::int64_t> high = {owned,     halo,   ghosts, neighbours,
+                                    exchanged, -owned, -halo,  -ghosts},
                             sum = {halo,
                                    ghosts,
                                    cycle_traffic_.sent_tets,
                                    cycle_traffic_.dropped_tets,
                                    cycle_traffic_.sent_bytes,
                                    exchanged};
-  comm_.min_in_place(low);
   comm_.max_in_place(high);
   comm_.sum_in_place(sum);
+  const std::int64_t low[3] = {-high[5], -high[6], -high[7]};
   report_.owned_tets_min = low[0];
   report_.owned_tets_max = high[0];
   report_.halo_tets_min = low[1];
