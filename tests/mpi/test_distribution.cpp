@@ -206,3 +206,43 @@ TEST_CASE("distribution invariants hold after re-partitions at random", "[mpi][d
   }
   if (comm.size() > 1) CHECK(d.report().rebalances == 2);
 }
+
+TEST_CASE(
+    "re-partition on measured cost: only when the busiest rank's excess pays for the last one",
+    "[mpi][distribution]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const Model global = slab_and_post();
+  DistributionSettings settings;
+  settings.rebalance_threshold = 0.0;  // the weights always call for a re-partition
+  TravellingState whole, state;
+  whole.x_at_detection = global.nodes.x;
+  Model local;
+  Distribution d(comm, settings, global, whole, 0.02, {}, local, state);
+  // Busy seconds since the last cycle: even, then rank 0 far busier (100 s against 1 s: far more
+  // than any re-partition of this model costs), then even again.
+  const double busy[4] = {1.0, 1.0, comm.rank() == 0 ? 100.0 : 1.0, 1.0};
+  long rebalances[4], declined[4];
+  for (int cycle = 0; cycle < 4; ++cycle) {
+    state.x_at_detection = local.nodes.x;
+    d.redistribute(local, state, {}, busy[cycle]);
+    rebalances[cycle] = d.report().rebalances;
+    declined[cycle] = d.report().repartitions_declined;
+  }
+  const DistributionReport& r = d.report();
+  if (comm.size() == 1) {  // nothing to re-partition
+    CHECK(r.rebalances == 0);
+    return;
+  }
+  CHECK(rebalances[0] == 1);  // the first goes ahead: no re-partition was timed yet
+  CHECK(declined[1] == 1);    // even load: no gain
+  CHECK(rebalances[1] == 1);
+  CHECK(rebalances[2] == 2);  // 99 s over the mean on rank 0 pays for it
+  CHECK(declined[2] == 1);
+  CHECK(declined[3] == 2);
+  CHECK(r.last_repartition_seconds > 0.0);
+  CHECK(r.last_repartition_seconds < 1.0);
+  CHECK(r.predicted_gain_seconds > 40.0);  // cycle 2: 100 − mean of (100, 1, …)
+  CHECK(r.measured_imbalance == Approx(1.0));
+  CHECK(r.incremental_cycles == 2);
+}
