@@ -285,12 +285,18 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   for (int p = 0; p < comm_.size(); ++p)
     if (p != comm_.rank()) cycle_traffic_.sent_tets += static_cast<long>(lists[p].size());
   cycle_traffic_.sent_bytes = static_cast<long>(send.size());
+  move_rows(model, state, send, send_counts, own, out, out_state);
+}
+
+void Distribution::move_rows(Model& source, TravellingState& source_state, std::vector<char>& send,
+                             const std::vector<std::size_t>& send_counts, std::vector<char>& own,
+                             Model& out, TravellingState& out_state) {
   // The rows hold everything that travels: the source arrays can go before the new ones come.
-  model.nodes = NodeArrays{};
-  model.tets = TetArrays{};
-  model.joints = JointArrays{};
-  model.tet_force_order = {};
-  state = TravellingState{};
+  source.nodes = NodeArrays{};
+  source.tets = TetArrays{};
+  source.joints = JointArrays{};
+  source.tet_force_order = {};
+  source_state = TravellingState{};
   std::vector<char> receive = exchange_rows(send, send_counts);
   assemble({&receive, &own}, out, out_state);
   build_exchange(out);
@@ -349,14 +355,7 @@ void Distribution::migrate_incremental(Model& model, TravellingState& state) {
   }
   cycle_traffic_.sent_bytes = static_cast<long>(send.size());
   packer.pack(kept, own);  // this rank's rows, rebuilt in place: no copy through MPI
-  model.nodes = NodeArrays{};
-  model.tets = TetArrays{};
-  model.joints = JointArrays{};
-  model.tet_force_order = {};
-  state = TravellingState{};
-  std::vector<char> receive = exchange_rows(send, send_counts);
-  assemble({&receive, &own}, model, state);
-  build_exchange(model);
+  move_rows(model, state, send, send_counts, own, model, state);
 }
 
 void Distribution::record_holders(const Model& model) {

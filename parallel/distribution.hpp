@@ -158,6 +158,11 @@ class Distribution {
   // the ranks that no longer need one to drop it; each rank rebuilds from what it kept and what
   // arrived.  Bytes on the wire ∝ the tets that entered or left a halo.
   void migrate_incremental(Model& model, TravellingState& state);
+  // Frees `source`'s mesh arrays and `source_state` (the rows hold what travels), sends the rows,
+  // and builds `out` (which may be `source`) from what arrived and this rank's `own` rows.
+  void move_rows(Model& source, TravellingState& source_state, std::vector<char>& send,
+                 const std::vector<std::size_t>& send_counts, std::vector<char>& own, Model& out,
+                 TravellingState& out_state);
   // After a full migration: every rank tells the owners of the tets it holds (not owned) that it
   // holds them, so that the next incremental cycle knows where copies are.
   void record_holders(const Model& model);

@@ -39,10 +39,8 @@ BodySpec body(const std::string& name) {
   return b;
 }
 
-}  // namespace
-
-TEST_CASE("friction history keyed by global ids above 2^32 survives re-detection",
-          "[contact][stage]") {
+// A block resting on a base, both one cell of stone with friction coefficient `friction`.
+Model block_on_base(double friction) {
   Scene scene;
   scene.source_path = "test";
   MaterialSpec stone;
@@ -50,11 +48,18 @@ TEST_CASE("friction history keyed by global ids above 2^32 survives re-detection
   stone.density = 2500;
   stone.elastic.young = 1e8;
   stone.elastic.poisson = 0.2;
-  stone.contact.friction = 0.6;
+  stone.contact.friction = friction;
   scene.materials.push_back(stone);
   scene.bodies = {body("base"), body("block")};
-  Model model = build_model(scene, {cell(Vec3(0, 0, 0), Vec3(1, 1, 0.2)),
-                                    cell(Vec3(0.2, 0.2, 0.199), Vec3(0.7, 0.7, 0.5))});
+  return build_model(scene, {cell(Vec3(0, 0, 0), Vec3(1, 1, 0.2)),
+                             cell(Vec3(0.2, 0.2, 0.199), Vec3(0.7, 0.7, 0.5))});
+}
+
+}  // namespace
+
+TEST_CASE("friction history keyed by global ids above 2^32 survives re-detection",
+          "[contact][stage]") {
+  Model model = block_on_base(0.6);
   const GlobalId offset = GlobalId{1} << 33;  // ids above 2^32, low 32 bits equal to the old ones
   for (GlobalId& g : model.tets.gid) g += offset;
   for (GlobalId& g : model.nodes.gid) g += offset;
@@ -105,17 +110,7 @@ TEST_CASE("friction entries travel as pair records and come back bit for bit", "
 
 TEST_CASE("a bonded pair never pairs, and pairs again at the detection after its bond is released",
           "[contact][stage]") {
-  Scene scene;
-  scene.source_path = "test";
-  MaterialSpec stone;
-  stone.name = "stone";
-  stone.density = 2500;
-  stone.elastic.young = 1e8;
-  stone.elastic.poisson = 0.2;
-  scene.materials.push_back(stone);
-  scene.bodies = {body("base"), body("block")};
-  const Model model = build_model(scene, {cell(Vec3(0, 0, 0), Vec3(1, 1, 0.2)),
-                                          cell(Vec3(0.2, 0.2, 0.199), Vec3(0.7, 0.7, 0.5))});
+  const Model model = block_on_base(0.0);
   const auto pairs_of = [](const ContactStage& stage) {
     std::vector<std::pair<LocalIndex, LocalIndex>> out;
     for (const CandidatePair& p : stage.candidates()) out.emplace_back(p.a, p.b);

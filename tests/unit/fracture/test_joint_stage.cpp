@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "../core/one_body_scene.hpp"
 #include "core/model_builder.hpp"
 #include "fracture/joint_stage.hpp"
 
@@ -36,13 +37,9 @@ namespace {
 
 // A jointed column of two Kuhn cells (12 tets, z from 0 to 2 m, joints on every inner face).
 Model jointed_column() {
-  Scene scene;
-  scene.source_path = "test";
-  MaterialSpec rock;
-  rock.name = "rock";
-  rock.density = 2500;
+  Scene scene = test::one_rock_body("column");
+  MaterialSpec& rock = scene.materials[0];
   rock.elastic.young = 1e9;
-  rock.elastic.poisson = 0.2;
   FractureSpec f;
   f.tensile_strength = 1e6;
   f.cohesion = 2e6;
@@ -50,12 +47,7 @@ Model jointed_column() {
   f.energy_I = 40.0;  // J/m²: above what the penalty stores before the peak (10 J/m² at h = 1 m)
   f.energy_II = 200.0;  // J/m²: above the snap-back limit of 1 m joints (63 J/m²)
   rock.fracture = f;
-  scene.materials.push_back(rock);
-  BodySpec body;
-  body.name = "column";
-  body.material = 0;
-  body.joints = JointPlacement::all;
-  scene.bodies.push_back(body);
+  scene.bodies[0].joints = JointPlacement::all;
   BodyMesh mesh;
   mesh.source = "test";
   for (int k = 0; k < 3; ++k)  // node (i, j, k) = i + 2 j + 4 k
