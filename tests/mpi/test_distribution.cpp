@@ -246,3 +246,50 @@ TEST_CASE(
   CHECK(r.measured_imbalance == Approx(1.0));
   CHECK(r.incremental_cycles == 2);
 }
+
+TEST_CASE(
+    "without contact the step's exchange brings every ghost the forces read, a redistribution "
+    "every ghost",
+    "[mpi][distribution]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const Model global = slab_and_post();
+  TravellingState whole, state;
+  whole.x_at_detection = global.nodes.x;
+  Model local;
+  Distribution d(comm, DistributionSettings{}, global, whole, 0.0, {}, local, state);
+  NodeArrays& nodes = local.nodes;
+  const auto value = [](GlobalId gid, int k) { return 10.0 + 0.25 * static_cast<double>(gid) + k; };
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n)  // the owners move their nodes; ghosts lag
+    for (int k = 0; k < 3; ++k) nodes.x[3 * n + k] = value(nodes.gid[n], k);
+  d.start_halo_exchange(nodes);
+  d.finish_halo_exchange(nodes);
+  // Every node of every tet that touches a node of an owned tet is current.
+  std::vector<std::uint8_t> of_owned(static_cast<std::size_t>(nodes.size()), 0);
+  const TetArrays& tets = local.tets;
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (tets.is_owned(t))
+      for (int c = 0; c < 4; ++c) of_owned[tets.nodes[4 * t + c]] = 1;
+  long stale_read = 0, stale_other = 0;
+  for (LocalIndex t = 0; t < tets.size(); ++t) {
+    bool read = false;
+    for (int c = 0; c < 4; ++c) read = read || of_owned[tets.nodes[4 * t + c]];
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = tets.nodes[4 * t + c];
+      if (nodes.x[3 * n] != value(nodes.gid[n], 0)) (read ? stale_read : stale_other) += 1;
+    }
+  }
+  CHECK(stale_read == 0);
+  const DistributionReport& r = d.report();
+  if (comm.size() > 1) {
+    CHECK(r.exchanged_ghosts_sum < r.ghost_nodes_sum);  // the halo holds more than the step reads
+    CHECK(comm.sum(static_cast<std::int64_t>(stale_other)) > 0);
+  }
+  // A redistribution decides from every held tet: every ghost is brought up to date first.
+  state.x_at_detection = nodes.x;
+  d.redistribute(local, state, {}, 0.0);
+  long stale = 0;
+  for (LocalIndex n = 0; n < local.nodes.size(); ++n)
+    for (int k = 0; k < 3; ++k) stale += local.nodes.x[3 * n + k] != value(local.nodes.gid[n], k);
+  CHECK(stale == 0);
+}
