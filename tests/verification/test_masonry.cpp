@@ -1,8 +1,9 @@
 // Masonry closed-form checks on generated scenes: a block on a tilting table slides at tanθ = μ or
 // topples at tanθ = b/h (docs/references.md 6 idea), a slender block on a moving base lifts off at
 // a = g·b/h (docs/references.md 13, Housner), the dry-joint shear of a generated wall course
-// (docs/references.md 12), and a dry running-bond wall with exactly touching units standing under
-// gravity.
+// (docs/references.md 12), a dry running-bond wall with exactly touching units standing under
+// gravity, and a block slipping on a table under a rectangular acceleration pulse
+// (docs/references.md 18, Newmark).
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
