@@ -245,6 +245,7 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
   if (r.fragments >= 0) j << "  \"fragments\": " << r.fragments << ",\n";
   j << "  \"gids\": {\"offset\": " << r.gid_offset << ", \"node_max\": " << r.node_gid_max
     << ", \"tet_max\": " << r.tet_gid_max << ", \"joint_max\": " << r.joint_gid_max << "},\n";
+  const MigrationReport& m = r.migration;
   if (r.parallel)
     j << "  \"decomposition\": {\"start\": \"" << r.start
       << "\", \"imbalance\": " << JsonNumber{r.imbalance}
@@ -258,14 +259,14 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
       << ", \"active_elements_max\": " << r.active_elements_max
       << ", \"ghost_nodes_exchanged_max\": " << r.exchanged_ghosts_max
       << ", \"ghost_nodes_exchanged_mean\": " << r.exchanged_ghosts_mean
-      << ", \"incremental_redistributions\": " << r.incremental_redistributions
-      << ", \"sent_elements\": " << r.sent_elements
-      << ", \"dropped_elements\": " << r.dropped_elements << ", \"sent_bytes\": " << r.sent_bytes
-      << ", \"measured_imbalance\": " << JsonNumber{r.measured_imbalance}
-      << ", \"repartition_seconds\": " << JsonNumber{r.repartition_seconds}
-      << ", \"incremental_seconds\": " << JsonNumber{r.incremental_seconds}
-      << ", \"predicted_gain_seconds\": " << JsonNumber{r.predicted_gain_seconds}
-      << ", \"repartitions_declined\": " << r.repartitions_declined
+      << ", \"incremental_redistributions\": " << m.incremental_cycles
+      << ", \"sent_elements\": " << m.sent_tets << ", \"dropped_elements\": " << m.dropped_tets
+      << ", \"sent_bytes\": " << m.sent_bytes
+      << ", \"measured_imbalance\": " << JsonNumber{m.measured_imbalance}
+      << ", \"repartition_seconds\": " << JsonNumber{m.repartition_seconds}
+      << ", \"incremental_seconds\": " << JsonNumber{m.incremental_seconds}
+      << ", \"predicted_gain_seconds\": " << JsonNumber{m.predicted_gain_seconds}
+      << ", \"repartitions_declined\": " << m.repartitions_declined
       << ", \"communication_seconds\": " << JsonNumber{r.communication_seconds} << "},\n";
   j << "  \"memory\": {\"startup_peak_rss_kib_max\": " << r.startup_peak_rss_kib_max
     << ", \"startup_peak_rss_kib_mean\": " << r.startup_peak_rss_kib_mean

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/energy.hpp"
+#include "core/migration_report.hpp"
 #include "drivers/stage_timer.hpp"
 
 namespace fdem {
@@ -48,14 +49,7 @@ struct RunReport {
   long halo_elements_max = 0, ghost_nodes_max = 0, ghost_nodes_mean = 0, neighbours_max = 0;
   long active_elements_max = 0;  // tets a rank computes internal forces for (owned + halo)
   long exchanged_ghosts_max = 0, exchanged_ghosts_mean = 0;  // ghost nodes the step exchanges
-  // Migration (parallel/distribution.hpp, DistributionReport): incremental cycles, tet copies
-  // sent and dropped and bytes of rows sent (all ranks, cycles after the first); re-partitioning
-  // on measured cost: seconds of the cycles, predicted gains, declined re-partitions.
-  long incremental_redistributions = 0, sent_elements = 0, dropped_elements = 0;
-  long sent_bytes = 0;
-  double measured_imbalance = 1.0, repartition_seconds = 0.0, incremental_seconds = 0.0;
-  double predicted_gain_seconds = 0.0;
-  long repartitions_declined = 0;
+  MigrationReport migration;           // tet copies moved, re-partitions on measured cost
   double communication_seconds = 0.0;  // halo exchange + redistribution + reductions (rank 0)
   // Peak resident set size per rank (KiB, largest and mean over ranks): start-up (scene, model,
   // distribution) and the step loop after it (counted afresh once start-up memory is freed).

@@ -83,17 +83,9 @@ RunReport Simulation::report() const {
     r.ghost_nodes_max = d.ghost_nodes_max;
     r.ghost_nodes_mean = d.ghost_nodes_sum / comm_->size();
     r.neighbours_max = d.neighbours_max;
-    r.incremental_redistributions = d.incremental_cycles;
     r.exchanged_ghosts_max = d.exchanged_ghosts_max;
     r.exchanged_ghosts_mean = d.exchanged_ghosts_sum / comm_->size();
-    r.sent_elements = d.sent_tets;
-    r.dropped_elements = d.dropped_tets;
-    r.sent_bytes = d.sent_bytes;
-    r.measured_imbalance = d.measured_imbalance;
-    r.repartition_seconds = d.repartition_seconds;
-    r.incremental_seconds = d.incremental_seconds;
-    r.predicted_gain_seconds = d.predicted_gain_seconds;
-    r.repartitions_declined = d.repartitions_declined;
+    r.migration = d.migration;
     r.active_elements_max = comm_->max(static_cast<std::int64_t>(model_.tet_force_order.size()));
     r.communication_seconds =
         clocks_[halo].seconds + clocks_[migration].seconds + reduction_seconds_;

@@ -394,18 +394,14 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   const std::vector<RankLoad> loads =
       comm_.allgather(RankLoad{my_cost, busy_seconds, last_cycle_seconds_});
   std::vector<double> rank_cost(loads.size());
-  double busy_max = 0.0, busy_sum = 0.0;
+  double busy_max = 0.0, busy_sum = 0.0, slowest_last_cycle = 0.0;
   for (std::size_t r = 0; r < loads.size(); ++r) {
     rank_cost[r] = loads[r].cost;
     busy_max = std::max(busy_max, loads[r].busy);
     busy_sum += loads[r].busy;
+    slowest_last_cycle = std::max(slowest_last_cycle, loads[r].last_cycle);
   }
-  account_last_cycle(
-      loads.empty()
-          ? 0.0
-          : std::max_element(loads.begin(), loads.end(), [](const RankLoad& a, const RankLoad& b) {
-              return a.last_cycle < b.last_cycle;
-            })->last_cycle);
+  account_last_cycle(slowest_last_cycle);
   const double total = std::accumulate(rank_cost.begin(), rank_cost.end(), 0.0);
   const double mean = total / ranks;
   const double before =
@@ -414,7 +410,7 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   report_.max_imbalance = std::max(report_.max_imbalance, before);
   report_.imbalance = before;
   const double busy_mean = busy_sum / ranks;
-  report_.measured_imbalance = busy_mean > 0.0 ? busy_max / busy_mean : 1.0;
+  report_.migration.measured_imbalance = busy_mean > 0.0 ? busy_max / busy_mean : 1.0;
 
   // Re-partition when the weights say the load is uneven — and, once a re-partition has been
   // timed, only when what it would save over the next interval (the busiest rank's time above
@@ -423,11 +419,11 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   bool repartition = ranks > 1 && before > settings_.rebalance_threshold;
   const double gain = busy_max - busy_mean;
   if (repartition && settings_.measured_repartition && !settings_.random_parts &&
-      report_.last_repartition_seconds >= 0.0) {
-    repartition = gain > report_.last_repartition_seconds;
-    if (!repartition) ++report_.repartitions_declined;
+      report_.migration.last_repartition_seconds >= 0.0) {
+    repartition = gain > report_.migration.last_repartition_seconds;
+    if (!repartition) ++report_.migration.repartitions_declined;
   }
-  if (repartition) report_.predicted_gain_seconds += gain;
+  if (repartition) report_.migration.predicted_gain_seconds += gain;
 
   long migrated = 0;
   const long rebalances_before = report_.rebalances;
@@ -471,7 +467,7 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     if (settings_.incremental) record_holders(model);
   } else {
     migrate_incremental(model, state);
-    ++report_.incremental_cycles;
+    ++report_.migration.incremental_cycles;
   }
   ++report_.cycles;
   update_report(model, true);
@@ -483,10 +479,10 @@ void Distribution::redistribute(Model& model, TravellingState& state,
 void Distribution::account_last_cycle(double seconds) {
   if (last_cycle_seconds_ < 0.0) return;  // no cycle since the start, or accounted already
   if (last_cycle_repartitioned_) {
-    report_.last_repartition_seconds = seconds;
-    report_.repartition_seconds += seconds;
+    report_.migration.last_repartition_seconds = seconds;
+    report_.migration.repartition_seconds += seconds;
   } else {
-    report_.incremental_seconds += seconds;
+    report_.migration.incremental_seconds += seconds;
   }
   last_cycle_seconds_ = -1.0;
 }
@@ -581,9 +577,9 @@ void Distribution::update_report(const Model& model, bool count_traffic) {
     report_.last_sent_tets = sum[2];
     report_.last_dropped_tets = sum[3];
     report_.last_sent_bytes = sum[4];
-    report_.sent_tets += sum[2];
-    report_.dropped_tets += sum[3];
-    report_.sent_bytes += sum[4];
+    report_.migration.sent_tets += sum[2];
+    report_.migration.dropped_tets += sum[3];
+    report_.migration.sent_bytes += sum[4];
   }
   cycle_traffic_ = {};
 }

@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/migration_report.hpp"
 #include "core/model.hpp"
 #include "core/travelling_state.hpp"
 #include "parallel/communicator.hpp"
@@ -61,23 +62,8 @@ struct DistributionReport {
   long neighbours_max = 0;  // ranks a rank exchanges ghosts with
   // Ghost nodes the step's exchange brings (without contact only those the forces read).
   long exchanged_ghosts_max = 0, exchanged_ghosts_sum = 0;
-  // Migration traffic, summed over ranks and cycles after the first: tet copies sent (a tet
-  // sent to its owner and two halo ranks counts 3), copies dropped by a rank that no longer
-  // needs them, and the bytes of rows sent.  Incremental cycles (no re-partition) send only the
-  // copies a rank does not hold yet.
-  long incremental_cycles = 0;
-  long sent_tets = 0, dropped_tets = 0;
-  long sent_bytes = 0;
+  MigrationReport migration;  // traffic and measured cost, summed over the cycles
   long last_sent_tets = 0, last_dropped_tets = 0, last_sent_bytes = 0;  // of the last cycle
-  // Re-partitioning on measured cost: the busiest rank's busy seconds over the mean at the last
-  // cycle; seconds of the cycles (the slowest rank's), re-partitioning and incremental; the
-  // last re-partition's (−1: none timed yet); the predicted gains of the re-partitions made; the
-  // cycles whose weights called for a re-partition that the measured gain did not justify.
-  double measured_imbalance = 1.0;
-  double repartition_seconds = 0.0, incremental_seconds = 0.0;
-  double last_repartition_seconds = -1.0;
-  double predicted_gain_seconds = 0.0;
-  long repartitions_declined = 0;
 };
 
 class Distribution {

@@ -175,8 +175,8 @@ TEST_CASE("distribution invariants: tets owned once, neighbours held, ghost owne
     CHECK(local_bytes(a_model) == local_bytes(b_model));
     CHECK(incremental.report().rebalances == 0);  // the weights stay balanced: no re-partition
   }
-  const DistributionReport& inc = incremental.report();
-  const DistributionReport& ref = full.report();
+  const MigrationReport& inc = incremental.report().migration;
+  const MigrationReport& ref = full.report().migration;
   CHECK(inc.incremental_cycles == 3);
   CHECK(ref.incremental_cycles == 0);
   if (comm.size() > 1) {
@@ -227,7 +227,7 @@ TEST_CASE(
     state.x_at_detection = local.nodes.x;
     d.redistribute(local, state, {}, busy[cycle]);
     rebalances[cycle] = d.report().rebalances;
-    declined[cycle] = d.report().repartitions_declined;
+    declined[cycle] = d.report().migration.repartitions_declined;
   }
   const DistributionReport& r = d.report();
   if (comm.size() == 1) {  // nothing to re-partition
@@ -240,11 +240,12 @@ TEST_CASE(
   CHECK(rebalances[2] == 2);  // 99 s over the mean on rank 0 pays for it
   CHECK(declined[2] == 1);
   CHECK(declined[3] == 2);
-  CHECK(r.last_repartition_seconds > 0.0);
-  CHECK(r.last_repartition_seconds < 1.0);
-  CHECK(r.predicted_gain_seconds > 40.0);  // cycle 2: 100 − mean of (100, 1, …)
-  CHECK(r.measured_imbalance == Approx(1.0));
-  CHECK(r.incremental_cycles == 2);
+  const MigrationReport& m = r.migration;
+  CHECK(m.last_repartition_seconds > 0.0);
+  CHECK(m.last_repartition_seconds < 1.0);
+  CHECK(m.predicted_gain_seconds > 40.0);  // cycle 2: 100 − mean of (100, 1, …)
+  CHECK(m.measured_imbalance == Approx(1.0));
+  CHECK(m.incremental_cycles == 2);
 }
 
 TEST_CASE(

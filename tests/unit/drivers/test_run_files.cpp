@@ -170,6 +170,13 @@ TEST_CASE("summary_json of an N-rank run reports the decomposition", "[cli]") {
   r.neighbours_max = 1;
   r.active_elements_max = 150;
   r.communication_seconds = 0.5;
+  r.exchanged_ghosts_max = 40;
+  r.migration.incremental_cycles = 11;
+  r.migration.sent_tets = 900;
+  r.migration.sent_bytes = 198000;
+  r.migration.repartition_seconds = 0.25;
+  r.migration.predicted_gain_seconds = 1.5;
+  r.migration.repartitions_declined = 4;
   r.joints = 10;
   r.broken_joints = 3;
   r.broken_by_mode[0] = 2;
@@ -193,6 +200,13 @@ TEST_CASE("summary_json of an N-rank run reports the decomposition", "[cli]") {
   CHECK(d["neighbours_max"].num() == 1);
   CHECK(d["active_elements_max"].num() == 150);
   CHECK(d["communication_seconds"].num() == 0.5);
+  CHECK(d["ghost_nodes_exchanged_max"].num() == 40);
+  CHECK(d["incremental_redistributions"].num() == 11);
+  CHECK(d["sent_elements"].num() == 900);
+  CHECK(d["sent_bytes"].num() == 198000);
+  CHECK(d["repartition_seconds"].num() == 0.25);
+  CHECK(d["predicted_gain_seconds"].num() == 1.5);
+  CHECK(d["repartitions_declined"].num() == 4);
 }
 
 TEST_CASE("summary_json of a failed run is valid JSON with the reason", "[cli]") {
