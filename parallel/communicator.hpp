@@ -323,16 +323,34 @@ std::vector<T> Communicator::allgather(const T& value) const {
   return all;
 }
 
+namespace detail {
+// The outboxes one after the other (grouped by destination rank), with each one's length.
+template <class T>
+std::vector<T> grouped(const std::vector<std::vector<T>>& outbox,
+                       std::vector<std::size_t>& counts) {
+  counts.resize(outbox.size());
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < outbox.size(); ++r) total += counts[r] = outbox[r].size();
+  std::vector<T> send;
+  send.reserve(total);
+  for (const auto& box : outbox) send.insert(send.end(), box.begin(), box.end());
+  return send;
+}
+// The source rank of each received element: rows[r] elements came from rank r, in rank order.
+inline void fill_sources(const std::vector<std::int64_t>& rows, std::vector<int>* sources) {
+  if (!sources) return;
+  sources->clear();
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    sources->insert(sources->end(), static_cast<std::size_t>(rows[r]), static_cast<int>(r));
+}
+}  // namespace detail
+
 template <class T>
 std::vector<T> Communicator::exchange(const std::vector<std::vector<T>>& outbox,
                                       std::vector<int>* sources) const {
   FDEM_VERIFY(static_cast<int>(outbox.size()) == size_, "one outbox per rank");
-  std::vector<std::size_t> counts(static_cast<std::size_t>(size_));
-  std::size_t total = 0;
-  for (int r = 0; r < size_; ++r) total += counts[r] = outbox[r].size();
-  std::vector<T> send;
-  send.reserve(total);
-  for (const auto& box : outbox) send.insert(send.end(), box.begin(), box.end());
+  std::vector<std::size_t> counts;
+  const std::vector<T> send = detail::grouped(outbox, counts);
   return exchange_grouped(send, counts, sources);
 }
 
@@ -341,24 +359,15 @@ std::vector<T> Communicator::exchange_sparse(const std::vector<std::vector<T>>& 
                                              std::vector<int>* sources) const {
   static_assert(std::is_trivially_copyable_v<T>, "exchange moves plain values only");
   FDEM_VERIFY(static_cast<int>(outbox.size()) == size_, "one outbox per rank");
-  std::vector<std::int64_t> send_rows(static_cast<std::size_t>(size_), 0);
-  std::size_t total = 0;
-  for (int r = 0; r < size_; ++r)
-    total += static_cast<std::size_t>(send_rows[r] = outbox[r].size());
-  std::vector<T> send;
-  send.reserve(total);
-  for (const auto& box : outbox) send.insert(send.end(), box.begin(), box.end());
+  std::vector<std::size_t> counts;
+  const std::vector<T> send = detail::grouped(outbox, counts);
   std::vector<std::int64_t> receive_rows;
   const std::vector<char> bytes =
-      exchange_rows_sparse(send.data(), send_rows, sizeof(T), receive_rows);
+      exchange_rows_sparse(send.data(), std::vector<std::int64_t>(counts.begin(), counts.end()),
+                           sizeof(T), receive_rows);
   std::vector<T> received(bytes.size() / sizeof(T));
   if (!bytes.empty()) std::memcpy(received.data(), bytes.data(), bytes.size());
-  if (sources) {
-    sources->clear();
-    sources->reserve(received.size());
-    for (int r = 0; r < size_; ++r)
-      sources->insert(sources->end(), static_cast<std::size_t>(receive_rows[r]), r);
-  }
+  detail::fill_sources(receive_rows, sources);
   return received;
 }
 
@@ -377,12 +386,7 @@ std::vector<T> Communicator::exchange_grouped(const std::vector<T>& grouped,
   for (std::int64_t c : receive_rows) total += static_cast<std::size_t>(c);
   std::vector<T> received(total);
   exchange_rows(grouped.data(), send_rows, received.data(), receive_rows, sizeof(T));
-  if (sources) {
-    sources->clear();
-    sources->reserve(total);
-    for (int r = 0; r < size_; ++r)
-      sources->insert(sources->end(), static_cast<std::size_t>(receive_rows[r]), r);
-  }
+  detail::fill_sources(receive_rows, sources);
   return received;
 }
 

@@ -132,10 +132,13 @@ class Distribution {
   void append_halo(Model& model, TravellingState& state, const std::vector<double>* start_reach);
   // Packs lists[p] for the other ranks into `send` (counts in 8-byte words) and lists[me] into
   // `own` when given; exchange_rows sends them (freeing `send`) and returns what arrived.
-  void pack_rows(const Model& model, const TravellingState& state,
+  // Returns the tet copies packed for other ranks.  `both_sides`: each tet carries every joint
+  // of which it is a side (RowPacker).
+  long pack_rows(const Model& model, const TravellingState& state,
                  const std::vector<std::vector<LocalIndex>>& lists, std::vector<char>& send,
                  std::vector<std::size_t>& send_counts, std::vector<char>* own,
-                 const std::vector<StartJoint>* start_joints = nullptr) const;
+                 const std::vector<StartJoint>* start_joints = nullptr,
+                 bool both_sides = false) const;
   std::vector<char> exchange_rows(std::vector<char>& send,
                                   const std::vector<std::size_t>& send_counts) const;
   // A cycle without re-partition: owners and active tets stay, so every copy a rank holds is

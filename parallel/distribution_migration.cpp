@@ -16,16 +16,28 @@ namespace fdem {
 
 using namespace distribution_rows;
 
+namespace {
+
+// Boxes span the positions at the last detection too (when the state has them): a rank repeats
+// that detection after a migration (rebind), however far the nodes went since.
+const std::vector<double>* detection_positions(const Model& model, const TravellingState& state) {
+  return state.x_at_detection.size() == model.nodes.x.size() ? &state.x_at_detection : nullptr;
+}
+
+}  // namespace
+
 // Packs lists[p] for every other rank p into `send` (grouped by rank; counts in 8-byte words),
-// and lists[me] into `own` when given.
-void Distribution::pack_rows(const Model& model, const TravellingState& state,
+// and lists[me] into `own` when given.  Returns the tet copies packed for other ranks.
+long Distribution::pack_rows(const Model& model, const TravellingState& state,
                              const std::vector<std::vector<LocalIndex>>& lists,
                              std::vector<char>& send, std::vector<std::size_t>& send_counts,
-                             std::vector<char>* own,
-                             const std::vector<StartJoint>* start_joints) const {
+                             std::vector<char>* own, const std::vector<StartJoint>* start_joints,
+                             bool both_sides) const {
   const int ranks = comm_.size(), me = comm_.rank();
   send_counts.assign(static_cast<std::size_t>(ranks), 0);
-  RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_, start_joints);
+  RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_, start_joints,
+                   both_sides);
+  long copies = 0;
   for (int p = 0; p < ranks; ++p) {
     if (lists[p].empty()) continue;
     if (p == me) {
@@ -35,7 +47,9 @@ void Distribution::pack_rows(const Model& model, const TravellingState& state,
     const std::size_t before = send.size();
     packer.pack(lists[p], send);
     send_counts[p] = (send.size() - before) / 8;  // in 8-byte words: every row is a multiple
+    copies += static_cast<long>(lists[p].size());
   }
+  return copies;
 }
 
 // Sends the packed rows (freeing `send`) and returns what the other ranks sent here.
@@ -55,25 +69,20 @@ std::vector<char> Distribution::exchange_rows(std::vector<char>& send,
 void Distribution::migrate(Model& model, TravellingState& state, Model& out,
                            TravellingState& out_state, const std::vector<StartJoint>* start_joints,
                            const std::vector<double>* start_reach) {
-  // Boxes span the positions at the last detection too: a rank repeats that detection after the
-  // migration (rebind), however far the nodes went since.
-  const std::vector<double>* also =
-      state.x_at_detection.size() == model.nodes.x.size() ? &state.x_at_detection : nullptr;
-  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false, start_reach, also);
+  const std::vector<std::vector<LocalIndex>> lists =
+      destinations(model, false, start_reach, detection_positions(model, state));
   // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
   std::vector<char> send, own;
   std::vector<std::size_t> send_counts;
-  pack_rows(model, state, lists, send, send_counts, &own, start_joints);
   cycle_traffic_ = {};
-  for (int p = 0; p < comm_.size(); ++p)
-    if (p != comm_.rank()) cycle_traffic_.sent_tets += static_cast<long>(lists[p].size());
-  cycle_traffic_.sent_bytes = static_cast<long>(send.size());
+  cycle_traffic_.sent_tets = pack_rows(model, state, lists, send, send_counts, &own, start_joints);
   move_rows(model, state, send, send_counts, own, out, out_state);
 }
 
 void Distribution::move_rows(Model& source, TravellingState& source_state, std::vector<char>& send,
                              const std::vector<std::size_t>& send_counts, std::vector<char>& own,
                              Model& out, TravellingState& out_state) {
+  cycle_traffic_.sent_bytes = static_cast<long>(send.size());
   // The rows hold everything that travels: the source arrays can go before the new ones come.
   source.nodes = NodeArrays{};
   source.tets = TetArrays{};
@@ -87,9 +96,8 @@ void Distribution::move_rows(Model& source, TravellingState& source_state, std::
 
 void Distribution::migrate_incremental(Model& model, TravellingState& state) {
   const int ranks = comm_.size(), me = comm_.rank();
-  const std::vector<double>* also =
-      state.x_at_detection.size() == model.nodes.x.size() ? &state.x_at_detection : nullptr;
-  const std::vector<std::vector<LocalIndex>> lists = destinations(model, false, nullptr, also);
+  const std::vector<std::vector<LocalIndex>> lists =
+      destinations(model, false, nullptr, detection_positions(model, state));
   const TetArrays& tets = model.tets;
   // The copies each owned tet needs now against those that exist: the new ones travel, the ones
   // no longer needed are dropped where they are.
@@ -112,8 +120,9 @@ void Distribution::migrate_incremental(Model& model, TravellingState& state) {
   std::vector<GlobalId> dropped = comm_.exchange_sparse(drops);
   std::sort(dropped.begin(), dropped.end());
 
-  // What stays here: the owned tets and every copy its owner did not drop.
-  std::vector<LocalIndex> kept;
+  // What stays here: the owned tets and every copy its owner did not drop; this rank's rows are
+  // rebuilt in place (no copy through MPI).
+  std::vector<LocalIndex>& kept = sends[me];
   kept.reserve(static_cast<std::size_t>(tets.size()));
   std::size_t found = 0;
   for (LocalIndex t = 0; t < tets.size(); ++t) {
@@ -124,20 +133,11 @@ void Distribution::migrate_incremental(Model& model, TravellingState& state) {
   }
   FDEM_VERIFY(found == dropped.size(), "a rank drops only copies it holds");
   // A new copy carries every joint of its tet: the receiver may hold the other side already.
-  RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_, nullptr, true);
   std::vector<char> send, own;
-  std::vector<std::size_t> send_counts(static_cast<std::size_t>(ranks), 0);
+  std::vector<std::size_t> send_counts;
   cycle_traffic_ = {};
   cycle_traffic_.dropped_tets = static_cast<long>(dropped.size());
-  for (int p = 0; p < ranks; ++p) {
-    if (sends[p].empty()) continue;
-    const std::size_t before = send.size();
-    packer.pack(sends[p], send);
-    send_counts[p] = (send.size() - before) / 8;
-    cycle_traffic_.sent_tets += static_cast<long>(sends[p].size());
-  }
-  cycle_traffic_.sent_bytes = static_cast<long>(send.size());
-  packer.pack(kept, own);  // this rank's rows, rebuilt in place: no copy through MPI
+  cycle_traffic_.sent_tets = pack_rows(model, state, sends, send, send_counts, &own, nullptr, true);
   move_rows(model, state, send, send_counts, own, model, state);
 }
 
