@@ -328,17 +328,26 @@ void ContactStage::crack_body(std::int32_t body) {
   body_cracked_[static_cast<std::size_t>(body)] = 1;
 }
 
-void ContactStage::release_bond(LocalIndex a, LocalIndex b) {
-  detected_ = false;
-  for (int side = 0; side < 2; ++side) {
-    const LocalIndex t = side == 0 ? a : b, other = side == 0 ? b : a;
-    if (t < 0) continue;  // that tet is not held here (parallel runs)
-    if (!joint_state_.empty()) joint_state_[t] = JointState::cracked;
-    if (bonds_.empty()) continue;
-    for (int k = 0; k < 4; ++k)
-      if (bonds_[4 * static_cast<std::size_t>(t) + k] == other)
-        bonds_[4 * static_cast<std::size_t>(t) + k] = -1;
-  }
+void ContactStage::release_bonds(const Model& model,
+                                 const std::vector<std::pair<LocalIndex, LocalIndex>>& pairs) {
+  bool changed = false;
+  for (const auto& [a, b] : pairs)
+    for (int side = 0; side < 2; ++side) {
+      const LocalIndex t = side == 0 ? a : b, other = side == 0 ? b : a;
+      if (t < 0) continue;  // that tet is not held here (parallel runs)
+      if (!joint_state_.empty() && joint_state_[t] != JointState::cracked) {
+        joint_state_[t] = JointState::cracked;
+        changed = true;
+      }
+      if (bonds_.empty() || other < 0) continue;  // a bond is held with both its tets
+      for (int k = 0; k < 4; ++k)
+        if (bonds_[4 * static_cast<std::size_t>(t) + k] == other) {
+          bonds_[4 * static_cast<std::size_t>(t) + k] = -1;
+          changed = true;
+        }
+    }
+  // Only widened eligibility at unchanged positions: every pair of the list is found again.
+  if (changed && detected_) run_detection(model, x_at_detection_.data());
 }
 
 ContactForceSummary ContactStage::add_forces(Model& model, double dt) {

@@ -106,16 +106,23 @@ class ContactStage {
   // Tets bonded by an intact cohesive joint never pair (the joint carries their load).  Pairs
   // are model tet indices, at most 4 bonds per tet (one per face).
   void set_bonds(LocalIndex n_tets, const std::vector<std::pair<LocalIndex, LocalIndex>>& pairs);
-  // A joint broke: its two tets become contact partners.  The next detect_if_needed() re-runs
-  // detection (the pair is already inside the buffer, so the buffer rule would not notice).
-  // An index of −1 is a tet not held by this rank.
-  void release_bond(LocalIndex a, LocalIndex b);
+  // Joints broke: the two tets of each (model tet indices; −1 for a tet not held here) become
+  // contact partners, and cracked (pairs with the tets they met at a mesh node may form).  The
+  // buffer rule would not notice pairs that are already inside the buffer, so the candidates are
+  // found again at the positions of the last detection: the list only grows, by the pairs the
+  // release allows, and the positions at detection, the detection count and the friction history
+  // stay — no detection falls due (the freed pairs are as safe as any until the next one).
+  void release_bonds(const Model& model,
+                     const std::vector<std::pair<LocalIndex, LocalIndex>>& pairs);
   // Bonded tets flagged in `enclosed` (per model tet, TetArrays::enclosed; empty: none) become
   // enclosed; call after set_bonds.
   void enclose(const std::vector<std::uint8_t>& enclosed);
   // A joint of body `body` broke (anywhere, on any rank): its enclosed tets take part in contact
   // from the next detection on.
   void crack_body(std::int32_t body);
+  bool body_cracked(std::int32_t body) const {
+    return body_cracked_[static_cast<std::size_t>(body)] != 0;
+  }
   // Enclosed tets left out of the last detection.
   std::int64_t left_out() const { return left_out_count_; }
 

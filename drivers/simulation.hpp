@@ -181,7 +181,7 @@ class Simulation {
   };
   std::vector<BrokenJoint> own_breaks_;  // this rank's, since the last step's reduction
   bool breaks_pending_ = false;          // some rank broke a joint in the last step
-  bool bonds_released_ = false;          // a broken joint freed two tets since the last detection
+  bool bodies_cracking_ = false;         // ... the first in its body (contact: every rank learns)
   bool moved_since_halo_ = false;        // positions changed since the halo was built
   double busy_at_last_cycle_ = 0.0;  // compute seconds (stage clocks) at the last redistribution
   double tunnel_size_ = 0.0;         // m, smallest tet altitude at the start (contact scenes)

@@ -50,8 +50,8 @@ constexpr double runaway_energy_growth = 100.0;
 // ---------------------------------------------------------------------------------------------
 void Simulation::step() {
   StepRecord r;
-  share_broken_joints();                // 3b last step's broken joints: every copy, every bond
-  const bool detect = detection_due();  // 4a a node went buffer/2, or a bond was released
+  share_broken_joints();                // 3b last step's broken joints: to the ranks holding them
+  const bool detect = detection_due();  // 4a a node went buffer/2, or a body cracked
   if (migration_due(detect))            // 4b before a detection cycle: re-balance, migrate,
     redistribute(detect);               //    rebuild the halo
   apply_loads();                        // 0  gravity (tilt, ramp) and base velocities at t_n
@@ -71,34 +71,50 @@ void Simulation::step() {
   ++steps_;
 }
 
-// Joints break where they are computed; every rank learns of them at the start of the next step
-// (the count travels in the step's reduction), so that every copy of the joint and every copy of
-// its tets' contact state changes at the same step, on any number of ranks.  A restart rebuilds
-// the same state from the joints' broken flags and detects at once.
+// Joints break where they are computed (the owners of both tets compute each); the ranks that
+// hold a copy of either tet learn of it at the start of the next step from the tet's owner, so
+// that every copy of the joint and of its tets' contact state changes at the same step, on any
+// number of ranks, and no other rank takes part (a neighbour-only exchange; the count that says
+// whether any joint broke travels in the step's reduction).  The freed tets become contact
+// partners by a detection at the positions of the last one, on the ranks that hold them only.
+// The first break in a body is told to every rank: the body's enclosed tets, anywhere, enter the
+// contact detection that follows (once per body).  A restart rebuilds the same state from the
+// joints' broken flags.
 void Simulation::share_broken_joints() {
   if (!breaks_pending_) return;
   breaks_pending_ = false;
   Timed timed(clocks_[fracture]);
-  const std::vector<BrokenJoint> all = gather_records(*domain_, own_breaks_);
+  std::vector<GlobalId> about;
+  std::vector<BrokenJoint> notices;
+  for (const BrokenJoint& b : own_breaks_)
+    for (const GlobalId tet : {b.tet_a, b.tet_b}) {
+      const LocalIndex t = model_.tets.find(tet);
+      if (t >= 0 && model_.tets.is_owned(t)) {
+        about.push_back(tet);
+        notices.push_back(b);
+      }
+    }
+  std::vector<BrokenJoint> known = records_to_holders(*domain_, about, notices);
+  known.insert(known.end(), own_breaks_.begin(), own_breaks_.end());
+  if (bodies_cracking_) {  // every rank, together: which bodies cracked
+    bodies_cracking_ = false;
+    std::vector<std::int32_t> cracked;
+    if (contact_)
+      for (const BrokenJoint& b : own_breaks_)
+        for (const std::int32_t body : {b.body_a, b.body_b})
+          if (!contact_->body_cracked(body)) cracked.push_back(body);
+    for (const std::int32_t body : gather_records(*domain_, cracked)) contact_->crack_body(body);
+  }
   own_breaks_.clear();
-  const auto local_tet = [&](GlobalId gid) -> LocalIndex {  // local tets are in ascending gid
-    const auto it = std::lower_bound(model_.tets.gid.begin(), model_.tets.gid.end(), gid);
-    return it != model_.tets.gid.end() && *it == gid
-               ? static_cast<LocalIndex>(it - model_.tets.gid.begin())
-               : -1;
-  };
-  for (const BrokenJoint& b : all) {
+  std::vector<std::pair<LocalIndex, LocalIndex>> freed;
+  for (const BrokenJoint& b : known) {
     const auto it = std::lower_bound(model_.joints.gid.begin(), model_.joints.gid.end(), b.joint);
     if (it != model_.joints.gid.end() && *it == b.joint)
       joints_->mark_broken(model_, static_cast<LocalIndex>(it - model_.joints.gid.begin()), b.time,
                            static_cast<std::uint8_t>(b.mode));
-    if (contact_) {
-      contact_->release_bond(local_tet(b.tet_a), local_tet(b.tet_b));
-      contact_->crack_body(b.body_a);
-      contact_->crack_body(b.body_b);
-      bonds_released_ = true;  // the freed faces become contact partners: detect now
-    }
+    freed.emplace_back(model_.tets.find(b.tet_a), model_.tets.find(b.tet_b));
   }
+  if (contact_) contact_->release_bonds(model_, freed);
 }
 
 bool Simulation::detection_due() {
@@ -107,7 +123,7 @@ bool Simulation::detection_due() {
   // From the last step's reduction, the same on every rank; before the first step and after a
   // restart, from one reduction of its own.
   if (detection_due_ < 0) detection_due_ = domain_->any(contact_->detection_due(model_)) ? 1 : 0;
-  return detection_due_ > 0 || !contact_->detected() || bonds_released_;
+  return detection_due_ > 0 || !contact_->detected();
 }
 
 bool Simulation::migration_due(bool detecting) const {
@@ -140,13 +156,16 @@ void Simulation::add_joint_forces(StepRecord& r) {
   if (!plan_.joints) return;
   Timed timed(clocks_[joints]);
   r.joints = joints_->add_forces(model_, time_);
-  // 3 fracture: the joints this rank reports broken, shared at the start of the next step.
+  // 3 fracture: the joints that broke here, shared at the start of the next step.
   for (LocalIndex b : joints_->newly_broken()) {
     const LocalIndex a = model_.joints.tets[2 * b], c = model_.joints.tets[2 * b + 1];
     own_breaks_.push_back({model_.joints.gid[b], model_.tets.gid[a], model_.tets.gid[c],
                            model_.joints.failure_time[b], model_.joints.mode[b],
                            model_.pieces.body_of(model_.tets.piece[a]),
                            model_.pieces.body_of(model_.tets.piece[c])});
+    if (contact_ && (!contact_->body_cracked(own_breaks_.back().body_a) ||
+                     !contact_->body_cracked(own_breaks_.back().body_b)))
+      r.flags.bodies_cracked = 1.0;
   }
   r.flags.broken_joints = static_cast<double>(r.joints.newly_broken);
 }
@@ -154,7 +173,6 @@ void Simulation::add_joint_forces(StepRecord& r) {
 void Simulation::detect_contacts() {
   Timed timed(clocks_[detection]);
   contact_->detect(model_);
-  bonds_released_ = false;
 }
 
 void Simulation::add_contact_forces(StepRecord& r) {
@@ -234,7 +252,7 @@ void Simulation::sum_over_ranks(StepRecord& r) {
   r.flags.inverted_tet = r.forces.min_jacobian > 0.0 ? 0.0 : 1.0;
   r.flags.interrupted = interrupt_signal() != 0 ? 1.0 : 0.0;
   const auto start = std::chrono::steady_clock::now();
-  const std::array<double*, 32> values = summed_values(r);
+  const std::array<double*, 33> values = summed_values(r);
   reduced_.resize(values.size());  // kept: no allocation per step
   for (std::size_t i = 0; i < values.size(); ++i) reduced_[i] = *values[i];
   domain_->sum(reduced_);
@@ -244,6 +262,7 @@ void Simulation::sum_over_ranks(StepRecord& r) {
   r.motion.finite = r.flags.nonfinite_velocity == 0.0;
   detection_due_ = r.flags.detection_due > 0.0 ? 1 : 0;
   breaks_pending_ = r.flags.broken_joints > 0.0;
+  bodies_cracking_ = r.flags.bodies_cracked > 0.0;
   // A signal on any rank ends the run after this step on every rank.
   if (r.flags.interrupted > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
 }

@@ -14,6 +14,10 @@ class OneRankDomain final : public StepDomain {
   void sum(std::vector<double>&) const override {}
   bool any(bool local) const override { return local; }
   std::vector<char> gather(const std::vector<char>& mine) const override { return mine; }
+  std::vector<char> send_to_holders(const std::vector<GlobalId>&, const std::vector<char>&,
+                                    std::size_t) const override {
+    return {};  // no copies elsewhere
+  }
   void run_collectively(const std::function<void()>& check) const override { check(); }
   void redistribute(Model&, TravellingState&, const std::vector<double>&, double) override {
     FDEM_VERIFY(false, "one rank never redistributes");
@@ -31,6 +35,11 @@ class DistributedDomain final : public StepDomain {
   bool any(bool local) const override { return comm_.max(std::int32_t{local}) > 0; }
   std::vector<char> gather(const std::vector<char>& mine) const override {
     return comm_.allgatherv(mine);
+  }
+  std::vector<char> send_to_holders(const std::vector<GlobalId>& tets,
+                                    const std::vector<char>& records,
+                                    std::size_t record_bytes) const override {
+    return distribution_.send_to_holders(tets, records, record_bytes);
   }
   void run_collectively(const std::function<void()>& check) const override {
     comm_.run_collectively(check);

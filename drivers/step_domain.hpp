@@ -30,6 +30,11 @@ class StepDomain {
   virtual bool any(bool local) const = 0;
   // Every rank's bytes, concatenated in rank order (a blocking collective).
   virtual std::vector<char> gather(const std::vector<char>& mine) const = 0;
+  // Collective, neighbour-only: record i (`record_bytes` bytes) about owned tet `tets[i]` goes to
+  // every other rank that holds a copy of that tet; returns what arrived (one rank: nothing).
+  virtual std::vector<char> send_to_holders(const std::vector<GlobalId>& tets,
+                                            const std::vector<char>& records,
+                                            std::size_t record_bytes) const = 0;
   // Runs `check` on every rank; what it throws on some ranks is thrown on every rank.
   virtual void run_collectively(const std::function<void()>& check) const = 0;
   // Collective: re-balances, migrates the tets with `state`, rebuilds the halo
@@ -58,6 +63,20 @@ std::vector<T> gather_records(const StepDomain& domain, const std::vector<T>& mi
   std::vector<T> all(bytes.size() / sizeof(T));
   if (!all.empty()) std::memcpy(all.data(), bytes.data(), all.size() * sizeof(T));
   return all;
+}
+
+// Record i (trivially copyable) about owned tet `tets[i]` to every other rank holding a copy of
+// that tet; returns the records that arrived.
+template <class T>
+std::vector<T> records_to_holders(const StepDomain& domain, const std::vector<GlobalId>& tets,
+                                  const std::vector<T>& records) {
+  static_assert(std::is_trivially_copyable_v<T>, "records travel as bytes");
+  std::vector<char> bytes(records.size() * sizeof(T));
+  if (!bytes.empty()) std::memcpy(bytes.data(), records.data(), bytes.size());
+  bytes = domain.send_to_holders(tets, bytes, sizeof(T));
+  std::vector<T> arrived(bytes.size() / sizeof(T));
+  if (!arrived.empty()) std::memcpy(arrived.data(), bytes.data(), arrived.size() * sizeof(T));
+  return arrived;
 }
 
 }  // namespace fdem

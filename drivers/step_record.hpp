@@ -22,6 +22,7 @@ struct StepFlags {
   double detection_due = 0.0;       // a node went more than buffer/2 since the last detection
   double tunnelling = 0.0;          // a node went further than the thinnest element in one step
   double broken_joints = 0.0;       // joints this rank reports broken in this step
+  double bodies_cracked = 0.0;      // ... of which in a body none of whose joints had broken
 };
 
 struct StepRecord {
@@ -38,7 +39,7 @@ struct StepRecord {
 };
 
 // Every value of a StepRecord that the step sums over the ranks, each listed once.
-inline std::array<double*, 32> summed_values(StepRecord& r) {
+inline std::array<double*, 33> summed_values(StepRecord& r) {
   double* p_before = r.motion.momentum_before.data();
   double* p_after = r.motion.momentum_after.data();
   StepFlags& f = r.flags;
@@ -73,7 +74,8 @@ inline std::array<double*, 32> summed_values(StepRecord& r) {
           &f.step_too_large,
           &f.detection_due,
           &f.tunnelling,
-          &f.broken_joints};
+          &f.broken_joints,
+          &f.bodies_cracked};
 }
 
 }  // namespace fdem

@@ -77,13 +77,13 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
       newly_broken_.push_back(j);
     }
   }
-  // Count the ones this rank reports; the others learn of them through mark_broken.
-  newly_broken_.erase(
-      std::remove_if(newly_broken_.begin(), newly_broken_.end(),
-                     [&](LocalIndex j) { return !tets.is_owned(joints.tets[2 * j]); }),
-      newly_broken_.end());
-  broken_ += static_cast<LocalIndex>(newly_broken_.size());
-  out.newly_broken = static_cast<LocalIndex>(newly_broken_.size());
+  // Count the ones this rank reports (tet A owned); the ranks that hold a joint without computing
+  // it learn of it through mark_broken.
+  const auto reported =
+      std::count_if(newly_broken_.begin(), newly_broken_.end(),
+                    [&](LocalIndex j) { return tets.is_owned(joints.tets[2 * j]); });
+  broken_ += static_cast<LocalIndex>(reported);
+  out.newly_broken = static_cast<LocalIndex>(reported);
   out.broken = broken_;
   return out;
 }

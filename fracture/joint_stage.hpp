@@ -36,12 +36,13 @@ class JointStage {
   // Advances every intact joint to the current positions, adds its forces to model.nodes.f in
   // ascending joint gid, and marks joints that break with `time` (s) and their failure mode.
   // With parallel roles, only joints with an active tet are computed, and only those whose tet A
-  // is owned count in the energies and in newly_broken().
+  // is owned count in the energies and in JointStepSummary::newly_broken.
   // The dissipation terms cover the motion since the previous call, so for the trapezoid
   // accumulators of core/energy.hpp they are all "before" work (see docs/fracture-model.md).
   JointStepSummary add_forces(Model& model, double time);
 
-  // Joints (indices) that broke in the last add_forces call.
+  // Joints (indices) that broke in the last add_forces call: every one computed here (with parallel
+  // roles the owners of both tets compute a joint, and each tells the ranks holding its tet).
   const std::vector<LocalIndex>& newly_broken() const { return newly_broken_; }
 
   // Stable step (s) of the joint springs alone.  Each intact point couples a_i and b_i with a

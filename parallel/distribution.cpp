@@ -464,7 +464,7 @@ void Distribution::redistribute(Model& model, TravellingState& state,
     TravellingState arrived;
     migrate(model, state, model, arrived);
     state = std::move(arrived);
-    if (settings_.incremental) record_holders(model);
+    record_holders(model);  // incremental cycles and send_to_holders read where copies are
   } else {
     migrate_incremental(model, state);
     ++report_.migration.incremental_cycles;
@@ -474,6 +474,22 @@ void Distribution::redistribute(Model& model, TravellingState& state,
   last_cycle_repartitioned_ = report_.rebalances > rebalances_before;
   last_cycle_seconds_ =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
+std::vector<char> Distribution::send_to_holders(const std::vector<GlobalId>& tets,
+                                                const std::vector<char>& records,
+                                                std::size_t record_bytes) const {
+  FDEM_VERIFY(records.size() == tets.size() * record_bytes, "one record per tet");
+  std::vector<std::vector<char>> outbox(static_cast<std::size_t>(comm_.size()));
+  for (std::size_t i = 0; i < tets.size(); ++i) {
+    const char* record = records.data() + i * record_bytes;
+    auto copy = std::lower_bound(held_by_.begin(), held_by_.end(),
+                                 std::pair<GlobalId, std::int32_t>{tets[i], -1});
+    for (; copy != held_by_.end() && copy->first == tets[i]; ++copy)
+      outbox[static_cast<std::size_t>(copy->second)].insert(
+          outbox[static_cast<std::size_t>(copy->second)].end(), record, record + record_bytes);
+  }
+  return comm_.exchange_sparse(outbox);
 }
 
 void Distribution::account_last_cycle(double seconds) {

@@ -112,6 +112,14 @@ class Distribution {
   const std::vector<std::pair<GlobalId, std::int32_t>>& copies_elsewhere() const {
     return held_by_;
   }
+  // Collective, neighbour-only (Communicator::exchange_sparse): record i (`record_bytes` bytes
+  // at records[i × record_bytes]) concerns tet `tets[i]`, owned here; it goes to every other rank
+  // that holds a copy of that tet.  Returns the records that arrived, in source rank order.
+  // What the step tells about a tet (a broken joint) reaches the ranks that hold it, and no one
+  // else.
+  std::vector<char> send_to_holders(const std::vector<GlobalId>& tets,
+                                    const std::vector<char>& records,
+                                    std::size_t record_bytes) const;
 
  private:
   struct Neighbour {

@@ -294,3 +294,103 @@ TEST_CASE(
     for (int k = 0; k < 3; ++k) stale += local.nodes.x[3 * n + k] != value(local.nodes.gid[n], k);
   CHECK(stale == 0);
 }
+
+namespace {
+
+// A jointed bar (a cohesive joint on every interior face), its nodes displaced a little.
+Model jointed_bar() {
+  Scene scene = builders::basic_scene(1.0);
+  MaterialSpec rock = builders::elastic_material(2600, 1e9, 0.25);
+  FractureSpec f;
+  f.tensile_strength = 1e6;
+  f.cohesion = 2e6;
+  f.friction_angle_deg = 30;
+  f.energy_I = 10;
+  f.energy_II = 50;
+  rock.fracture = f;
+  scene.materials = {rock};
+  BodySpec bar = builders::box_body("bar", {0, 0, 0}, {2.0, 0.2, 0.2}, 20, 2, 2, 0);
+  bar.joints = JointPlacement::all;
+  scene.bodies = {bar};
+  Model model = build_model(scene, load_body_meshes(scene));
+  for (LocalIndex i = 0; i < model.nodes.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      model.nodes.x[3 * i + k] +=
+          1e-4 * std::sin(0.7 * static_cast<double>(model.nodes.gid[i]) + k);
+  return model;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "a record about a tet reaches every rank that holds a copy of it and no other, and the owners "
+    "of both tets of a joint hold it",
+    "[mpi][distribution]") {
+  const Communicator comm = Communicator::world();
+  const int me = comm.rank();
+  INFO("rank " << me << " of " << comm.size());
+  const Model global = jointed_bar();
+  REQUIRE(global.joints.size() > 0);
+  for (const bool incremental : {true, false}) {
+    INFO((incremental ? "incremental" : "full") << " migration");
+    DistributionSettings settings;
+    settings.incremental = incremental;
+    settings.random_parts = true;        // owners scattered: many copies, on every rank
+    settings.rebalance_threshold = 0.0;  // a re-partition at every cycle
+    TravellingState whole, state;
+    whole.x_at_detection = global.nodes.x;
+    whole.tet_joint_state.assign(static_cast<std::size_t>(global.tets.size()), 1);
+    Model local;
+    Distribution d(comm, settings, global, whole, 0.01, {}, local, state);
+    for (int cycle = 0; cycle < 3; ++cycle) {
+      INFO("cycle " << cycle);
+      if (cycle > 0) {
+        state.x_at_detection = local.nodes.x;
+        d.redistribute(local, state, {}, 0.0);
+      }
+      const TetArrays& tets = local.tets;
+      // Both owners of a joint's tets hold it: each computes it and sees it break.
+      std::map<GlobalId, int> sides_held;
+      for (LocalIndex j = 0; j < local.joints.size(); ++j)
+        for (int s = 0; s < 2; ++s) ++sides_held[tets.gid[local.joints.tets[2 * j + s]]];
+      std::map<GlobalId, int> sides;
+      for (LocalIndex j = 0; j < global.joints.size(); ++j)
+        for (int s = 0; s < 2; ++s) ++sides[global.tets.gid[global.joints.tets[2 * j + s]]];
+      long joints_missing = 0;
+      for (LocalIndex t = 0; t < tets.size(); ++t)
+        if (tets.is_owned(t)) joints_missing += sides[tets.gid[t]] - sides_held[tets.gid[t]];
+      CHECK(joints_missing == 0);
+      // Each owner tells about each of its tets: every copy hears once, from the owner.
+      struct Notice {
+        GlobalId tet;
+        std::int32_t from;
+      };
+      std::vector<GlobalId> about;
+      std::vector<Notice> notices;
+      for (LocalIndex t = 0; t < tets.size(); ++t)
+        if (tets.is_owned(t)) {
+          about.push_back(tets.gid[t]);
+          notices.push_back({tets.gid[t], me});
+        }
+      std::vector<char> bytes(notices.size() * sizeof(Notice));
+      if (!bytes.empty()) std::memcpy(bytes.data(), notices.data(), bytes.size());
+      const std::vector<char> arrived = d.send_to_holders(about, bytes, sizeof(Notice));
+      REQUIRE(arrived.size() % sizeof(Notice) == 0);
+      std::vector<GlobalId> heard;
+      long wrong_sender = 0;
+      for (std::size_t i = 0; i < arrived.size() / sizeof(Notice); ++i) {
+        Notice n;
+        std::memcpy(&n, arrived.data() + i * sizeof(Notice), sizeof(Notice));
+        heard.push_back(n.tet);
+        const LocalIndex t = tets.find(n.tet);
+        if (t < 0 || tets.is_owned(t) || n.from == me) ++wrong_sender;
+      }
+      std::sort(heard.begin(), heard.end());
+      std::vector<GlobalId> copies;
+      for (LocalIndex t = 0; t < tets.size(); ++t)
+        if (!tets.is_owned(t)) copies.push_back(tets.gid[t]);
+      CHECK(wrong_sender == 0);
+      CHECK(heard == copies);  // every copy once, nothing else
+    }
+  }
+}

@@ -108,7 +108,7 @@ TEST_CASE("friction entries travel as pair records and come back bit for bit", "
   }
 }
 
-TEST_CASE("a bonded pair never pairs, and pairs again at the detection after its bond is released",
+TEST_CASE("a bonded pair never pairs, and pairs again as soon as its bond is released",
           "[contact][stage]") {
   const Model model = block_on_base(0.0);
   const auto pairs_of = [](const ContactStage& stage) {
@@ -133,11 +133,28 @@ TEST_CASE("a bonded pair never pairs, and pairs again at the detection after its
   const std::vector<std::uint8_t> states = stage.tet_joint_states();
   CHECK(states[bonded.first] == static_cast<std::uint8_t>(TetJointState::intact));
 
-  stage.release_bond(bonded.first, -1);  // the other tet held on another rank: a no-op for it
-  stage.release_bond(bonded.first, bonded.second);
-  CHECK(stage.detection_due(model));  // nothing moved, yet the freed faces must be found
-  CHECK(stage.detect_if_needed(model));
+  // The bricks moved since the detection: the freed pair is found at the positions of the last
+  // detection, which stay, and no detection falls due.
+  Model moved = model;
+  for (double& x : moved.nodes.x) x += 1e-4;
+  const std::vector<double> at_detection = stage.x_at_detection();
+  const long detections = stage.detections();
+  stage.release_bonds(moved, {{bonded.first, -1}});  // the other tet on another rank: cracked
+  CHECK(stage.tet_joint_states()[bonded.first] ==
+        static_cast<std::uint8_t>(TetJointState::cracked));
+  CHECK(pairs_of(stage) == expected);  // still bonded to its partner
+  stage.release_bonds(moved, {{bonded.first, bonded.second}});
   CHECK(pairs_of(stage) == all);
   CHECK(stage.tet_joint_states()[bonded.second] ==
         static_cast<std::uint8_t>(TetJointState::cracked));
+  CHECK(stage.x_at_detection() == at_detection);
+  CHECK(stage.detections() == detections);
+  CHECK_FALSE(stage.detection_due(moved));  // 0.1 mm < buffer / 2
+
+  // Released before any detection: the first detection finds it.
+  ContactStage fresh(model, ContactSettings{0.02});
+  fresh.set_bonds(model.tets.size(), {bonded});
+  fresh.release_bonds(model, {bonded});
+  CHECK(fresh.detect_if_needed(model));
+  CHECK(pairs_of(fresh) == all);
 }
