@@ -180,11 +180,9 @@ void ContactStage::detect(const Model& model) {
   ++detections_;
 }
 
-void ContactStage::run_detection(const Model& model, const double* x) {
-  compute_boxes(model, x);
+// Enclosed tets of bodies whose joints all hold take no part (TetJointState::enclosed).
+void ContactStage::mark_left_out(const Model& model) {
   const TetArrays& tets = model.tets;
-  const bool all_active = tets.active.empty();
-  // Enclosed tets of bodies whose joints all hold take no part (TetJointState::enclosed).
   left_out_.assign(static_cast<std::size_t>(tets.size()), 0);
   left_out_count_ = 0;
   if (skip_enclosed_ && !joint_state_.empty())
@@ -194,6 +192,14 @@ void ContactStage::run_detection(const Model& model, const double* x) {
         left_out_[t] = 1;
         ++left_out_count_;
       }
+}
+
+void ContactStage::run_detection(const Model& model, const double* x) {
+  ++broad_phase_passes_;
+  compute_boxes(model, x);
+  const TetArrays& tets = model.tets;
+  const bool all_active = tets.active.empty();
+  mark_left_out(model);
   const auto eligible = [&](LocalIndex a, LocalIndex b) {
     if (left_out_[a] || left_out_[b]) return false;
     // A pair between two tets this rank does not compute is left to the ranks that do.
@@ -227,7 +233,8 @@ void ContactStage::run_detection(const Model& model, const double* x) {
 
 void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection,
                           std::vector<std::uint8_t> tet_joint_state,
-                          const std::vector<FrictionEntry>& friction, bool detected) {
+                          const std::vector<FrictionEntry>& friction, bool detected,
+                          const std::vector<GidPair>* candidates) {
   const TetArrays& tets = model.tets;
   FDEM_VERIFY(x_at_detection.size() == model.nodes.x.size(), "positions at detection per node");
   FDEM_VERIFY(
@@ -255,7 +262,31 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
   x_at_detection_ = std::move(x_at_detection);
   detected_ = detected;
   pairs_.clear();
-  if (detected_) run_detection(model, x_at_detection_.data());
+  if (!detected_) return;
+  if (!candidates) {
+    run_detection(model, x_at_detection_.data());
+    return;
+  }
+  // The pairs this rank computes (run_detection's `eligible` keeps a pair with an active tet; the
+  // rest of it holds on every rank alike): local tets are in ascending gid, so gid order is the
+  // local order the broad phase gives.
+  mark_left_out(model);
+  pairs_.reserve(candidates->size());
+  for (const GidPair& c : *candidates) {
+    const auto a = local.find(c.a), b = local.find(c.b);
+    if (a == local.end() || b == local.end()) continue;
+    if (!tets.is_active(a->second) && !tets.is_active(b->second)) continue;
+    pairs_.push_back({a->second, b->second});
+  }
+  std::sort(pairs_.begin(), pairs_.end());
+  may_hold_friction_.assign(pairs_.size(), 1);
+}
+
+std::vector<GidPair> ContactStage::candidate_gids(const Model& model) const {
+  std::vector<GidPair> out;
+  out.reserve(pairs_.size());
+  for (const CandidatePair& p : pairs_) out.push_back({model.tets.gid[p.a], model.tets.gid[p.b]});
+  return out;  // pairs_ is in ascending (a, b) and local tets in ascending gid
 }
 
 void ContactStage::release_until_rebind() {

@@ -83,13 +83,21 @@ class ContactStage {
 
   // Parallel runs (docs/parallel.md): after the model was redistributed, take over the state
   // that travelled with it — positions at the last detection (3 per local node), each local
-  // tet's joint state, the friction history of the pairs held here — rebuild the bonds from the
-  // model's intact joints and repeat the last detection at the positions it saw, which gives
-  // the candidate pairs the previous layout had.  `detected`: whether a detection happened yet.
+  // tet's joint state, the friction history of the pairs held here — and rebuild the bonds from
+  // the model's intact joints.  `detected`: whether a detection happened yet.  Then the candidate
+  // pairs of the last detection: `candidates` (by gid, as candidate_gids() gave them on the ranks
+  // that owned their tet a) keeps those this rank computes — both tets held, one active; without
+  // them, the last detection is repeated at the positions it saw.  Both give the same list.
   void rebind(const Model& model, std::vector<double> x_at_detection,
               std::vector<std::uint8_t> tet_joint_state, const std::vector<FrictionEntry>& friction,
-              bool detected);
+              bool detected, const std::vector<GidPair>* candidates = nullptr);
+  // The candidate pairs of the last detection by global ids, sorted: what travels with the tets
+  // when the model is redistributed between detections.
+  std::vector<GidPair> candidate_gids(const Model& model) const;
   std::vector<FrictionEntry> friction_entries() const;
+  // How many broad-phase passes ran (detections, and their repeats after a migration or a
+  // release of bonds): a measure of what travelling candidates save.
+  long broad_phase_passes() const { return broad_phase_passes_; }
   // Parallel runs, once the travelling state was taken: frees what rebind() rebuilds (candidate
   // pairs, their records and friction map, the detector's grids) so that it does not add to
   // the migration's buffers at the peak of the step loop.
@@ -188,6 +196,9 @@ class ContactStage {
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;
   long detections_ = 0;
+  long broad_phase_passes_ = 0;
+  // left_out_ for the current joint states and cracked bodies (enclosed tets of intact bodies).
+  void mark_left_out(const Model& model);
   bool detected_ = false;
 };
 

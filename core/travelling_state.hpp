@@ -26,6 +26,11 @@ struct PairRecord {
   double value[4] = {0.0, 0.0, 0.0, 0.0};
 };
 
+// A candidate pair of the last contact detection by global ids (a < b); travels with tet a.
+struct GidPair {
+  GlobalId a = 0, b = 0;
+};
+
 struct TravellingState {
   std::vector<double> x_at_detection;         // 3 per local node (m); tet boxes span them too
   std::vector<std::uint8_t> tet_joint_state;  // per local tet, a TetJointState (empty: no joints)
@@ -33,6 +38,11 @@ struct TravellingState {
   std::size_t joint_record_bytes = 0;
   std::vector<std::uint8_t> joint_records;
   std::vector<PairRecord> pairs;  // held here, sorted by (a, b)
+  // The contact candidates of the last detection, when they travel (a migration between
+  // detections: the receiving ranks keep them instead of repeating the detection); sorted by
+  // (a, b).  `carries_candidates` is the same on every rank.
+  bool carries_candidates = false;
+  std::vector<GidPair> candidates;
 };
 
 }  // namespace fdem

@@ -345,7 +345,8 @@ TravellingState Simulation::travelling_state() const {
 void Simulation::rebind_stages(TravellingState& state, bool detected) {
   if (contact_)
     contact_->rebind(model_, std::move(state.x_at_detection), std::move(state.tet_joint_state),
-                     friction_entries(state.pairs), detected);
+                     friction_entries(state.pairs), detected,
+                     state.carries_candidates ? &state.candidates : nullptr);
   if (joints_) joints_->rebind(model_, joint_histories(state.joint_records));
   loads_->rebind(model_);
   if (absorbing_) absorbing_->rebind(model_);
@@ -354,12 +355,17 @@ void Simulation::rebind_stages(TravellingState& state, bool detected) {
   build_internal_force_split(model_, split_);
 }
 
-// `detecting`: a detection at the current positions follows at once (the halo is built for it,
-// and the last detection is not repeated).
+// `detecting`: a detection at the current positions follows at once (the halo is built for it).
+// Else the candidate pairs of the last detection travel with their tets (parallel.redistribute_every
+// between detections): the last detection is never repeated.
 void Simulation::redistribute(bool detecting) {
   finish_halo_exchange();
   Timed timed(clocks_[migration]);
   TravellingState state = travelling_state();
+  if (contact_ && contact_->detected() && !detecting) {
+    state.carries_candidates = true;
+    state.candidates = contact_->candidate_gids(model_);
+  }
   std::vector<double> contact_cost;  // per local tet, in units of one tet's internal force
   if (contact_) {
     // Relative costs from bench_contact_pair and bench_internal_forces (docs/benchmarks.md): a

@@ -88,9 +88,11 @@ void Distribution::move_rows(Model& source, TravellingState& source_state, std::
   source.tets = TetArrays{};
   source.joints = JointArrays{};
   source.tet_force_order = {};
+  const bool carries_candidates = source_state.carries_candidates;
   source_state = TravellingState{};
   std::vector<char> receive = exchange_rows(send, send_counts);
   assemble({&receive, &own}, out, out_state);
+  out_state.carries_candidates = carries_candidates;
   build_exchange(out);
 }
 
@@ -245,6 +247,15 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
 
   state.pairs = std::move(parsed.pairs);
   std::sort(state.pairs.begin(), state.pairs.end(), [](const PairRecord& p, const PairRecord& q) {
+    return p.a != q.a ? p.a < q.a : p.b < q.b;
+  });
+  // Each pair came once, with the one copy of its tet a; kept where its tet b is held too.
+  state.candidates = std::move(parsed.candidates);
+  state.candidates.erase(
+      std::remove_if(state.candidates.begin(), state.candidates.end(),
+                     [&](const GidPair& c) { return tets.find(c.b) < 0; }),
+      state.candidates.end());
+  std::sort(state.candidates.begin(), state.candidates.end(), [](const GidPair& p, const GidPair& q) {
     return p.a != q.a ? p.a < q.a : p.b < q.b;
   });
 }

@@ -49,11 +49,12 @@ struct JointRow {
 };
 using PairRow = PairRecord;  // stage state of a pair of tets, sent with its first tet
 struct BlockHeader {
-  std::int64_t tets = 0, nodes = 0, joints = 0, pairs = 0;
+  std::int64_t tets = 0, nodes = 0, joints = 0, pairs = 0, candidates = 0;
   std::int64_t joint_record_bytes = 0;  // of each joint's stage record (0: none)
 };
 static_assert(sizeof(TetRow) % 8 == 0 && sizeof(NodeRow) % 8 == 0 && sizeof(JointRow) % 8 == 0 &&
-                  sizeof(PairRow) % 8 == 0 && sizeof(BlockHeader) % 8 == 0,
+                  sizeof(PairRow) % 8 == 0 && sizeof(GidPair) % 8 == 0 &&
+                  sizeof(BlockHeader) % 8 == 0,
               "rows travel as 8-byte words");
 // A joint record's bytes on the wire: padded to whole 8-byte words.
 inline std::size_t padded_record_bytes(std::size_t bytes) {
@@ -77,8 +78,8 @@ inline T take(const char*& p) {
 }
 
 // Packs the rows that travel with a set of tets: the tets, their nodes (once per block), the
-// joints whose first tet they are, and the stages' records of their pairs (keyed by their first
-// tet).
+// joints whose first tet they are, and the stages' records of their pairs and the contact
+// candidates (both keyed by their first tet).
 class RowPacker {
  public:
   // `tet_owner`, `node_owner`, `node_first_tet`: per local tet and node, their owners after the
@@ -119,6 +120,7 @@ class RowPacker {
     std::vector<LocalIndex> node_list, joint_list;
     std::vector<const StartJoint*> start_list;
     std::vector<const PairRecord*> pair_list;
+    std::vector<GidPair> candidate_list;
     for (LocalIndex t : tet_list) {
       if (start_joints_) {
         auto it =
@@ -145,19 +147,23 @@ class RowPacker {
       auto it = std::lower_bound(state_.pairs.begin(), state_.pairs.end(), g,
                                  [](const PairRecord& e, GlobalId value) { return e.a < value; });
       for (; it != state_.pairs.end() && it->a == g; ++it) pair_list.push_back(&*it);
+      auto c = std::lower_bound(state_.candidates.begin(), state_.candidates.end(), g,
+                                [](const GidPair& e, GlobalId value) { return e.a < value; });
+      for (; c != state_.candidates.end() && c->a == g; ++c) candidate_list.push_back(*c);
     }
     BlockHeader header;
     header.tets = static_cast<std::int64_t>(tet_list.size());
     header.nodes = static_cast<std::int64_t>(node_list.size());
     header.joints = static_cast<std::int64_t>(joint_list.size() + start_list.size());
     header.pairs = static_cast<std::int64_t>(pair_list.size());
+    header.candidates = static_cast<std::int64_t>(candidate_list.size());
     const std::size_t record_bytes = state_.joint_record_bytes;
     header.joint_record_bytes = static_cast<std::int64_t>(record_bytes);
     out.reserve(out.size() + sizeof(header) + tet_list.size() * sizeof(TetRow) +
                 node_list.size() * sizeof(NodeRow) +
                 (joint_list.size() + start_list.size()) *
                     (sizeof(JointRow) + padded_record_bytes(record_bytes)) +
-                pair_list.size() * sizeof(PairRow));
+                pair_list.size() * sizeof(PairRow) + candidate_list.size() * sizeof(GidPair));
     append(out, header);
     for (LocalIndex t : tet_list) {
       TetRow row{};
@@ -219,6 +225,7 @@ class RowPacker {
       append_record(out, nullptr, record_bytes);  // made at the start: the stage makes its own
     }
     for (const PairRecord* e : pair_list) append(out, *e);
+    for (const GidPair& c : candidate_list) append(out, c);
   }
 
  private:
@@ -293,10 +300,11 @@ struct ParsedRows {
   std::size_t joint_record_bytes = 0;
   std::vector<std::uint8_t> joint_records;  // joint_record_bytes per joint row, in row order
   std::vector<PairRow> pairs;
+  std::vector<GidPair> candidates;
 };
 inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) {
   ParsedRows parsed;
-  std::int64_t counts[4] = {0, 0, 0, 0};
+  std::int64_t counts[5] = {0, 0, 0, 0, 0};
   // Exact sizes first: growing the row arrays would hold up to three copies at once.
   for (std::vector<char>* rows : buffers)
     for (const char* p = rows->data(); p < rows->data() + rows->size();) {
@@ -305,6 +313,7 @@ inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) 
       counts[1] += header.nodes;
       counts[2] += header.joints;
       counts[3] += header.pairs;
+      counts[4] += header.candidates;
       const auto record_bytes = static_cast<std::size_t>(header.joint_record_bytes);
       if (header.joints > 0) {
         FDEM_VERIFY(parsed.joint_record_bytes == 0 || parsed.joint_record_bytes == record_bytes,
@@ -313,13 +322,14 @@ inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) 
       }
       p += header.tets * sizeof(TetRow) + header.nodes * sizeof(NodeRow) +
            header.joints * (sizeof(JointRow) + padded_record_bytes(record_bytes)) +
-           header.pairs * sizeof(PairRow);
+           header.pairs * sizeof(PairRow) + header.candidates * sizeof(GidPair);
     }
   parsed.tets.reserve(static_cast<std::size_t>(counts[0]));
   parsed.nodes.reserve(static_cast<std::size_t>(counts[1]));
   parsed.joints.reserve(static_cast<std::size_t>(counts[2]));
   parsed.joint_records.reserve(static_cast<std::size_t>(counts[2]) * parsed.joint_record_bytes);
   parsed.pairs.reserve(static_cast<std::size_t>(counts[3]));
+  parsed.candidates.reserve(static_cast<std::size_t>(counts[4]));
   for (std::vector<char>* rows : buffers) {
     for (const char* p = rows->data(); p < rows->data() + rows->size();) {
       const BlockHeader header = take<BlockHeader>(p);
@@ -334,6 +344,8 @@ inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) 
         p += padded_record_bytes(record_bytes);
       }
       for (std::int64_t i = 0; i < header.pairs; ++i) parsed.pairs.push_back(take<PairRow>(p));
+      for (std::int64_t i = 0; i < header.candidates; ++i)
+        parsed.candidates.push_back(take<GidPair>(p));
     }
     *rows = std::vector<char>{};  // parsed: its memory goes back before the arrays are built
   }

@@ -9,9 +9,11 @@
 #include <cstdint>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <utility>
 #include <vector>
 
+#include "contact/contact_stage.hpp"
 #include "core/model_builder.hpp"
 #include "drivers/scene_builders.hpp"
 #include "parallel/communicator.hpp"
@@ -392,5 +394,55 @@ TEST_CASE(
       CHECK(wrong_sender == 0);
       CHECK(heard == copies);  // every copy once, nothing else
     }
+  }
+}
+
+TEST_CASE(
+    "candidate pairs travel with their tets: a migration between detections keeps the list a "
+    "repeated detection gives, without the pass",
+    "[mpi][distribution][contact]") {
+  const Communicator comm = Communicator::world();
+  INFO("rank " << comm.rank() << " of " << comm.size());
+  const Model global = slab_and_post();
+  const double buffer = 0.02;  // m: the post stands 0.01 m above the slab, inside it
+  const auto gids = [](const Model& m, const ContactStage& stage) {
+    std::vector<std::pair<GlobalId, GlobalId>> out;
+    for (const CandidatePair& p : stage.candidates())
+      out.emplace_back(m.tets.gid[p.a], m.tets.gid[p.b]);
+    return out;
+  };
+  for (const bool repartition : {false, true}) {
+    INFO((repartition ? "re-partition at every cycle" : "incremental cycles"));
+    DistributionSettings settings;
+    settings.random_parts = repartition;
+    settings.rebalance_threshold = repartition ? 0.0 : 1.10;
+    TravellingState whole, state;
+    whole.x_at_detection = global.nodes.x;
+    Model local;
+    Distribution d(comm, settings, global, whole, buffer, {}, local, state);
+    auto stage = std::make_unique<ContactStage>(local, ContactSettings{buffer});
+    stage->detect(local);
+    for (int cycle = 0; cycle < 3; ++cycle) {
+      INFO("cycle " << cycle);
+      move(local, 0.002);  // within buffer / 2 of the detection: no detection due
+      state = TravellingState{};
+      state.x_at_detection = stage->x_at_detection();
+      state.carries_candidates = true;
+      state.candidates = stage->candidate_gids(local);
+      d.redistribute(local, state, {}, 0.0);
+      CHECK(state.carries_candidates);
+      // What travelled, against the detection repeated at the positions it saw.
+      auto travelled = std::make_unique<ContactStage>(local, ContactSettings{buffer});
+      travelled->rebind(local, state.x_at_detection, {}, {}, true, &state.candidates);
+      ContactStage repeated(local, ContactSettings{buffer});
+      repeated.rebind(local, state.x_at_detection, {}, {}, true);
+      CHECK(gids(local, *travelled) == gids(local, repeated));
+      CHECK(travelled->broad_phase_passes() == 0);
+      CHECK(repeated.broad_phase_passes() == 1);
+      CHECK(comm.sum(static_cast<std::int64_t>(travelled->candidates().size())) > 0);
+      stage = std::move(travelled);
+    }
+    if (comm.size() > 1 && repartition) CHECK(d.report().rebalances == 3);
+    if (!repartition) CHECK(d.report().migration.incremental_cycles == 3);
   }
 }
