@@ -356,8 +356,8 @@ void Simulation::rebind_stages(TravellingState& state, bool detected) {
 }
 
 // `detecting`: a detection at the current positions follows at once (the halo is built for it).
-// Else the candidate pairs of the last detection travel with their tets (parallel.redistribute_every
-// between detections): the last detection is never repeated.
+// Else the candidate pairs of the last detection travel with their tets
+// (parallel.redistribute_every between detections): the last detection is never repeated.
 void Simulation::redistribute(bool detecting) {
   finish_halo_exchange();
   Timed timed(clocks_[migration]);

@@ -251,13 +251,11 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   });
   // Each pair came once, with the one copy of its tet a; kept where its tet b is held too.
   state.candidates = std::move(parsed.candidates);
-  state.candidates.erase(
-      std::remove_if(state.candidates.begin(), state.candidates.end(),
-                     [&](const GidPair& c) { return tets.find(c.b) < 0; }),
-      state.candidates.end());
-  std::sort(state.candidates.begin(), state.candidates.end(), [](const GidPair& p, const GidPair& q) {
-    return p.a != q.a ? p.a < q.a : p.b < q.b;
-  });
+  state.candidates.erase(std::remove_if(state.candidates.begin(), state.candidates.end(),
+                                        [&](const GidPair& c) { return tets.find(c.b) < 0; }),
+                         state.candidates.end());
+  std::sort(state.candidates.begin(), state.candidates.end(),
+            [](const GidPair& p, const GidPair& q) { return p.a != q.a ? p.a < q.a : p.b < q.b; });
 }
 
 }  // namespace fdem
