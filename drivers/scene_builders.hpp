@@ -23,6 +23,20 @@ inline MaterialSpec elastic_material(double density, double young, double poisso
   return m;
 }
 
+// Cohesive joint parameters: strengths (Pa), friction angle (degrees), fracture energies (J/m²).
+// The defaults are a weak rock's joints, as the tests use them.
+inline FractureSpec fracture_spec(double tensile_strength = 1e6, double cohesion = 2e6,
+                                  double friction_angle_deg = 30.0, double energy_I = 10.0,
+                                  double energy_II = 50.0) {
+  FractureSpec f;
+  f.tensile_strength = tensile_strength;
+  f.cohesion = cohesion;
+  f.friction_angle_deg = friction_angle_deg;
+  f.energy_I = energy_I;
+  f.energy_II = energy_II;
+  return f;
+}
+
 inline BodySpec box_body(const std::string& name, const Vec3& lo, const Vec3& hi, int nx, int ny,
                          int nz, int material = 0) {
   BodySpec b;

@@ -303,13 +303,7 @@ namespace {
 Model jointed_bar() {
   Scene scene = builders::basic_scene(1.0);
   MaterialSpec rock = builders::elastic_material(2600, 1e9, 0.25);
-  FractureSpec f;
-  f.tensile_strength = 1e6;
-  f.cohesion = 2e6;
-  f.friction_angle_deg = 30;
-  f.energy_I = 10;
-  f.energy_II = 50;
-  rock.fracture = f;
+  rock.fracture = builders::fracture_spec();
   scene.materials = {rock};
   BodySpec bar = builders::box_body("bar", {0, 0, 0}, {2.0, 0.2, 0.2}, 20, 2, 2, 0);
   bar.joints = JointPlacement::all;

@@ -10,6 +10,7 @@
 #include "core/model_builder.hpp"
 #include "core/tet_kernels.hpp"
 #include "drivers/mesh_generators.hpp"
+#include "drivers/scene_builders.hpp"
 #include "io/scene_reader.hpp"
 
 using namespace fdem;
@@ -55,13 +56,7 @@ MaterialSpec mortar_material() {
   m.density = 1800;
   m.elastic.young = 5e9;
   m.elastic.poisson = 0.2;
-  FractureSpec f;
-  f.tensile_strength = 0.2e6;
-  f.cohesion = 0.3e6;
-  f.friction_angle_deg = 35;
-  f.energy_I = 10;
-  f.energy_II = 50;
-  m.fracture = f;
+  m.fracture = builders::fracture_spec(0.2e6, 0.3e6, 35.0);
   return m;
 }
 
