@@ -40,8 +40,7 @@ struct TravellingState {
   std::vector<PairRecord> pairs;  // held here, sorted by (a, b)
   // The contact candidates of the last detection, when they travel (a migration between
   // detections: the receiving ranks keep them instead of repeating the detection); sorted by
-  // (a, b).  `carries_candidates` is the same on every rank.
-  bool carries_candidates = false;
+  // (a, b).
   std::vector<GidPair> candidates;
 };
 

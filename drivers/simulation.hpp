@@ -136,7 +136,9 @@ class Simulation {
   void book_energy(const StepRecord& r);
   void check_step(const StepRecord& r);
   TravellingState travelling_state() const;
-  void rebind_stages(TravellingState& state, bool detected);
+  // `detected`: the contact stage has candidates to restore — those that travelled in `state`
+  // (`candidates_travelled`), or else the last detection repeated at the positions it saw.
+  void rebind_stages(TravellingState& state, bool detected, bool candidates_travelled = false);
   void write_checkpoint();
   void restore_checkpoint(const std::string& path);
   bool is_root() const;

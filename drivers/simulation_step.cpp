@@ -342,11 +342,11 @@ TravellingState Simulation::travelling_state() const {
   return state;
 }
 
-void Simulation::rebind_stages(TravellingState& state, bool detected) {
+void Simulation::rebind_stages(TravellingState& state, bool detected, bool candidates_travelled) {
   if (contact_)
     contact_->rebind(model_, std::move(state.x_at_detection), std::move(state.tet_joint_state),
                      friction_entries(state.pairs), detected,
-                     state.carries_candidates ? &state.candidates : nullptr);
+                     candidates_travelled ? &state.candidates : nullptr);
   if (joints_) joints_->rebind(model_, joint_histories(state.joint_records));
   loads_->rebind(model_);
   if (absorbing_) absorbing_->rebind(model_);
@@ -362,10 +362,8 @@ void Simulation::redistribute(bool detecting) {
   finish_halo_exchange();
   Timed timed(clocks_[migration]);
   TravellingState state = travelling_state();
-  if (contact_ && contact_->detected() && !detecting) {
-    state.carries_candidates = true;
-    state.candidates = contact_->candidate_gids(model_);
-  }
+  const bool keep_candidates = contact_ && contact_->detected() && !detecting;
+  if (keep_candidates) state.candidates = contact_->candidate_gids(model_);
   std::vector<double> contact_cost;  // per local tet, in units of one tet's internal force
   if (contact_) {
     // Relative costs from bench_contact_pair and bench_internal_forces (docs/benchmarks.md): a
@@ -378,7 +376,7 @@ void Simulation::redistribute(bool detecting) {
     for (std::size_t i = 0; i < pairs.size(); ++i)
       contact_cost[pairs[i].a] +=
           candidate_cost + (i < overlapping.size() && overlapping[i] ? overlap_cost : 0.0);
-    contact_->release_until_rebind();  // `state` holds what rebind needs; pairs are re-detected
+    contact_->release_until_rebind();  // `state` holds what rebind needs
   }
   // This rank's compute seconds since the last cycle: what a re-partition could even out.
   double busy = 0.0;
@@ -386,7 +384,7 @@ void Simulation::redistribute(bool detecting) {
     busy += clocks_[s].seconds;
   domain_->redistribute(model_, state, contact_cost, busy - busy_at_last_cycle_);
   busy_at_last_cycle_ = busy;
-  rebind_stages(state, contact_ && contact_->detected() && !detecting);
+  rebind_stages(state, keep_candidates, keep_candidates);
   moved_since_halo_ = false;
 }
 

@@ -53,16 +53,27 @@ std::unique_ptr<StepDomain> one_rank_domain();
 std::unique_ptr<StepDomain> distributed_domain(const Communicator& comm,
                                                Distribution& distribution);
 
+namespace detail {
+// Trivially copyable records as the bytes the domain moves, and back.
+template <class T>
+std::vector<char> record_bytes(const std::vector<T>& records) {
+  static_assert(std::is_trivially_copyable_v<T>, "records travel as bytes");
+  std::vector<char> bytes(records.size() * sizeof(T));
+  if (!bytes.empty()) std::memcpy(bytes.data(), records.data(), bytes.size());
+  return bytes;
+}
+template <class T>
+std::vector<T> records_of(const std::vector<char>& bytes) {
+  std::vector<T> records(bytes.size() / sizeof(T));
+  if (!records.empty()) std::memcpy(records.data(), bytes.data(), records.size() * sizeof(T));
+  return records;
+}
+}  // namespace detail
+
 // The records of every rank (trivially copyable values), concatenated in rank order.
 template <class T>
 std::vector<T> gather_records(const StepDomain& domain, const std::vector<T>& mine) {
-  static_assert(std::is_trivially_copyable_v<T>, "records travel as bytes");
-  std::vector<char> bytes(mine.size() * sizeof(T));
-  if (!bytes.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
-  bytes = domain.gather(bytes);
-  std::vector<T> all(bytes.size() / sizeof(T));
-  if (!all.empty()) std::memcpy(all.data(), bytes.data(), all.size() * sizeof(T));
-  return all;
+  return detail::records_of<T>(domain.gather(detail::record_bytes(mine)));
 }
 
 // Record i (trivially copyable) about owned tet `tets[i]` to every other rank holding a copy of
@@ -70,13 +81,8 @@ std::vector<T> gather_records(const StepDomain& domain, const std::vector<T>& mi
 template <class T>
 std::vector<T> records_to_holders(const StepDomain& domain, const std::vector<GlobalId>& tets,
                                   const std::vector<T>& records) {
-  static_assert(std::is_trivially_copyable_v<T>, "records travel as bytes");
-  std::vector<char> bytes(records.size() * sizeof(T));
-  if (!bytes.empty()) std::memcpy(bytes.data(), records.data(), bytes.size());
-  bytes = domain.send_to_holders(tets, bytes, sizeof(T));
-  std::vector<T> arrived(bytes.size() / sizeof(T));
-  if (!arrived.empty()) std::memcpy(arrived.data(), bytes.data(), arrived.size() * sizeof(T));
-  return arrived;
+  return detail::records_of<T>(
+      domain.send_to_holders(tets, detail::record_bytes(records), sizeof(T)));
 }
 
 }  // namespace fdem

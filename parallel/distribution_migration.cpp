@@ -88,11 +88,9 @@ void Distribution::move_rows(Model& source, TravellingState& source_state, std::
   source.tets = TetArrays{};
   source.joints = JointArrays{};
   source.tet_force_order = {};
-  const bool carries_candidates = source_state.carries_candidates;
   source_state = TravellingState{};
   std::vector<char> receive = exchange_rows(send, send_counts);
   assemble({&receive, &own}, out, out_state);
-  out_state.carries_candidates = carries_candidates;
   build_exchange(out);
 }
 

@@ -256,6 +256,14 @@ std::vector<Row> rows_for(int from, int to) {
   for (int k = 0; k < n; ++k) rows.push_back({from, to, k, 0.5 * k + from - to});
   return rows;
 }
+// Whether `got` (received by rank `me`) holds `expected`'s rows, in order, meant for `me`.
+bool same_rows(const std::vector<Row>& got, const std::vector<Row>& expected, int me) {
+  bool same = got.size() == expected.size();
+  for (std::size_t i = 0; same && i < got.size(); ++i)
+    same = got[i].from == expected[i].from && got[i].to == me && got[i].k == expected[i].k &&
+           got[i].x == expected[i].x;
+  return same;
+}
 }  // namespace
 
 TEST_CASE("64-bit counts: exchanges cut into pieces give what one message gives", "[mpi]") {
@@ -282,11 +290,8 @@ TEST_CASE("64-bit counts: exchanges cut into pieces give what one message gives"
     const MessageLimit scope(limit);
     std::vector<int> sources;
     const std::vector<Row> got = comm.exchange(outbox, &sources);
-    bool same = got.size() == whole.size() && sources == whole_sources;
-    for (std::size_t i = 0; same && i < got.size(); ++i)
-      same = got[i].from == whole[i].from && got[i].to == me && got[i].k == whole[i].k &&
-             got[i].x == whole[i].x;
-    CHECK(same);
+    CHECK(sources == whole_sources);
+    CHECK(same_rows(got, whole, me));
     std::vector<std::int64_t> counts;
     CHECK(comm.allgatherv(local, &counts) == gathered);
     CHECK(counts == whole_counts);
@@ -332,11 +337,8 @@ TEST_CASE("sparse exchange gives what the all-to-all exchange gives, calls back 
         std::vector<int> sources, sparse_sources;
         const std::vector<Row> expected = comm.exchange(outbox, &sources);
         const std::vector<Row> got = comm.exchange_sparse(outbox, &sparse_sources);
-        bool same = got.size() == expected.size() && sparse_sources == sources;
-        for (std::size_t i = 0; same && i < got.size(); ++i)
-          same = got[i].from == expected[i].from && got[i].to == me && got[i].k == expected[i].k &&
-                 got[i].x == expected[i].x;
-        CHECK(same);
+        CHECK(sparse_sources == sources);
+        CHECK(same_rows(got, expected, me));
       }
     const std::vector<std::vector<Row>> ring = outbox_of(1);
     std::vector<Row> first = comm.exchange_sparse(ring), second = comm.exchange_sparse(ring);

@@ -421,10 +421,8 @@ TEST_CASE(
       move(local, 0.002);  // within buffer / 2 of the detection: no detection due
       state = TravellingState{};
       state.x_at_detection = stage->x_at_detection();
-      state.carries_candidates = true;
       state.candidates = stage->candidate_gids(local);
       d.redistribute(local, state, {}, 0.0);
-      CHECK(state.carries_candidates);
       // What travelled, against the detection repeated at the positions it saw.
       auto travelled = std::make_unique<ContactStage>(local, ContactSettings{buffer});
       travelled->rebind(local, state.x_at_detection, {}, {}, true, &state.candidates);
