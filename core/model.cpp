@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/fields.hpp"
 
 namespace fdem {
 
@@ -17,16 +18,35 @@ LocalIndex local_count(std::size_t n, const char* what) {
   return static_cast<LocalIndex>(n);
 }
 
+// A member added to one of the array structs without a line in its field table
+// (core/fields.hpp) fails here: the structs hold their identity and roles and the tables' arrays.
+namespace {
+using AnyArray = std::vector<double>;
+struct NodeArraysShape {
+  LocalIndex n_owned;
+  std::vector<GlobalId> gid;
+  AnyArray fields[std::tuple_size_v<decltype(node_fields)>];
+};
+struct TetArraysShape {
+  LocalIndex n_owned;
+  std::vector<GlobalId> gid;
+  std::vector<LocalIndex> nodes;
+  AnyArray fields[std::tuple_size_v<decltype(tet_fields)>];
+  std::vector<std::uint8_t> enclosed, owned, active;
+};
+struct JointArraysShape {
+  std::vector<GlobalId> gid;
+  std::vector<LocalIndex> nodes, tets;
+  AnyArray fields[std::tuple_size_v<decltype(joint_fields)>];
+};
+static_assert(sizeof(NodeArrays) == sizeof(NodeArraysShape), "node field without a table line");
+static_assert(sizeof(TetArrays) == sizeof(TetArraysShape), "tet field without a table line");
+static_assert(sizeof(JointArrays) == sizeof(JointArraysShape), "joint field without a table line");
+}  // namespace
+
 void NodeArrays::resize(LocalIndex n) {
   resize_exact(gid, static_cast<std::size_t>(n));
-  resize_exact(x, static_cast<std::size_t>(3 * n));
-  resize_exact(x0, static_cast<std::size_t>(3 * n));
-  resize_exact(v, static_cast<std::size_t>(3 * n));
-  resize_exact(f, static_cast<std::size_t>(3 * n));
-  resize_exact(mass, static_cast<std::size_t>(n));
-  resize_exact(piece, static_cast<std::size_t>(n));
-  resize_exact(constrained, static_cast<std::size_t>(n));
-  resize_exact(prescribed_velocity, static_cast<std::size_t>(3 * n));
+  for (const auto& field : node_fields) field.resize(*this, static_cast<std::size_t>(n));
 }
 
 LocalIndex NodeArrays::find(GlobalId id) const {
@@ -44,23 +64,14 @@ LocalIndex TetArrays::find(GlobalId id) const {
 void TetArrays::resize(LocalIndex n) {
   resize_exact(gid, static_cast<std::size_t>(n));
   resize_exact(nodes, static_cast<std::size_t>(4 * n));
-  resize_exact(dm_inv, static_cast<std::size_t>(9 * n));
-  resize_exact(volume0, static_cast<std::size_t>(n));
-  resize_exact(material, static_cast<std::size_t>(n));
-  resize_exact(piece, static_cast<std::size_t>(n));
-  resize_exact(viscosity, static_cast<std::size_t>(n));
+  for (const auto& field : tet_fields) field.resize(*this, static_cast<std::size_t>(n));
 }
 
 void JointArrays::resize(LocalIndex n) {
   resize_exact(gid, static_cast<std::size_t>(n));
   resize_exact(nodes, static_cast<std::size_t>(6 * n));
   resize_exact(tets, static_cast<std::size_t>(2 * n));
-  resize_exact(area0, static_cast<std::size_t>(n));
-  resize_exact(law, static_cast<std::size_t>(n));
-  resize_exact(broken, static_cast<std::size_t>(n), 0);
-  resize_exact(mode, static_cast<std::size_t>(n), 0);
-  resize_exact(failure_time, static_cast<std::size_t>(n), -1.0);
-  resize_exact(damage, static_cast<std::size_t>(n), 0.0);
+  for (const auto& field : joint_fields) field.resize(*this, static_cast<std::size_t>(n));
 }
 
 void PieceTable::add_body(std::int32_t pieces) {

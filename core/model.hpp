@@ -1,5 +1,6 @@
 // Run-time state of the engine: structure-of-arrays with global ids and [owned | ghost] ranges.
-// Physics kernels read and write these flat arrays; nothing here knows about MPI.
+// Physics kernels read and write these flat arrays; nothing here knows about MPI.  Every per-entry
+// field is declared once more, with what it takes part in, in core/fields.hpp.
 #pragma once
 
 #include <string>
@@ -53,7 +54,7 @@ struct TetArrays {
   // Contact group: tets of one group never contact each other.  A body without joints is one
   // group per piece; in a body with `joints: all` every tet is its own group (its neighbours are
   // held by joints, and become contact partners when those break).  Empty: the piece is the group
-  // (models assembled by hand).  Not touched by resize().
+  // (models assembled by hand); resize() keeps it empty.
   std::vector<std::int32_t> contact_group;
   // Start-up only (build_model): 1 for a tet of a `joints: all` body none of whose corners lies on
   // the body mesh's boundary — while that body's joints hold nothing can reach it, so the contact

@@ -4,6 +4,9 @@
 #include <initializer_list>
 #include <vector>
 
+#include "core/error.hpp"
+#include "core/fields.hpp"
+
 namespace fdem {
 
 namespace {
@@ -41,7 +44,27 @@ std::uint64_t sum_of_node_hashes(const NodeArrays& nodes, LocalIndex count, Glob
 }  // namespace
 
 std::uint64_t state_hash(const NodeArrays& nodes, GlobalId gid_offset) {
-  return sum_of_node_hashes(nodes, nodes.n_owned, gid_offset, {&nodes.x, &nodes.v});
+  // The hashed fields, in table order (x, v): 3 doubles each (checked once).
+  static const std::vector<std::vector<double> NodeArrays::*> hashed = [] {
+    std::vector<std::vector<double> NodeArrays::*> members;
+    for (const auto& field : node_fields)
+      if (field.has(FieldUse::hash)) {
+        FDEM_VERIFY(field.type() == ValueType::f64 && field.components == 3,
+                    "hashed node fields are 3-vectors of doubles");
+        members.push_back(std::get<Field<NodeArrays>::F64>(field.member));
+      }
+    return members;
+  }();
+  std::uint64_t sum = 0;
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
+    std::uint64_t h = 0xcbf29ce484222325ULL;
+    const GlobalId index = nodes.gid[n] - gid_offset;
+    fnv_mix(h, &index, sizeof(GlobalId));
+    for (const auto member : hashed)
+      fnv_mix(h, (nodes.*member).data() + 3 * static_cast<std::size_t>(n), 3 * sizeof(double));
+    sum += finish(h);
+  }
+  return sum;
 }
 
 std::uint64_t reference_hash(const NodeArrays& nodes, GlobalId gid_offset) {

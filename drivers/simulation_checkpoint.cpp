@@ -17,6 +17,7 @@
 #include "fracture/joint_kernels.hpp"
 #include "fracture/joint_stage.hpp"
 #include "parallel/checkpoint.hpp"
+#include "parallel/checkpoint_fields.hpp"
 #include "parallel/communicator.hpp"
 #include "parallel/distribution.hpp"
 
@@ -57,41 +58,8 @@ void Simulation::write_checkpoint() {
                      {"state_hash", static_cast<std::int64_t>(hash)},
                      {"gid_offset", model_.gid_offset}};  // for the record: rows are gid − it
 
-  CheckpointRows rows;
-  const NodeArrays& nodes = model_.nodes;
-  const GlobalId offset = model_.gid_offset;
-  const std::vector<double>& at_detection = contact_ ? contact_->x_at_detection() : nodes.x;
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    rows.node_gid.push_back(nodes.gid[n] - offset);
-    for (int k = 0; k < 3; ++k) {
-      rows.node_x.push_back(nodes.x[3 * n + k]);
-      rows.node_v.push_back(nodes.v[3 * n + k]);
-      rows.node_x_at_detection.push_back(at_detection[3 * n + k]);
-      rows.node_prescribed_velocity.push_back(nodes.prescribed_velocity[3 * n + k]);
-    }
-  }
-  rows.joint_history_bytes = sizeof(JointHistory);
-  const JointArrays& joint_rows = model_.joints;
-  for (LocalIndex j = 0; j < joint_rows.size(); ++j) {
-    if (!model_.tets.is_owned(joint_rows.tets[2 * j])) continue;
-    rows.joint_gid.push_back(joint_rows.gid[j] - offset);
-    rows.joint_broken.push_back(joint_rows.broken[j]);
-    rows.joint_mode.push_back(joint_rows.mode[j]);
-    rows.joint_failure_time.push_back(joint_rows.failure_time[j]);
-    rows.joint_damage.push_back(joint_rows.damage[j]);
-    const auto* bytes = reinterpret_cast<const std::uint8_t*>(&joints_->history()[j]);
-    rows.joint_history.insert(rows.joint_history.end(), bytes, bytes + sizeof(JointHistory));
-  }
-  if (contact_)
-    for (const FrictionEntry& e : contact_->friction_entries()) {
-      const LocalIndex a = model_.tets.find(e.a);
-      if (a < 0 || !model_.tets.is_owned(a))
-        continue;  // the owner of the pair's first tet writes it
-      rows.friction_a.push_back(e.a - offset);
-      rows.friction_b.push_back(e.b - offset);
-      for (int k = 0; k < 3; ++k) rows.friction_spring.push_back(e.spring[k]);
-      rows.friction_stiffness.push_back(e.stiffness);
-    }
+  // Every checkpoint field of the tables (core/fields.hpp) and the stages' records.
+  const CheckpointRows rows = owned_checkpoint_rows(model_, travelling_state());
   char name[64];
   std::snprintf(name, sizeof(name), "checkpoint_%08ld.h5", steps_);
   const std::string path = (std::filesystem::path(options_.output_dir) / name).string();
@@ -132,11 +100,10 @@ void Simulation::restore_checkpoint(const std::string& path) {
                        (header.n_nodes == whole_nodes_ ? ", and other reference positions" : "") +
                        ")");
   };
-  const auto [header, rows] = read_checkpoint(path, *comm_, &wanted, same_scene);
-  if (header.n_joints > 0 && rows.joint_history_bytes != sizeof(JointHistory))
-    throw InputError("checkpoint '" + path + "' holds joint histories of " +
-                     std::to_string(rows.joint_history_bytes) + " bytes; this fdem uses " +
-                     std::to_string(sizeof(JointHistory)));
+  // The stages' state as it is, sized for the model; the rows overwrite it.
+  TravellingState state = travelling_state();
+  const CheckpointRows layout = checkpoint_layout(state.joint_record_bytes);
+  const auto [header, rows] = read_checkpoint(path, *comm_, &wanted, same_scene, &layout);
   std::map<std::string, double> doubles, scene_values;
   for (const auto& [name, value] : header.doubles) doubles[name] = value;
   const std::string prefix = restart_scene_prefix;
@@ -169,43 +136,19 @@ void Simulation::restore_checkpoint(const std::string& path) {
     return it->second;
   };
   // Rows of the entries held here (all of them when this rank holds the whole model).
-  NodeArrays& nodes = model_.nodes;
-  std::vector<double> at_detection = nodes.x;
-  for (std::size_t i = 0; i < rows.node_gid.size(); ++i) {
-    const LocalIndex local = nodes.find(rows.node_gid[i] + offset);
-    if (local < 0) continue;
-    const auto n = static_cast<std::size_t>(local);
-    for (int k = 0; k < 3; ++k) {
-      nodes.x[3 * n + k] = rows.node_x[3 * i + k];
-      nodes.v[3 * n + k] = rows.node_v[3 * i + k];
-      nodes.prescribed_velocity[3 * n + k] = rows.node_prescribed_velocity[3 * i + k];
-      at_detection[3 * n + k] = rows.node_x_at_detection[3 * i + k];
-    }
-  }
+  store_checkpoint_rows(rows, model_, state);
   // Every node of the model is restored (on N ranks, by the ranks that own them).
   const std::uint64_t restored =
-      distribution_ ? global_state_hash(model_, *comm_) : state_hash(nodes, model_.gid_offset);
+      distribution_ ? global_state_hash(model_, *comm_) : state_hash(model_.nodes, offset);
   if (static_cast<std::uint64_t>(integer("state_hash")) != restored)
     throw InputError("checkpoint corrupt: the restored state has state_hash " +
                      hash_to_hex(restored) + ", the checkpoint '" + path + "' holds " +
                      hash_to_hex(static_cast<std::uint64_t>(integer("state_hash"))));
-  JointArrays& joint_rows = model_.joints;
-  std::vector<JointHistory> history(static_cast<std::size_t>(joint_rows.size()));
-  for (std::size_t i = 0; i < rows.joint_gid.size(); ++i) {
-    const GlobalId gid = rows.joint_gid[i] + offset;
-    const auto it = std::lower_bound(joint_rows.gid.begin(), joint_rows.gid.end(), gid);
-    if (it == joint_rows.gid.end() || *it != gid) continue;
-    const auto j = static_cast<std::size_t>(it - joint_rows.gid.begin());
-    joint_rows.broken[j] = rows.joint_broken[i];
-    joint_rows.mode[j] = rows.joint_mode[i];
-    joint_rows.failure_time[j] = rows.joint_failure_time[i];
-    joint_rows.damage[j] = rows.joint_damage[i];
-    std::memcpy(&history[j], &rows.joint_history[i * sizeof(JointHistory)], sizeof(JointHistory));
-  }
-  if (joints_) joints_->rebind(model_, std::move(history));
+  if (joints_) joints_->rebind(model_, joint_histories(state.joint_records));
   if (contact_) {
     // A tet's joint state: cracked once one of its joints broke, intact while it has joints.
     std::vector<std::uint8_t> joint_state = contact_->tet_joint_states();
+    const JointArrays& joint_rows = model_.joints;
     // A body with a broken joint anywhere (on any rank) has no enclosed tets left out.
     std::vector<std::int32_t> cracked(static_cast<std::size_t>(model_.pieces.bodies()), 0);
     for (LocalIndex j = 0; j < joint_rows.size(); ++j)
@@ -218,19 +161,8 @@ void Simulation::restore_checkpoint(const std::string& path) {
     comm_->max_in_place(cracked);
     for (std::size_t b = 0; b < cracked.size(); ++b)
       if (cracked[b]) contact_->crack_body(static_cast<std::int32_t>(b));
-    std::vector<FrictionEntry> friction;  // the pairs whose first tet is held here
-    for (std::size_t i = 0; i < rows.friction_a.size(); ++i) {
-      FrictionEntry e;
-      e.a = rows.friction_a[i] + offset;
-      e.b = rows.friction_b[i] + offset;
-      if (!std::binary_search(model_.tets.gid.begin(), model_.tets.gid.end(), e.a)) continue;
-      e.spring = Vec3(rows.friction_spring[3 * i], rows.friction_spring[3 * i + 1],
-                      rows.friction_spring[3 * i + 2]);
-      e.stiffness = rows.friction_stiffness[i];
-      friction.push_back(e);
-    }
-    contact_->rebind(model_, std::move(at_detection), std::move(joint_state), friction,
-                     integer("contact_detected") != 0);
+    contact_->rebind(model_, std::move(state.x_at_detection), std::move(joint_state),
+                     friction_entries(state.pairs), integer("contact_detected") != 0);
   }
   time_ = number("time");
   steps_ = integer("steps");

@@ -42,28 +42,35 @@ void check_run_names(const CheckpointHeader& header) {
   for (const auto& entry : header.integers) check(entry.first);
 }
 
+void check_columns(const std::vector<CheckpointColumn>& columns, std::size_t rows,
+                   const char* group) {
+  std::set<std::string> names{"gid", "a", "b"};
+  for (const CheckpointColumn& c : columns) {
+    FDEM_VERIFY(!c.name.empty() && c.name.find_first_of("/: ") == std::string::npos,
+                std::string("checkpoint dataset name '") + c.name + "' in " + group);
+    FDEM_VERIFY(names.insert(c.name).second,
+                std::string("checkpoint dataset ") + group + "/" + c.name + " given twice");
+    FDEM_VERIFY(c.size() == c.components * rows,
+                std::string("checkpoint dataset ") + group + "/" + c.name + " does not have " +
+                    std::to_string(c.components) + " values per row");
+  }
+}
+
 void check_local_rows(const CheckpointHeader& header, const CheckpointRows& rows) {
   FDEM_VERIFY(header.n_nodes >= 0 && header.n_tets >= 0 && header.n_joints >= 0,
               "checkpoint header has a negative count");
   check_run_names(header);
-  const std::size_t nodes = rows.node_gid.size();
-  FDEM_VERIFY(rows.node_x.size() == 3 * nodes && rows.node_v.size() == 3 * nodes &&
-                  rows.node_x_at_detection.size() == 3 * nodes &&
-                  rows.node_prescribed_velocity.size() == 3 * nodes,
-              "checkpoint node arrays are not 3 values per node gid");
-  const std::size_t joints = rows.joint_gid.size();
-  FDEM_VERIFY(rows.joint_broken.size() == joints && rows.joint_mode.size() == joints &&
-                  rows.joint_failure_time.size() == joints && rows.joint_damage.size() == joints &&
-                  rows.joint_history.size() == joints * rows.joint_history_bytes,
-              "checkpoint joint arrays do not match the joint gids");
-  const std::size_t pairs = rows.friction_a.size();
-  FDEM_VERIFY(rows.friction_b.size() == pairs && rows.friction_spring.size() == 3 * pairs &&
-                  rows.friction_stiffness.size() == pairs,
-              "checkpoint friction arrays do not match the pair count");
+  check_columns(rows.nodes.columns, rows.nodes.gid.size(), "/nodes");
+  check_columns(rows.joints.columns, rows.joints.gid.size(), "/joints");
+  const std::size_t pairs = rows.pair_a.size();
+  FDEM_VERIFY(rows.pair_b.size() == pairs, "checkpoint friction pairs: as many b as a");
+  check_columns(rows.pair_columns, pairs, "/friction");
+  for (const CheckpointColumn& c : rows.pair_columns)
+    FDEM_VERIFY(c.type() == ValueType::f64, "checkpoint pair datasets are float64");
   for (std::size_t k = 0; k < pairs; ++k)
-    FDEM_VERIFY(rows.friction_a[k] < rows.friction_b[k],
-                "checkpoint friction pair without a < b: (" + std::to_string(rows.friction_a[k]) +
-                    ", " + std::to_string(rows.friction_b[k]) + ")");
+    FDEM_VERIFY(rows.pair_a[k] < rows.pair_b[k], "checkpoint friction pair without a < b: (" +
+                                                     std::to_string(rows.pair_a[k]) + ", " +
+                                                     std::to_string(rows.pair_b[k]) + ")");
   auto check_gids = [](const std::vector<GlobalId>& gids, std::int64_t n, const char* what) {
     std::vector<GlobalId> sorted = gids;
     std::sort(sorted.begin(), sorted.end());
@@ -76,8 +83,8 @@ void check_local_rows(const CheckpointHeader& header, const CheckpointRows& rows
                                                             " given twice on one rank");
     }
   };
-  check_gids(rows.node_gid, header.n_nodes, "node");
-  check_gids(rows.joint_gid, header.n_joints, "joint");
+  check_gids(rows.nodes.gid, header.n_nodes, "node");
+  check_gids(rows.joints.gid, header.n_joints, "joint");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -183,57 +190,74 @@ struct FileBlock {
   std::map<std::string, std::uint64_t> checksums;   // of every dataset, over all ranks
 };
 
+// Every dataset by its full name, with its rows here and the file row of the first.
+template <class F>
+void for_each_dataset(const FileBlock& block, F&& f) {
+  const CheckpointRows& r = block.rows;
+  const auto table = [&](const std::string& group, const CheckpointTable& t, std::uint64_t first) {
+    f(group + "/gid", CheckpointValues{}, 1, first, &t.gid);
+    for (const CheckpointColumn& c : t.columns)
+      f(group + "/" + c.name, c.values, c.components, first, nullptr);
+  };
+  table("/nodes", r.nodes, block.nodes.start);
+  table("/joints", r.joints, block.joints.start);
+  f("/friction/a", CheckpointValues{}, 1, block.friction_offset, &r.pair_a);
+  f("/friction/b", CheckpointValues{}, 1, block.friction_offset, &r.pair_b);
+  for (const CheckpointColumn& c : r.pair_columns)
+    f("/friction/" + c.name, c.values, c.components, block.friction_offset, nullptr);
+}
+
 // Every dataset's checksum (checkpoint_checksum.hpp): this rank's rows, summed over the ranks.
 // Collective.
 void compute_checksums(const Communicator& comm, FileBlock& block) {
-  const CheckpointRows& r = block.rows;
-  const std::uint64_t node0 = block.nodes.start, joint0 = block.joints.start;
-  const std::uint64_t pair0 = block.friction_offset;
-  const std::vector<std::pair<std::string, std::uint64_t>> local = {
-      {"/nodes/gid", rows_checksum("/nodes/gid", r.node_gid, 1, node0)},
-      {"/nodes/x", rows_checksum("/nodes/x", r.node_x, 3, node0)},
-      {"/nodes/v", rows_checksum("/nodes/v", r.node_v, 3, node0)},
-      {"/nodes/x_at_detection",
-       rows_checksum("/nodes/x_at_detection", r.node_x_at_detection, 3, node0)},
-      {"/nodes/prescribed_velocity",
-       rows_checksum("/nodes/prescribed_velocity", r.node_prescribed_velocity, 3, node0)},
-      {"/joints/gid", rows_checksum("/joints/gid", r.joint_gid, 1, joint0)},
-      {"/joints/broken", rows_checksum("/joints/broken", r.joint_broken, 1, joint0)},
-      {"/joints/mode", rows_checksum("/joints/mode", r.joint_mode, 1, joint0)},
-      {"/joints/failure_time",
-       rows_checksum("/joints/failure_time", r.joint_failure_time, 1, joint0)},
-      {"/joints/damage", rows_checksum("/joints/damage", r.joint_damage, 1, joint0)},
-      {"/joints/history",
-       rows_checksum("/joints/history", r.joint_history, r.joint_history_bytes, joint0)},
-      {"/friction/a", rows_checksum("/friction/a", r.friction_a, 1, pair0)},
-      {"/friction/b", rows_checksum("/friction/b", r.friction_b, 1, pair0)},
-      {"/friction/spring", rows_checksum("/friction/spring", r.friction_spring, 3, pair0)},
-      {"/friction/stiffness",
-       rows_checksum("/friction/stiffness", r.friction_stiffness, 1, pair0)}};
+  std::vector<std::string> names;
   std::vector<std::uint64_t> sums;
-  for (const auto& entry : local) sums.push_back(entry.second);
+  for_each_dataset(
+      block, [&](const std::string& name, const CheckpointValues& values, std::size_t width,
+                 std::uint64_t first, const std::vector<GlobalId>* gids) {
+        names.push_back(name);
+        sums.push_back(
+            gids ? rows_checksum(name, *gids, 1, first)
+                 : std::visit([&](const auto& v) { return rows_checksum(name, v, width, first); },
+                              values));
+      });
   comm.sum_in_place(sums);  // unsigned: wraps mod 2^64, the same on any rank count
-  for (std::size_t i = 0; i < local.size(); ++i) block.checksums[local[i].first] = sums[i];
+  for (std::size_t i = 0; i < names.size(); ++i) block.checksums[names[i]] = sums[i];
 }
 
 // ---------------------------------------------------------------------------------------------
 // Writing.
 
 // Where every dataset's raw data lies in the file (for the seal).  Collective (metadata reads).
-std::vector<FileRegion> data_regions(const Context& ctx, hid_t file) {
+std::vector<FileRegion> data_regions(const Context& ctx, hid_t file, const FileBlock& block) {
   std::vector<FileRegion> regions;
-  for (const char* name :
-       {"/nodes/gid", "/nodes/x", "/nodes/v", "/nodes/x_at_detection", "/nodes/prescribed_velocity",
-        "/joints/gid", "/joints/broken", "/joints/mode", "/joints/failure_time", "/joints/damage",
-        "/joints/history", "/friction/a", "/friction/b", "/friction/spring",
-        "/friction/stiffness"}) {
+  for (const auto& entry : block.checksums) {
+    const std::string& name = entry.first;
     Handle dataset =
-        ctx.own(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, std::string("cannot open ") + name);
+        ctx.own(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "cannot open " + name);
     const haddr_t address = H5Dget_offset(dataset.get());  // from the start of the file
     const hsize_t size = H5Dget_storage_size(dataset.get());
     if (address != HADDR_UNDEF && size > 0) regions.push_back({address, size});
   }
   return regions;
+}
+
+// One column of `n` rows, this rank's in `runs`.
+void write_column(const Context& ctx, const Writer& write, hid_t group, const CheckpointColumn& c,
+                  hsize_t n, const std::vector<Run>& runs, std::uint64_t checksum) {
+  if (c.components == 0) {  // n × 0, so that the record size is visible in the file
+    Handle space = make_space(ctx, {n, 0});
+    const Handle empty = ctx.own(H5Dcreate2(group, c.name.c_str(), H5T_STD_U8LE, space.get(),
+                                            H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                                 H5Dclose, "cannot create dataset " + c.name);
+    write.attribute(empty.get(), "checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &checksum);
+    return;
+  }
+  std::visit(
+      [&](const auto& values) {
+        write.rows(group, c.name.c_str(), n, file_width(c), values, runs, checksum);
+      },
+      c.values);
 }
 
 // Writes the file; returns where its datasets' raw data lie.
@@ -250,11 +274,12 @@ std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_pa
   });
 
   // Root attributes and the named run values.
+  const CheckpointRows& rows = block.rows;
   comm.run_collectively([&] {
     const Writer write(ctx, file.get());
     const hid_t root = file.get();
     const std::int32_t version = checkpoint_format_version, ranks = comm.size();
-    const auto history_bytes = static_cast<std::int64_t>(block.rows.joint_history_bytes);
+    const std::string fields = rows.field_list();
     write.string_attribute(root, "format", format_name);
     write.attribute(root, "version", H5T_STD_I32LE, H5T_NATIVE_INT32, &version);
     write.attribute(root, "ranks", H5T_STD_I32LE, H5T_NATIVE_INT32, &ranks);
@@ -263,8 +288,8 @@ std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_pa
     write.attribute(root, "n_joints", H5T_STD_I64LE, H5T_NATIVE_INT64, &header.n_joints);
     write.attribute(root, "reference_hash", H5T_STD_U64LE, H5T_NATIVE_UINT64,
                     &header.reference_hash);
-    write.attribute(root, "joint_history_bytes", H5T_STD_I64LE, H5T_NATIVE_INT64, &history_bytes);
-    const std::uint64_t checksum = header_checksum(serialized(header), history_bytes);
+    write.string_attribute(root, "fields", fields);
+    const std::uint64_t checksum = header_checksum(serialized(header), fields);
     write.attribute(root, "header_checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &checksum);
     Handle run = write.group("run", /*track_attribute_order=*/true);
     for (const auto& [name, value] : header.doubles)
@@ -274,72 +299,38 @@ std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_pa
   });
 
   // Nodes and joints: this rank's block of gids, one hyperslab per dataset.
-  const CheckpointRows& rows = block.rows;
-  comm.run_collectively([&] {
-    const Writer write(ctx, file.get());
-    const auto n = static_cast<hsize_t>(header.n_nodes);
-    std::vector<Run> runs;
-    if (block.nodes.count > 0) runs.push_back(block.nodes);
-    Handle nodes = write.group("nodes");
-    write.rows(nodes.get(), "gid", n, 0, rows.node_gid, runs, block.checksums.at("/nodes/gid"));
-    write.rows(nodes.get(), "x", n, 3, rows.node_x, runs, block.checksums.at("/nodes/x"));
-    write.rows(nodes.get(), "v", n, 3, rows.node_v, runs, block.checksums.at("/nodes/v"));
-    write.rows(nodes.get(), "x_at_detection", n, 3, rows.node_x_at_detection, runs,
-               block.checksums.at("/nodes/x_at_detection"));
-    write.rows(nodes.get(), "prescribed_velocity", n, 3, rows.node_prescribed_velocity, runs,
-               block.checksums.at("/nodes/prescribed_velocity"));
-  });
-
-  comm.run_collectively([&] {
-    const Writer write(ctx, file.get());
-    const auto n = static_cast<hsize_t>(header.n_joints);
-    const hsize_t bytes = rows.joint_history_bytes;
-    std::vector<Run> runs;
-    if (block.joints.count > 0) runs.push_back(block.joints);
-    Handle joints = write.group("joints");
-    write.rows(joints.get(), "gid", n, 0, rows.joint_gid, runs, block.checksums.at("/joints/gid"));
-    write.rows(joints.get(), "broken", n, 0, rows.joint_broken, runs,
-               block.checksums.at("/joints/broken"));
-    write.rows(joints.get(), "mode", n, 0, rows.joint_mode, runs,
-               block.checksums.at("/joints/mode"));
-    write.rows(joints.get(), "failure_time", n, 0, rows.joint_failure_time, runs,
-               block.checksums.at("/joints/failure_time"));
-    write.rows(joints.get(), "damage", n, 0, rows.joint_damage, runs,
-               block.checksums.at("/joints/damage"));
-    // history is n × bytes even for bytes = 0, so the record size is visible in the file.
-    if (bytes == 0) {
-      Handle history_space = make_space(ctx, {n, bytes});
-      const Handle empty_history =
-          ctx.own(H5Dcreate2(joints.get(), "history", H5T_STD_U8LE, history_space.get(),
-                             H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                  H5Dclose, "cannot create dataset history");
-      const std::uint64_t none = 0;  // no rows
-      write.attribute(empty_history.get(), "checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &none);
-    } else {
-      write.rows(joints.get(), "history", n, bytes, rows.joint_history, runs,
-                 block.checksums.at("/joints/history"));
-    }
-  });
+  const auto write_table = [&](const char* group, const CheckpointTable& table, hsize_t n,
+                               Run rows_here) {
+    comm.run_collectively([&] {
+      const Writer write(ctx, file.get());
+      std::vector<Run> runs;
+      if (rows_here.count > 0) runs.push_back(rows_here);
+      Handle handle = write.group(group);
+      const std::string prefix = std::string("/") + group + "/";
+      write.rows(handle.get(), "gid", n, 0, table.gid, runs, block.checksums.at(prefix + "gid"));
+      for (const CheckpointColumn& c : table.columns)
+        write_column(ctx, write, handle.get(), c, n, runs, block.checksums.at(prefix + c.name));
+    });
+  };
+  write_table("nodes", rows.nodes, static_cast<hsize_t>(header.n_nodes), block.nodes);
+  write_table("joints", rows.joints, static_cast<hsize_t>(header.n_joints), block.joints);
 
   // Friction pairs: this rank's rows after those of the lower ranks.
   comm.run_collectively([&] {
     const Writer write(ctx, file.get());
     const hsize_t offset = block.friction_offset, total = block.friction_total;
     std::vector<Run> runs;
-    if (!rows.friction_a.empty()) runs.push_back({offset, rows.friction_a.size()});
+    if (!rows.pair_a.empty()) runs.push_back({offset, rows.pair_a.size()});
     Handle friction = write.group("friction");
-    write.rows(friction.get(), "a", total, 0, rows.friction_a, runs,
-               block.checksums.at("/friction/a"));
-    write.rows(friction.get(), "b", total, 0, rows.friction_b, runs,
-               block.checksums.at("/friction/b"));
-    write.rows(friction.get(), "spring", total, 3, rows.friction_spring, runs,
-               block.checksums.at("/friction/spring"));
-    write.rows(friction.get(), "stiffness", total, 0, rows.friction_stiffness, runs,
-               block.checksums.at("/friction/stiffness"));
+    write.rows(friction.get(), "a", total, 0, rows.pair_a, runs, block.checksums.at("/friction/a"));
+    write.rows(friction.get(), "b", total, 0, rows.pair_b, runs, block.checksums.at("/friction/b"));
+    for (const CheckpointColumn& c : rows.pair_columns)
+      write_column(ctx, write, friction.get(), c, total, runs,
+                   block.checksums.at("/friction/" + c.name));
   });
 
   std::vector<FileRegion> regions;
-  comm.run_collectively([&] { regions = data_regions(ctx, file.get()); });
+  comm.run_collectively([&] { regions = data_regions(ctx, file.get(), block); });
   // Flush to storage (MPI_File_sync), then close: only a complete file gets the final name.
   comm.run_collectively([&] {
     ctx.check_collective_write(H5Fflush(file.get(), H5F_SCOPE_GLOBAL),
@@ -349,12 +340,21 @@ std::vector<FileRegion> write_file(const Context& ctx, const std::string& tmp_pa
   return regions;
 }
 
-// The file's size, about: its datasets (bytes per row) and 1 MiB for metadata.
-double estimated_file_bytes(const CheckpointHeader& header, std::size_t history_bytes,
+// Bytes per row of a group's datasets (its gid included).
+double row_bytes(const std::vector<CheckpointColumn>& columns, double keys) {
+  double bytes = 8.0 * keys;
+  for (const CheckpointColumn& c : columns)
+    bytes += double(c.components) *
+             std::visit([](const auto& v) { return double(sizeof(v[0])); }, c.values);
+  return bytes;
+}
+
+// The file's size, about: its datasets and 1 MiB for metadata.
+double estimated_file_bytes(const CheckpointHeader& header, const CheckpointRows& rows,
                             std::int64_t friction_pairs) {
-  return double(header.n_nodes) * (8 + 4 * 24) +
-         double(header.n_joints) * (8 + 1 + 1 + 8 + 8 + double(history_bytes)) +
-         double(friction_pairs) * (8 + 8 + 24 + 8) + 1048576.0;
+  return double(header.n_nodes) * row_bytes(rows.nodes.columns, 1) +
+         double(header.n_joints) * row_bytes(rows.joints.columns, 1) +
+         double(friction_pairs) * row_bytes(rows.pair_columns, 2) + 1048576.0;
 }
 
 }  // namespace
@@ -370,16 +370,17 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
   //    that no rank is left alone in a collective HDF5 call).
   comm.run_collectively([&] { check_local_rows(header, owned); });
   const std::string root_header = comm.broadcast(serialized(header), 0);
-  const auto history_bytes = static_cast<std::uint64_t>(owned.joint_history_bytes);
-  const bool same_history_bytes = comm.min(history_bytes) == comm.max(history_bytes);
+  const std::string root_fields = comm.broadcast(owned.field_list(), 0);
   comm.run_collectively([&] {
     FDEM_VERIFY(root_header == serialized(header),
                 "checkpoint header differs between rank 0 and rank " + std::to_string(comm.rank()));
-    FDEM_VERIFY(same_history_bytes, "checkpoint joint_history_bytes differs between ranks");
+    FDEM_VERIFY(
+        root_fields == owned.field_list(),
+        "checkpoint datasets differ between rank 0 and rank " + std::to_string(comm.rank()));
   });
   // Rows to the ranks of their file blocks; the block ranks see whether every gid arrived once.
-  const BlockExchange node_exchange(comm, owned.node_gid, header.n_nodes, "node");
-  const BlockExchange joint_exchange(comm, owned.joint_gid, header.n_joints, "joint");
+  const BlockExchange node_exchange(comm, owned.nodes.gid, header.n_nodes, "node");
+  const BlockExchange joint_exchange(comm, owned.joints.gid, header.n_joints, "joint");
   comm.run_collectively([&] {
     FDEM_VERIFY(node_exchange.problem().empty(), "checkpoint rows: " + node_exchange.problem());
     FDEM_VERIFY(joint_exchange.problem().empty(), "checkpoint rows: " + joint_exchange.problem());
@@ -388,26 +389,26 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
   block.nodes = node_exchange.block();
   block.joints = joint_exchange.block();
   CheckpointRows& rows = block.rows;
-  rows.node_gid.resize(block.nodes.count);
-  std::iota(rows.node_gid.begin(), rows.node_gid.end(), GlobalId(block.nodes.start));
-  rows.node_x = node_exchange.to_block(owned.node_x, 3);
-  rows.node_v = node_exchange.to_block(owned.node_v, 3);
-  rows.node_x_at_detection = node_exchange.to_block(owned.node_x_at_detection, 3);
-  rows.node_prescribed_velocity = node_exchange.to_block(owned.node_prescribed_velocity, 3);
-  rows.joint_gid.resize(block.joints.count);
-  std::iota(rows.joint_gid.begin(), rows.joint_gid.end(), GlobalId(block.joints.start));
-  rows.joint_broken = joint_exchange.to_block(owned.joint_broken, 1);
-  rows.joint_mode = joint_exchange.to_block(owned.joint_mode, 1);
-  rows.joint_failure_time = joint_exchange.to_block(owned.joint_failure_time, 1);
-  rows.joint_damage = joint_exchange.to_block(owned.joint_damage, 1);
-  rows.joint_history_bytes = owned.joint_history_bytes;
-  rows.joint_history = joint_exchange.to_block(owned.joint_history, owned.joint_history_bytes);
-  rows.friction_a = owned.friction_a;
-  rows.friction_b = owned.friction_b;
-  rows.friction_spring = owned.friction_spring;
-  rows.friction_stiffness = owned.friction_stiffness;
+  const auto to_block = [](const BlockExchange& exchange, const CheckpointTable& from, Run run,
+                           CheckpointTable& to) {
+    to.gid.resize(run.count);
+    std::iota(to.gid.begin(), to.gid.end(), GlobalId(run.start));
+    for (const CheckpointColumn& c : from.columns) {
+      CheckpointColumn& column = to.columns.emplace_back();
+      column.name = c.name;
+      column.components = c.components;
+      column.values = std::visit(
+          [&](const auto& v) { return CheckpointValues(exchange.to_block(v, c.components)); },
+          c.values);
+    }
+  };
+  to_block(node_exchange, owned.nodes, block.nodes, rows.nodes);
+  to_block(joint_exchange, owned.joints, block.joints, rows.joints);
+  rows.pair_a = owned.pair_a;
+  rows.pair_b = owned.pair_b;
+  rows.pair_columns = owned.pair_columns;
   const std::vector<std::int64_t> pair_counts =
-      comm.allgather(static_cast<std::int64_t>(rows.friction_a.size()));
+      comm.allgather(static_cast<std::int64_t>(rows.pair_a.size()));
   for (int r = 0; r < comm.size(); ++r) {
     if (r < comm.rank()) block.friction_offset += static_cast<hsize_t>(pair_counts[r]);
     block.friction_total += static_cast<hsize_t>(pair_counts[r]);
@@ -418,9 +419,9 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
   //    every rank unwinds (closing the file together) and rank 0 removes the partial file.
   comm.run_collectively([&] {
     if (comm.is_root())
-      reserve_space(ctx, tmp_path,
-                    estimated_file_bytes(header, owned.joint_history_bytes,
-                                         static_cast<std::int64_t>(block.friction_total)));
+      reserve_space(
+          ctx, tmp_path,
+          estimated_file_bytes(header, owned, static_cast<std::int64_t>(block.friction_total)));
   });
   std::vector<FileRegion> regions;
   {
@@ -449,6 +450,49 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
     }
     sync_directory_of(path);
   });
+}
+
+// ---------------------------------------------------------------------------------------------
+std::string CheckpointColumn::description() const {
+  return name + ":" + value_type_name(type()) + "[" + std::to_string(components) + "]";
+}
+
+const CheckpointColumn& CheckpointTable::column(const std::string& name) const {
+  for (const CheckpointColumn& c : columns)
+    if (c.name == name) return c;
+  FDEM_VERIFY(false, "checkpoint rows have a column '" + name + "'");
+  return columns.front();
+}
+
+std::string CheckpointRows::field_list() const {
+  std::string text;
+  const auto add = [&](const char* group, const std::vector<CheckpointColumn>& list) {
+    for (const CheckpointColumn& c : list)
+      text += (text.empty() ? "" : " ") + std::string(group) + "/" + c.description();
+  };
+  add("nodes", nodes.columns);
+  add("joints", joints.columns);
+  add("friction", pair_columns);
+  return text;
+}
+
+CheckpointRows CheckpointRows::layout() const {
+  CheckpointRows empty;
+  const auto strip = [](const std::vector<CheckpointColumn>& from) {
+    std::vector<CheckpointColumn> out;
+    for (const CheckpointColumn& c : from) {
+      CheckpointColumn& column = out.emplace_back();
+      column.name = c.name;
+      column.components = c.components;
+      column.values = std::visit(
+          [](const auto& v) { return CheckpointValues(std::decay_t<decltype(v)>{}); }, c.values);
+    }
+    return out;
+  };
+  empty.nodes.columns = strip(nodes.columns);
+  empty.joints.columns = strip(joints.columns);
+  empty.pair_columns = strip(pair_columns);
+  return empty;
 }
 
 }  // namespace fdem

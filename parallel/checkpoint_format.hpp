@@ -3,6 +3,8 @@
 // that rank r writes and reads (parallel/gid_blocks).  Internal to parallel/.
 #pragma once
 
+#include <hdf5.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
@@ -33,10 +35,15 @@ inline std::string serialized(const CheckpointHeader& header) {
   return out.str();
 }
 
-// The checksum of the header (root counts and /run values).
+// The checksum of the header (root counts, /run values and the field list).
 inline std::uint64_t header_checksum(const std::string& serialized_header,
-                                     std::int64_t history_bytes) {
-  return text_checksum(serialized_header + " h:" + std::to_string(history_bytes));
+                                     const std::string& field_list) {
+  return text_checksum(serialized_header + " f:" + field_list);
+}
+
+// Dataset shape of a column: [rows] for one component, else [rows][components].
+inline hsize_t file_width(const CheckpointColumn& column) {
+  return column.components == 1 ? 0 : column.components;
 }
 
 // Rank r writes (and reads) rows [begin(r), begin(r + 1)).

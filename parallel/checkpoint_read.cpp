@@ -8,7 +8,9 @@
 #include <array>
 #include <filesystem>
 #include <numeric>
+#include <sstream>
 #include <type_traits>
+#include <variant>
 
 #include "core/error.hpp"
 #include "parallel/checkpoint.hpp"
@@ -216,11 +218,12 @@ class BlockFetch {
   std::vector<int> askers_;
 };
 
-// One friction pair as it travels between ranks.
+// One friction pair as it travels between ranks: its tets and up to four values (the pair
+// columns' components, in column order).
+constexpr std::size_t max_pair_values = 4;
 struct FrictionRow {
   GlobalId a, b;
-  double spring[3];  // m
-  double stiffness;  // N/m
+  double value[max_pair_values];
 };
 
 bool pair_less(const FrictionRow& p, const FrictionRow& q) {
@@ -256,6 +259,51 @@ std::vector<FrictionRow> deliver_friction(const Communicator& comm, std::int64_t
   return mine;
 }
 
+// The columns a field list ("group/name:type[components]" separated by spaces) names, with no
+// rows; an empty string when it is well formed, else what is wrong.
+std::string parse_field_list(const std::string& text, CheckpointRows& layout) {
+  std::istringstream in(text);
+  std::string item;
+  while (in >> item) {
+    const std::size_t slash = item.find('/'), colon = item.find(':'), open = item.find('['),
+                      close = item.find(']');
+    if (slash == std::string::npos || colon == std::string::npos || open == std::string::npos ||
+        close != item.size() - 1 || !(slash < colon && colon < open))
+      return "'" + item + "' is not group/name:type[components]";
+    const std::string group = item.substr(0, slash),
+                      type = item.substr(colon + 1, open - colon - 1);
+    CheckpointColumn column;
+    column.name = item.substr(slash + 1, colon - slash - 1);
+    const std::string count = item.substr(open + 1, close - open - 1);
+    if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos ||
+        count.size() > 6)
+      return "'" + item + "' has no component count";
+    column.components = std::stoul(count);
+    if (type == value_type_name(ValueType::f64))
+      column.values = std::vector<double>{};
+    else if (type == value_type_name(ValueType::i32))
+      column.values = std::vector<std::int32_t>{};
+    else if (type == value_type_name(ValueType::u8))
+      column.values = std::vector<std::uint8_t>{};
+    else
+      return "'" + item + "' has type '" + type + "' (float64, int32 or uint8)";
+    if (group == "nodes")
+      layout.nodes.columns.push_back(std::move(column));
+    else if (group == "joints")
+      layout.joints.columns.push_back(std::move(column));
+    else if (group == "friction" && type == value_type_name(ValueType::f64))
+      layout.pair_columns.push_back(std::move(column));
+    else
+      return "'" + item + "' is not in nodes, joints or friction (float64)";
+  }
+  std::size_t pair_values = 0;
+  for (const CheckpointColumn& c : layout.pair_columns) pair_values += c.components;
+  if (pair_values > max_pair_values)
+    return "friction pairs have " + std::to_string(pair_values) + " values, at most " +
+           std::to_string(max_pair_values);
+  return {};
+}
+
 // `wanted` must be ascending, without repeats, within 0..n-1.
 void check_wanted(const Context& ctx, const std::vector<GlobalId>& wanted, std::int64_t n,
                   const char* what) {
@@ -274,7 +322,7 @@ std::vector<GlobalId> all_gids(std::int64_t n) {
 
 // The header: format, version, seal, counts and run values.  Collective.
 CheckpointHeader read_header(const Context& ctx, const Communicator& comm, hid_t root,
-                             SealState sealed, std::int64_t& history_bytes) {
+                             SealState sealed, std::string& field_list) {
   CheckpointHeader header;
   comm.run_collectively([&] {
     const Reader read(ctx, root);
@@ -288,7 +336,11 @@ CheckpointHeader read_header(const Context& ctx, const Communicator& comm, hid_t
     const auto version = read.number_attribute<std::int32_t>(root, "/", "version");
     if (version != checkpoint_format_version)
       ctx.fail("has format version " + std::to_string(version) + "; this fdem reads version " +
-               std::to_string(checkpoint_format_version));
+               std::to_string(checkpoint_format_version) +
+               (version < checkpoint_format_version
+                    ? " (the file was written by an older fdem: continue it with that fdem, or "
+                      "run the scene from the start)"
+                    : " (the file was written by a newer fdem)"));
     if (comm.is_root() && sealed != SealState::intact)
       ctx.corrupt("its checksum block (the HDF5 userblock) is missing");
     header.ranks = read.number_attribute<std::int32_t>(root, "/", "ranks");
@@ -296,8 +348,8 @@ CheckpointHeader read_header(const Context& ctx, const Communicator& comm, hid_t
     header.n_tets = read.number_attribute<std::int64_t>(root, "/", "n_tets");
     header.n_joints = read.number_attribute<std::int64_t>(root, "/", "n_joints");
     header.reference_hash = read.number_attribute<std::uint64_t>(root, "/", "reference_hash");
-    history_bytes = read.number_attribute<std::int64_t>(root, "/", "joint_history_bytes");
-    if (header.n_nodes < 0 || header.n_tets < 0 || header.n_joints < 0 || history_bytes < 0)
+    field_list = read.string_attribute(root, "/", "fields");
+    if (header.n_nodes < 0 || header.n_tets < 0 || header.n_joints < 0)
       ctx.fail("has a negative count in its root attributes");
 
     Handle run = read.group("/run");
@@ -314,7 +366,7 @@ CheckpointHeader read_header(const Context& ctx, const Communicator& comm, hid_t
         ctx.fail("value /run/" + name + " is neither a floating-point number nor an integer");
     }
     const auto stored = read.number_attribute<std::uint64_t>(root, "/", "header_checksum");
-    if (header_checksum(serialized(header), history_bytes) != stored)
+    if (header_checksum(serialized(header), field_list) != stored)
       ctx.corrupt("header (the root attributes and /run values)");
   });
   return header;
@@ -326,48 +378,48 @@ struct FileBlocks {
   CheckpointRows rows;  // gids, values of the blocks; friction of the slice
 };
 
+// Rows `b` of every column of `layout` in `group` (n rows), into `out`.
+void read_columns(const Reader& read, hid_t group, const std::string& group_name,
+                  const std::vector<CheckpointColumn>& layout, hsize_t n, const std::string& why,
+                  Run b, ChecksumTally& tally, std::vector<CheckpointColumn>& out) {
+  for (const CheckpointColumn& c : layout) {
+    CheckpointColumn& column = out.emplace_back();
+    column.name = c.name;
+    column.components = c.components;
+    const std::vector<hsize_t> dims =
+        c.components == 1 ? std::vector<hsize_t>{n} : std::vector<hsize_t>{n, c.components};
+    column.values = std::visit(
+        [&](const auto& empty) {
+          using T = typename std::decay_t<decltype(empty)>::value_type;
+          return CheckpointValues(
+              read.template block<T>(group, group_name, c.name.c_str(), dims, why, b, tally));
+        },
+        c.values);
+  }
+}
+
 FileBlocks read_blocks(const Context& ctx, const Communicator& comm, hid_t file,
-                       const CheckpointHeader& header, std::int64_t history_bytes) {
+                       const CheckpointHeader& header, const CheckpointRows& layout) {
   FileBlocks blocks;
   CheckpointRows& rows = blocks.rows;
   ChecksumTally tally;
   blocks.nodes = block_of(GidBlocks{header.n_nodes, comm.size()}, comm.rank());
   blocks.joints = block_of(GidBlocks{header.n_joints, comm.size()}, comm.rank());
-  comm.run_collectively([&] {
-    const Reader read(ctx, file);
-    const auto n = static_cast<hsize_t>(header.n_nodes);
-    const std::string why = "n_nodes = " + std::to_string(n);
-    const Run b = blocks.nodes;
-    Handle nodes = read.group("/nodes");
-    rows.node_gid = read.block<GlobalId>(nodes.get(), "/nodes", "gid", {n}, why, b, tally);
-    check_dense_gids(ctx, rows.node_gid, b, "/nodes/gid");
-    rows.node_x = read.block<double>(nodes.get(), "/nodes", "x", {n, 3}, why, b, tally);
-    rows.node_v = read.block<double>(nodes.get(), "/nodes", "v", {n, 3}, why, b, tally);
-    rows.node_x_at_detection =
-        read.block<double>(nodes.get(), "/nodes", "x_at_detection", {n, 3}, why, b, tally);
-    rows.node_prescribed_velocity =
-        read.block<double>(nodes.get(), "/nodes", "prescribed_velocity", {n, 3}, why, b, tally);
-  });
-  comm.run_collectively([&] {
-    const Reader read(ctx, file);
-    const auto n = static_cast<hsize_t>(header.n_joints);
-    const auto bytes = static_cast<hsize_t>(history_bytes);
-    const std::string why = "n_joints = " + std::to_string(n);
-    const Run b = blocks.joints;
-    Handle joints = read.group("/joints");
-    rows.joint_gid = read.block<GlobalId>(joints.get(), "/joints", "gid", {n}, why, b, tally);
-    check_dense_gids(ctx, rows.joint_gid, b, "/joints/gid");
-    rows.joint_broken =
-        read.block<std::uint8_t>(joints.get(), "/joints", "broken", {n}, why, b, tally);
-    rows.joint_mode = read.block<std::uint8_t>(joints.get(), "/joints", "mode", {n}, why, b, tally);
-    rows.joint_failure_time =
-        read.block<double>(joints.get(), "/joints", "failure_time", {n}, why, b, tally);
-    rows.joint_damage = read.block<double>(joints.get(), "/joints", "damage", {n}, why, b, tally);
-    rows.joint_history_bytes = static_cast<std::size_t>(bytes);
-    rows.joint_history = read.block<std::uint8_t>(
-        joints.get(), "/joints", "history", {n, bytes},
-        why + ", joint_history_bytes = " + std::to_string(bytes), b, tally);
-  });
+  const auto read_table = [&](const char* name, std::int64_t count, Run b,
+                              const CheckpointTable& wanted, CheckpointTable& out) {
+    comm.run_collectively([&] {
+      const Reader read(ctx, file);
+      const auto n = static_cast<hsize_t>(count);
+      const std::string group_name = std::string("/") + name;
+      const std::string why = std::string("n_") + name + " = " + std::to_string(n);
+      Handle group = read.group(group_name.c_str());
+      out.gid = read.block<GlobalId>(group.get(), group_name, "gid", {n}, why, b, tally);
+      check_dense_gids(ctx, out.gid, b, (group_name + "/gid").c_str());
+      read_columns(read, group.get(), group_name, wanted.columns, n, why, b, tally, out.columns);
+    });
+  };
+  read_table("nodes", header.n_nodes, blocks.nodes, layout.nodes, rows.nodes);
+  read_table("joints", header.n_joints, blocks.joints, layout.joints, rows.joints);
   hsize_t pairs = 0;
   comm.run_collectively([&] {
     const Reader read(ctx, file);
@@ -386,17 +438,12 @@ FileBlocks read_blocks(const Context& ctx, const Communicator& comm, hid_t file,
     Handle friction = read.group("/friction");
     const std::string why = "/friction/a has " + std::to_string(pairs) + " pairs";
     const Run b = blocks.pairs;
-    rows.friction_a =
-        read.block<GlobalId>(friction.get(), "/friction", "a", {pairs}, why, b, tally);
-    rows.friction_b =
-        read.block<GlobalId>(friction.get(), "/friction", "b", {pairs}, why, b, tally);
-    rows.friction_spring =
-        read.block<double>(friction.get(), "/friction", "spring", {pairs, 3}, why, b, tally);
-    rows.friction_stiffness =
-        read.block<double>(friction.get(), "/friction", "stiffness", {pairs}, why, b, tally);
-    for (std::size_t k = 0; k < rows.friction_a.size(); ++k)
-      if (rows.friction_a[k] < 0 || rows.friction_a[k] >= rows.friction_b[k] ||
-          rows.friction_b[k] >= header.n_tets)
+    rows.pair_a = read.block<GlobalId>(friction.get(), "/friction", "a", {pairs}, why, b, tally);
+    rows.pair_b = read.block<GlobalId>(friction.get(), "/friction", "b", {pairs}, why, b, tally);
+    read_columns(read, friction.get(), "/friction", layout.pair_columns, pairs, why, b, tally,
+                 rows.pair_columns);
+    for (std::size_t k = 0; k < rows.pair_a.size(); ++k)
+      if (rows.pair_a[k] < 0 || rows.pair_a[k] >= rows.pair_b[k] || rows.pair_b[k] >= header.n_tets)
         ctx.fail(
             "dataset /friction/a, /friction/b row " + std::to_string(b.start + k) +
             " is not a pair of tet gids a < b below n_tets = " + std::to_string(header.n_tets));
@@ -410,11 +457,25 @@ FileBlocks read_blocks(const Context& ctx, const Communicator& comm, hid_t file,
   return blocks;
 }
 
+// The first difference between two field lists, for the message.
+std::string first_difference(const std::string& file, const std::string& here) {
+  std::istringstream a(file), b(here);
+  std::string x, y;
+  while (true) {
+    const bool has_x = static_cast<bool>(a >> x), has_y = static_cast<bool>(b >> y);
+    if (!has_x && !has_y) return {};
+    if (!has_x) return "the file has no dataset " + y;
+    if (!has_y) return "the file has a dataset " + x + " this fdem does not restore";
+    if (x != y) return "the file has " + x + " where this fdem restores " + y;
+  }
+}
+
 }  // namespace
 
 std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(
     const std::string& path, const Communicator& comm, const CheckpointWanted* wanted,
-    const std::function<void(const CheckpointHeader&)>& check_header) {
+    const std::function<void(const CheckpointHeader&)>& check_header,
+    const CheckpointRows* layout) {
   const Context ctx(path, "checkpoint", Context::Mode::read);
   const SilenceHdf5Errors silence;
 
@@ -438,9 +499,19 @@ std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(
     file = ctx.own(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()), H5Fclose,
                    "cannot open the HDF5 file (damaged or truncated?)");
   });
-  std::int64_t history_bytes = 0;
-  CheckpointHeader header = read_header(ctx, comm, file.get(), sealed, history_bytes);
+  std::string field_list;
+  CheckpointHeader header = read_header(ctx, comm, file.get(), sealed, field_list);
   if (check_header) comm.run_collectively([&] { check_header(header); });
+  CheckpointRows file_layout;
+  comm.run_collectively([&] {
+    const std::string problem = parse_field_list(field_list, file_layout);
+    if (!problem.empty()) ctx.fail("root attribute fields: " + problem);
+    if (layout && field_list != layout->field_list())
+      ctx.fail("does not hold the datasets this fdem restores (" +
+               first_difference(field_list, layout->field_list()) +
+               "): it was written by another build of fdem; continue it with that one, or run "
+               "the scene from the start");
+  });
 
   CheckpointWanted everything;
   if (!wanted) {
@@ -454,47 +525,60 @@ std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(
     check_wanted(ctx, wanted->joints, header.n_joints, "joint");
     check_wanted(ctx, wanted->tets, header.n_tets, "tet");
   });
-  FileBlocks blocks = read_blocks(ctx, comm, file.get(), header, history_bytes);
+  FileBlocks blocks = read_blocks(ctx, comm, file.get(), header, file_layout);
   comm.run_collectively([&] { ctx.check_status(file.close(), "cannot close the file"); });
 
   // The block rows to the ranks that want them.
   CheckpointRows rows;
-  const CheckpointRows& in = blocks.rows;
-  const BlockFetch nodes(comm, GidBlocks{header.n_nodes, comm.size()}, wanted->nodes);
-  rows.node_gid = wanted->nodes;
-  rows.node_x = nodes.fetch(in.node_x, 3);
-  rows.node_v = nodes.fetch(in.node_v, 3);
-  rows.node_x_at_detection = nodes.fetch(in.node_x_at_detection, 3);
-  rows.node_prescribed_velocity = nodes.fetch(in.node_prescribed_velocity, 3);
-  const BlockFetch joints(comm, GidBlocks{header.n_joints, comm.size()}, wanted->joints);
-  rows.joint_gid = wanted->joints;
-  rows.joint_broken = joints.fetch(in.joint_broken, 1);
-  rows.joint_mode = joints.fetch(in.joint_mode, 1);
-  rows.joint_failure_time = joints.fetch(in.joint_failure_time, 1);
-  rows.joint_damage = joints.fetch(in.joint_damage, 1);
-  rows.joint_history_bytes = in.joint_history_bytes;
-  rows.joint_history = joints.fetch(in.joint_history, in.joint_history_bytes);
+  CheckpointRows& in = blocks.rows;
+  const auto fetch = [&](const CheckpointTable& block, std::int64_t n,
+                         const std::vector<GlobalId>& gids, CheckpointTable& out) {
+    const BlockFetch fetcher(comm, GidBlocks{n, comm.size()}, gids);
+    out.gid = gids;
+    for (const CheckpointColumn& c : block.columns) {
+      CheckpointColumn& column = out.columns.emplace_back();
+      column.name = c.name;
+      column.components = c.components;
+      column.values = std::visit(
+          [&](const auto& v) { return CheckpointValues(fetcher.fetch(v, c.components)); },
+          c.values);
+    }
+  };
+  fetch(in.nodes, header.n_nodes, wanted->nodes, rows.nodes);
+  fetch(in.joints, header.n_joints, wanted->joints, rows.joints);
 
-  std::vector<FrictionRow> slice(in.friction_a.size());
+  std::vector<FrictionRow> slice(in.pair_a.size());
   for (std::size_t k = 0; k < slice.size(); ++k) {
-    slice[k].a = in.friction_a[k];
-    slice[k].b = in.friction_b[k];
-    for (int i = 0; i < 3; ++i) slice[k].spring[i] = in.friction_spring[3 * k + i];
-    slice[k].stiffness = in.friction_stiffness[k];
+    slice[k].a = in.pair_a[k];
+    slice[k].b = in.pair_b[k];
+    std::size_t at = 0;
+    for (const CheckpointColumn& c : in.pair_columns)
+      for (std::size_t i = 0; i < c.components; ++i)
+        slice[k].value[at++] = std::get<std::vector<double>>(c.values)[k * c.components + i];
+  }
+  for (const CheckpointColumn& c : in.pair_columns) {
+    CheckpointColumn& column = rows.pair_columns.emplace_back();
+    column.name = c.name;
+    column.components = c.components;
+    column.values = std::vector<double>{};
   }
   blocks = FileBlocks{};  // the blocks are no longer needed
   for (const FrictionRow& row : deliver_friction(comm, header.n_tets, slice, wanted->tets)) {
-    rows.friction_a.push_back(row.a);
-    rows.friction_b.push_back(row.b);
-    rows.friction_spring.insert(rows.friction_spring.end(), row.spring, row.spring + 3);
-    rows.friction_stiffness.push_back(row.stiffness);
+    rows.pair_a.push_back(row.a);
+    rows.pair_b.push_back(row.b);
+    std::size_t at = 0;
+    for (CheckpointColumn& c : rows.pair_columns) {
+      auto& values = std::get<std::vector<double>>(c.values);
+      values.insert(values.end(), row.value + at, row.value + at + c.components);
+      at += c.components;
+    }
   }
   return {std::move(header), std::move(rows)};
 }
 
 std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(const std::string& path,
                                                             const Communicator& comm) {
-  return read_checkpoint(path, comm, nullptr, {});
+  return read_checkpoint(path, comm, nullptr, {}, nullptr);
 }
 
 }  // namespace fdem

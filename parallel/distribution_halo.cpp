@@ -1,14 +1,47 @@
 // The per-step ghost exchange (parallel/distribution.hpp): which ghost nodes each neighbour
-// sends, split-phase sends and receives of positions and velocities, and the refresh of every
+// sends, split-phase sends and receives of the halo fields (core/fields.hpp: positions and
+// velocities), and the refresh of every
 // ghost before a redistribution when the step's exchange is trimmed.
+#include <algorithm>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/fields.hpp"
 #include "parallel/distribution.hpp"
 
 namespace fdem {
+
+namespace {
+
+struct HaloField {
+  std::vector<double> NodeArrays::*member;
+  std::size_t components;
+};
+
+// The node fields ghost copies refresh every step, in table order (doubles).
+const std::vector<HaloField>& halo_fields() {
+  static const std::vector<HaloField> fields = [] {
+    std::vector<HaloField> out;
+    for (const auto& field : node_fields)
+      if (field.has(FieldUse::halo)) {
+        FDEM_VERIFY(field.type() == ValueType::f64, "halo fields are doubles");
+        out.push_back({std::get<Field<NodeArrays>::F64>(field.member),
+                       static_cast<std::size_t>(field.components)});
+      }
+    return out;
+  }();
+  return fields;
+}
+
+std::size_t halo_doubles_per_node() {
+  std::size_t width = 0;
+  for (const HaloField& field : halo_fields()) width += field.components;
+  return width;
+}
+
+}  // namespace
 
 void Distribution::build_exchange(const Model& model) {
   const int ranks = comm_.size();
@@ -82,9 +115,10 @@ void Distribution::build_exchange(const Model& model) {
       all.send.push_back(it->second);
       if (asked[i].needed) step.send.push_back(it->second);
     }
+    const std::size_t width = halo_doubles_per_node();
     for (Neighbour* nb : {&all, &step}) {
-      nb->send_buffer.resize(6 * nb->send.size());
-      nb->receive_buffer.resize(6 * nb->receive.size());
+      nb->send_buffer.resize(width * nb->send.size());
+      nb->receive_buffer.resize(width * nb->receive.size());
     }
     if (!step.send.empty() || !step.receive.empty()) neighbours_.push_back(std::move(step));
     if (trimmed_) all_ghosts_.push_back(std::move(all));
@@ -105,17 +139,17 @@ void Distribution::start_exchange(std::vector<Neighbour>& plan, const NodeArrays
   for (Neighbour& nb : plan)
     if (!nb.receive.empty()) {
       requests_.emplace_back();
-      // 6 doubles per node: fits an int, local counts being at most max_local_entries.
+      // A few doubles per node: fits an int, local counts being at most max_local_entries.
       MPI_Irecv(nb.receive_buffer.data(), detail::checked_count(nb.receive_buffer.size(), 1),
                 MPI_DOUBLE, nb.rank, tag, comm_.handle(), &requests_.back());
     }
   for (Neighbour& nb : plan)
     if (!nb.send.empty()) {
       double* out = nb.send_buffer.data();
-      for (LocalIndex n : nb.send) {
-        for (int k = 0; k < 3; ++k) *out++ = nodes.x[3 * n + k];
-        for (int k = 0; k < 3; ++k) *out++ = nodes.v[3 * n + k];
-      }
+      for (LocalIndex n : nb.send)
+        for (const HaloField& field : halo_fields())
+          out = std::copy_n((nodes.*field.member).data() + field.components * std::size_t(n),
+                            field.components, out);
       requests_.emplace_back();
       MPI_Isend(nb.send_buffer.data(), detail::checked_count(nb.send_buffer.size(), 1), MPI_DOUBLE,
                 nb.rank, tag, comm_.handle(), &requests_.back());
@@ -128,10 +162,12 @@ void Distribution::finish_exchange(const std::vector<Neighbour>& plan, NodeArray
   requests_.clear();
   for (const Neighbour& nb : plan) {
     const double* in = nb.receive_buffer.data();
-    for (LocalIndex n : nb.receive) {
-      for (int k = 0; k < 3; ++k) nodes.x[3 * n + k] = *in++;
-      for (int k = 0; k < 3; ++k) nodes.v[3 * n + k] = *in++;
-    }
+    for (LocalIndex n : nb.receive)
+      for (const HaloField& field : halo_fields()) {
+        std::copy_n(in, field.components,
+                    (nodes.*field.member).data() + field.components * std::size_t(n));
+        in += field.components;
+      }
   }
 }
 

@@ -178,20 +178,20 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   nodes.n_owned = 0;
   node_owner_.resize(static_cast<std::size_t>(n_nodes));
   node_first_tet_.resize(static_cast<std::size_t>(n_nodes));
-  state.x_at_detection.assign(3 * static_cast<std::size_t>(n_nodes), 0.0);
+  for (const auto& field : travelling_node_fields) field.resize(state, std::size_t(n_nodes));
   for (LocalIndex n = 0; n < n_nodes; ++n) {
     const NodeRow& r = node_rows[n];
     if (r.owner == me) nodes.n_owned = n + 1;
-    store_node_row(r, static_cast<std::size_t>(n), nodes, node_owner_, node_first_tet_,
-                   state.x_at_detection);
+    store_node_row(parsed, r, static_cast<std::size_t>(n), nodes, node_owner_, node_first_tet_,
+                   state);
   }
-
   node_rows = std::vector<NodeRow>{};
+  parsed.node_values = std::vector<unsigned char>{};
   TetArrays& tets = model.tets;
   const LocalIndex n_tets = local_count(tet_rows.size(), "tetrahedra");
+  tets.contact_group.resize(n_tets);  // every arriving tet has its group
   tets.resize(n_tets);
   tets.n_owned = 0;
-  tets.contact_group.resize(n_tets);
   tets.owned.assign(n_tets, 0);
   tets.active.assign(n_tets, 0);
   tet_owner_.resize(static_cast<std::size_t>(n_tets));
@@ -199,13 +199,13 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   for (LocalIndex t = 0; t < n_tets; ++t) {
     const TetRow& r = tet_rows[t];
     const bool touches_owned =
-        store_tet_row(r, static_cast<std::size_t>(t), tets, tet_owner_, nodes);
+        store_tet_row(parsed, r, static_cast<std::size_t>(t), tets, tet_owner_, nodes, state);
     tets.owned[t] = r.owner == me;
     tets.active[t] = tets.owned[t] || touches_owned;
     tets.n_owned += tets.owned[t];
-    if (has_joint_state_) state.tet_joint_state[t] = r.joint_state;
   }
   tet_rows = std::vector<TetRow>{};
+  parsed.tet_values = std::vector<unsigned char>{};
   build_tet_force_order(tets, model.tet_force_order);
 
   // Joints whose two tets are both here (a joint with one tet missing is never computed here).
@@ -232,16 +232,12 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
       joints.nodes[6 * j + i] = n;
     }
     for (int i = 0; i < 2; ++i) joints.tets[2 * j + i] = tets.find(r.tets[i]);
-    joints.area0[j] = r.area0;
-    joints.failure_time[j] = r.failure_time;
-    joints.damage[j] = r.damage;
-    joints.law[j] = r.law;
-    joints.broken[j] = r.broken;
-    joints.mode[j] = r.mode;
-    std::copy_n(parsed.joint_records.data() + r.record * record_bytes, record_bytes,
+    const unsigned char* record =
+        store_joint_values(parsed, r, static_cast<std::size_t>(j), joints);
+    std::copy_n(record, record_bytes,
                 state.joint_records.data() + static_cast<std::size_t>(j) * record_bytes);
   }
-  parsed.joint_records = std::vector<std::uint8_t>{};
+  parsed.joint_values = std::vector<unsigned char>{};
 
   state.pairs = std::move(parsed.pairs);
   std::sort(state.pairs.begin(), state.pairs.end(), [](const PairRecord& p, const PairRecord& q) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
@@ -12,40 +13,36 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/fields.hpp"
 #include "core/model.hpp"
 #include "parallel/distribution.hpp"
 
 namespace fdem::distribution_rows {
 
-// Rows as they travel: plain values, node and tet references as global ids.
+// Rows as they travel: each entry's identity and references as global ids, followed by the values
+// of its fields that migrate (core/fields.hpp, in table order: the model's, then the stages'
+// travelling ones), padded to whole 8-byte words.  Adding a field to a table adds it here.
 struct TetRow {
   GlobalId gid;
-  std::int32_t owner;  // rank that owns it after this redistribution
   GlobalId nodes[4];
-  double dm_inv[9];
-  double volume0, viscosity;
-  std::int32_t material, piece, contact_group;
-  std::uint8_t joint_state;
+  std::int32_t owner;  // rank that owns it after this redistribution
+  std::int32_t unused;
+  std::int64_t values;  // sent: 0; parsed: its row in ParsedRows::tet_values
 };
 struct NodeRow {
   GlobalId gid;
   GlobalId first_tet;  // smallest tet gid that uses it (fixed)
   std::int32_t owner;  // the owner of first_tet after this redistribution
-  double x[3], x0[3], v[3], prescribed_velocity[3], x_at_detection[3];
-  double mass;
-  std::int32_t piece;
-  std::uint8_t constrained;
+  std::int32_t unused;
+  std::int64_t values;  // sent: 0; parsed: its row in ParsedRows::node_values
 };
 struct JointRow {
   GlobalId gid;
   GlobalId nodes[6];
   GlobalId tets[2];
-  double area0, failure_time, damage;
-  std::int32_t law;
-  std::uint8_t broken, mode;
-  // Where its stage record is: sent, 0; parsed, its index in ParsedRows::joint_records.  The
-  // record itself follows the row (BlockHeader::joint_record_bytes, padded to 8 bytes).
-  std::int64_t record;
+  // Sent: 0; parsed: its row in ParsedRows::joint_values.  Its field values are followed by its
+  // stage record (BlockHeader::joint_record_bytes) on the wire and in the parsed row.
+  std::int64_t values;
 };
 using PairRow = PairRecord;  // stage state of a pair of tets, sent with its first tet
 struct BlockHeader {
@@ -56,9 +53,24 @@ static_assert(sizeof(TetRow) % 8 == 0 && sizeof(NodeRow) % 8 == 0 && sizeof(Join
                   sizeof(PairRow) % 8 == 0 && sizeof(GidPair) % 8 == 0 &&
                   sizeof(BlockHeader) % 8 == 0,
               "rows travel as 8-byte words");
-// A joint record's bytes on the wire: padded to whole 8-byte words.
-inline std::size_t padded_record_bytes(std::size_t bytes) {
+// Bytes on the wire: padded to whole 8-byte words.
+inline std::size_t padded(std::size_t bytes) {
   return (bytes + 7) / 8 * 8;
+}
+// Bytes of the migrating field values of one node, tet or joint.
+inline std::size_t node_value_bytes() {
+  static const std::size_t bytes = field_bytes(node_fields, FieldUse::migrates) +
+                                   field_bytes(travelling_node_fields, FieldUse::migrates);
+  return bytes;
+}
+inline std::size_t tet_value_bytes() {
+  static const std::size_t bytes = field_bytes(tet_fields, FieldUse::migrates) +
+                                   field_bytes(travelling_tet_fields, FieldUse::migrates);
+  return bytes;
+}
+inline std::size_t joint_value_bytes() {
+  static const std::size_t bytes = field_bytes(joint_fields, FieldUse::migrates);
+  return bytes;
 }
 
 template <class T>
@@ -100,6 +112,7 @@ class RowPacker {
         start_joints_(start_joints),
         stamp_(model.nodes.size(), -1),
         joint_stamp_(model.joints.size(), -1) {
+    start_joint_.resize(1);
     const JointArrays& joints = model.joints;
     const int sides = both_sides ? 2 : 1;
     joint_offsets_.assign(static_cast<std::size_t>(model.tets.size()) + 1, 0);
@@ -159,10 +172,11 @@ class RowPacker {
     header.candidates = static_cast<std::int64_t>(candidate_list.size());
     const std::size_t record_bytes = state_.joint_record_bytes;
     header.joint_record_bytes = static_cast<std::int64_t>(record_bytes);
-    out.reserve(out.size() + sizeof(header) + tet_list.size() * sizeof(TetRow) +
-                node_list.size() * sizeof(NodeRow) +
-                (joint_list.size() + start_list.size()) *
-                    (sizeof(JointRow) + padded_record_bytes(record_bytes)) +
+    const std::size_t joint_bytes = padded(joint_value_bytes() + record_bytes);
+    out.reserve(out.size() + sizeof(header) +
+                tet_list.size() * (sizeof(TetRow) + padded(tet_value_bytes())) +
+                node_list.size() * (sizeof(NodeRow) + padded(node_value_bytes())) +
+                (joint_list.size() + start_list.size()) * (sizeof(JointRow) + joint_bytes) +
                 pair_list.size() * sizeof(PairRow) + candidate_list.size() * sizeof(GidPair));
     append(out, header);
     for (LocalIndex t : tet_list) {
@@ -170,59 +184,43 @@ class RowPacker {
       row.gid = tets.gid[t];
       row.owner = tet_owner_[t];
       for (int c = 0; c < 4; ++c) row.nodes[c] = nodes.gid[tets.nodes[4 * t + c]];
-      std::copy_n(&tets.dm_inv[9 * static_cast<std::size_t>(t)], 9, row.dm_inv);
-      row.volume0 = tets.volume0[t];
-      row.viscosity = tets.viscosity[t];
-      row.material = tets.material[t];
-      row.piece = tets.piece[t];
-      row.contact_group = tets.group_of(t);
-      row.joint_state = state_.tet_joint_state.empty() ? 0 : state_.tet_joint_state[t];
       append(out, row);
+      unsigned char* p = open_values(out, tet_value_bytes());
+      p = pack_fields(tet_fields, FieldUse::migrates, tets, t, p);
+      pack_fields(travelling_tet_fields, FieldUse::migrates, state_, t, p);
     }
     for (LocalIndex n : node_list) {
       NodeRow row{};
       row.gid = nodes.gid[n];
       row.first_tet = node_first_tet_[n];
       row.owner = node_owner_[n];
-      for (int k = 0; k < 3; ++k) {
-        row.x[k] = nodes.x[3 * n + k];
-        row.x0[k] = nodes.x0[3 * n + k];
-        row.v[k] = nodes.v[3 * n + k];
-        row.prescribed_velocity[k] = nodes.prescribed_velocity[3 * n + k];
-        row.x_at_detection[k] = state_.x_at_detection[3 * n + k];
-      }
-      row.mass = nodes.mass[n];
-      row.piece = nodes.piece[n];
-      row.constrained = nodes.constrained[n];
       append(out, row);
+      unsigned char* p = open_values(out, node_value_bytes());
+      p = pack_fields(node_fields, FieldUse::migrates, nodes, n, p);
+      pack_fields(travelling_node_fields, FieldUse::migrates, state_, n, p);
     }
     for (LocalIndex j : joint_list) {
       JointRow row{};
       row.gid = joints.gid[j];
       for (int i = 0; i < 6; ++i) row.nodes[i] = nodes.gid[joints.nodes[6 * j + i]];
       for (int i = 0; i < 2; ++i) row.tets[i] = tets.gid[joints.tets[2 * j + i]];
-      row.area0 = joints.area0[j];
-      row.failure_time = joints.failure_time[j];
-      row.damage = joints.damage[j];
-      row.law = joints.law[j];
-      row.broken = joints.broken[j];
-      row.mode = joints.mode[j];
       append(out, row);
-      append_record(out, state_.joint_records.data() + j * record_bytes, record_bytes);
+      unsigned char* p = open_values(out, joint_value_bytes() + record_bytes);
+      p = pack_fields(joint_fields, FieldUse::migrates, joints, j, p);
+      if (record_bytes > 0)
+        std::memcpy(p, state_.joint_records.data() + j * record_bytes, record_bytes);
     }
     for (const StartJoint* j : start_list) {  // intact, as JointArrays::resize leaves a joint
       JointRow row{};
       row.gid = j->gid;
       std::copy_n(j->nodes, 6, row.nodes);
       std::copy_n(j->tets, 2, row.tets);
-      row.area0 = j->area0;
-      row.failure_time = -1.0;
-      row.damage = 0.0;
-      row.law = j->law;
-      row.broken = 0;
-      row.mode = 0;
       append(out, row);
-      append_record(out, nullptr, record_bytes);  // made at the start: the stage makes its own
+      start_joint_.area0[0] = j->area0;
+      start_joint_.law[0] = j->law;
+      unsigned char* p = open_values(out, joint_value_bytes() + record_bytes);
+      pack_fields(joint_fields, FieldUse::migrates, start_joint_, 0, p);
+      // Its record stays zero: the stage makes its own at the start.
     }
     for (const PairRecord* e : pair_list) append(out, *e);
     for (const GidPair& c : candidate_list) append(out, c);
@@ -239,41 +237,59 @@ class RowPacker {
   int mark_ = 0;
   std::vector<std::int64_t> joint_offsets_;
   std::vector<LocalIndex> joint_list_;
+  JointArrays start_joint_;  // one intact joint: the values of a joint made at the start
 
-  // `bytes` of `record` (zeros when null), padded to whole words.
-  static void append_record(std::vector<char>& out, const std::uint8_t* record, std::size_t bytes) {
+  // Appends `bytes` zero bytes padded to whole words; returns where they start.
+  static unsigned char* open_values(std::vector<char>& out, std::size_t bytes) {
     const std::size_t at = out.size();
-    out.resize(at + padded_record_bytes(bytes), 0);
-    if (record && bytes > 0) std::memcpy(out.data() + at, record, bytes);
+    out.resize(at + padded(bytes), 0);
+    return reinterpret_cast<unsigned char*>(out.data() + at);
   }
 };
 
-// Writes node row `r` into entry n of the arrays (its force zeroed).
-inline void store_node_row(const NodeRow& r, std::size_t n, NodeArrays& nodes,
-                           std::vector<std::int32_t>& node_owner,
-                           std::vector<GlobalId>& node_first_tet,
-                           std::vector<double>& x_at_detection) {
+// The rows of packed buffers (each emptied once parsed), in the order they come, and their field
+// values (row r's at values[r * value bytes]).
+struct ParsedRows {
+  std::vector<TetRow> tets;
+  std::vector<NodeRow> nodes;
+  std::vector<JointRow> joints;
+  std::vector<unsigned char> tet_values, node_values;
+  std::size_t joint_record_bytes = 0;
+  std::vector<unsigned char> joint_values;  // joint_value_bytes() + joint_record_bytes per row
+  std::vector<PairRow> pairs;
+  std::vector<GidPair> candidates;
+
+  const unsigned char* values_of(const TetRow& r) const {
+    return tet_values.data() + static_cast<std::size_t>(r.values) * tet_value_bytes();
+  }
+  const unsigned char* values_of(const NodeRow& r) const {
+    return node_values.data() + static_cast<std::size_t>(r.values) * node_value_bytes();
+  }
+  const unsigned char* values_of(const JointRow& r) const {
+    return joint_values.data() +
+           static_cast<std::size_t>(r.values) * (joint_value_bytes() + joint_record_bytes);
+  }
+};
+
+// Writes node row `r` into entry n of the arrays and of the state's node fields (the fields that
+// do not migrate, such as the force, are reset).
+inline void store_node_row(const ParsedRows& rows, const NodeRow& r, std::size_t n,
+                           NodeArrays& nodes, std::vector<std::int32_t>& node_owner,
+                           std::vector<GlobalId>& node_first_tet, TravellingState& state) {
   nodes.gid[n] = r.gid;
   node_owner[n] = r.owner;
   node_first_tet[n] = r.first_tet;
-  for (std::size_t k = 0; k < 3; ++k) {
-    nodes.x[3 * n + k] = r.x[k];
-    nodes.x0[3 * n + k] = r.x0[k];
-    nodes.v[3 * n + k] = r.v[k];
-    nodes.f[3 * n + k] = 0.0;
-    nodes.prescribed_velocity[3 * n + k] = r.prescribed_velocity[k];
-    x_at_detection[3 * n + k] = r.x_at_detection[k];
-  }
-  nodes.mass[n] = r.mass;
-  nodes.piece[n] = r.piece;
-  nodes.constrained[n] = r.constrained;
+  const unsigned char* p =
+      unpack_fields(node_fields, FieldUse::migrates, nodes, n, rows.values_of(r));
+  unpack_fields(travelling_node_fields, FieldUse::migrates, state, n, p);
 }
 
-// Writes tet row `r` into entry t of the arrays, its nodes found by gid in `nodes` (which must
-// hold them); the roles (owned, active) are the caller's.  Returns whether it touches a node
-// owned here.
-inline bool store_tet_row(const TetRow& r, std::size_t t, TetArrays& tets,
-                          std::vector<std::int32_t>& tet_owner, const NodeArrays& nodes) {
+// Writes tet row `r` into entry t of the arrays and of the state's tet fields, its nodes found by
+// gid in `nodes` (which must hold them); the roles (owned, active) are the caller's.  Returns
+// whether it touches a node owned here.
+inline bool store_tet_row(const ParsedRows& rows, const TetRow& r, std::size_t t, TetArrays& tets,
+                          std::vector<std::int32_t>& tet_owner, const NodeArrays& nodes,
+                          TravellingState& state) {
   tets.gid[t] = r.gid;
   tet_owner[t] = r.owner;
   bool touches_owned = false;
@@ -283,28 +299,22 @@ inline bool store_tet_row(const TetRow& r, std::size_t t, TetArrays& tets,
     tets.nodes[4 * t + c] = n;
     touches_owned = touches_owned || n < nodes.n_owned;
   }
-  std::copy_n(r.dm_inv, 9, &tets.dm_inv[9 * t]);
-  tets.volume0[t] = r.volume0;
-  tets.viscosity[t] = r.viscosity;
-  tets.material[t] = r.material;
-  tets.piece[t] = r.piece;
-  tets.contact_group[t] = r.contact_group;
+  const unsigned char* p =
+      unpack_fields(tet_fields, FieldUse::migrates, tets, t, rows.values_of(r));
+  unpack_fields(travelling_tet_fields, FieldUse::migrates, state, t, p);
   return touches_owned;
 }
 
-// The rows of packed buffers (each emptied once parsed), in the order they come.
-struct ParsedRows {
-  std::vector<TetRow> tets;
-  std::vector<NodeRow> nodes;
-  std::vector<JointRow> joints;  // JointRow::record: the index of its record
-  std::size_t joint_record_bytes = 0;
-  std::vector<std::uint8_t> joint_records;  // joint_record_bytes per joint row, in row order
-  std::vector<PairRow> pairs;
-  std::vector<GidPair> candidates;
-};
+// Writes joint row `r`'s field values into entry j and returns its stage record.
+inline const unsigned char* store_joint_values(const ParsedRows& rows, const JointRow& r,
+                                               std::size_t j, JointArrays& joints) {
+  return unpack_fields(joint_fields, FieldUse::migrates, joints, j, rows.values_of(r));
+}
+
 inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) {
   ParsedRows parsed;
   std::int64_t counts[5] = {0, 0, 0, 0, 0};
+  const std::size_t tet_bytes = tet_value_bytes(), node_bytes = node_value_bytes();
   // Exact sizes first: growing the row arrays would hold up to three copies at once.
   for (std::vector<char>* rows : buffers)
     for (const char* p = rows->data(); p < rows->data() + rows->size();) {
@@ -320,29 +330,39 @@ inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) 
                     "every rank sends joint records of one size");
         parsed.joint_record_bytes = record_bytes;
       }
-      p += header.tets * sizeof(TetRow) + header.nodes * sizeof(NodeRow) +
-           header.joints * (sizeof(JointRow) + padded_record_bytes(record_bytes)) +
+      p += header.tets * (sizeof(TetRow) + padded(tet_bytes)) +
+           header.nodes * (sizeof(NodeRow) + padded(node_bytes)) +
+           header.joints * (sizeof(JointRow) + padded(joint_value_bytes() + record_bytes)) +
            header.pairs * sizeof(PairRow) + header.candidates * sizeof(GidPair);
     }
-  parsed.tets.reserve(static_cast<std::size_t>(counts[0]));
-  parsed.nodes.reserve(static_cast<std::size_t>(counts[1]));
-  parsed.joints.reserve(static_cast<std::size_t>(counts[2]));
-  parsed.joint_records.reserve(static_cast<std::size_t>(counts[2]) * parsed.joint_record_bytes);
-  parsed.pairs.reserve(static_cast<std::size_t>(counts[3]));
-  parsed.candidates.reserve(static_cast<std::size_t>(counts[4]));
+  const std::size_t joint_bytes = joint_value_bytes() + parsed.joint_record_bytes;
+  const auto count = [&](int k) { return static_cast<std::size_t>(counts[k]); };
+  parsed.tets.reserve(count(0));
+  parsed.tet_values.reserve(count(0) * tet_bytes);
+  parsed.nodes.reserve(count(1));
+  parsed.node_values.reserve(count(1) * node_bytes);
+  parsed.joints.reserve(count(2));
+  parsed.joint_values.reserve(count(2) * joint_bytes);
+  parsed.pairs.reserve(count(3));
+  parsed.candidates.reserve(count(4));
+  // Row `row` and its values (`bytes`, padded on the wire) into `keys` and `values`.
+  const auto take_row = [](const char*& p, auto& keys, std::vector<unsigned char>& values,
+                           std::size_t bytes) {
+    auto row = take<typename std::decay_t<decltype(keys)>::value_type>(p);
+    row.values = static_cast<std::int64_t>(keys.size());
+    keys.push_back(row);
+    values.insert(values.end(), p, p + bytes);
+    p += padded(bytes);
+  };
   for (std::vector<char>* rows : buffers) {
     for (const char* p = rows->data(); p < rows->data() + rows->size();) {
       const BlockHeader header = take<BlockHeader>(p);
-      for (std::int64_t i = 0; i < header.tets; ++i) parsed.tets.push_back(take<TetRow>(p));
-      for (std::int64_t i = 0; i < header.nodes; ++i) parsed.nodes.push_back(take<NodeRow>(p));
-      const auto record_bytes = static_cast<std::size_t>(header.joint_record_bytes);
-      for (std::int64_t i = 0; i < header.joints; ++i) {
-        JointRow row = take<JointRow>(p);
-        row.record = static_cast<std::int64_t>(parsed.joints.size());
-        parsed.joints.push_back(row);
-        parsed.joint_records.insert(parsed.joint_records.end(), p, p + record_bytes);
-        p += padded_record_bytes(record_bytes);
-      }
+      for (std::int64_t i = 0; i < header.tets; ++i)
+        take_row(p, parsed.tets, parsed.tet_values, tet_bytes);
+      for (std::int64_t i = 0; i < header.nodes; ++i)
+        take_row(p, parsed.nodes, parsed.node_values, node_bytes);
+      for (std::int64_t i = 0; i < header.joints; ++i)
+        take_row(p, parsed.joints, parsed.joint_values, joint_bytes);
       for (std::int64_t i = 0; i < header.pairs; ++i) parsed.pairs.push_back(take<PairRow>(p));
       for (std::int64_t i = 0; i < header.candidates; ++i)
         parsed.candidates.push_back(take<GidPair>(p));

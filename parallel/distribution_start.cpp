@@ -4,6 +4,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/fields.hpp"
 #include "parallel/distribution.hpp"
 #include "parallel/distribution_rows.hpp"
 
@@ -99,14 +100,15 @@ void Distribution::append_halo(Model& model, TravellingState& state,
   nodes.resize(local_count(n_all, "nodes"));
   resize_exact(node_owner_, n_all);
   resize_exact(node_first_tet_, n_all);
-  resize_exact(state.x_at_detection, 3 * n_all);
+  for (const auto& field : travelling_node_fields) field.resize(state, n_all);
   for (std::size_t k = 0; k < rows.nodes.size(); ++k) {
     const NodeRow& r = rows.nodes[k];
     const std::size_t n = n_old + k;
     FDEM_VERIFY(r.owner != comm_.rank(), "a node owned here is held already");
-    store_node_row(r, n, nodes, node_owner_, node_first_tet_, state.x_at_detection);
+    store_node_row(rows, r, n, nodes, node_owner_, node_first_tet_, state);
   }
   rows.nodes = std::vector<NodeRow>{};
+  rows.node_values = std::vector<unsigned char>{};
   std::vector<std::size_t> order(n_all - n_owned);
   std::iota(order.begin(), order.end(), n_owned);
   std::sort(order.begin(), order.end(),
@@ -114,18 +116,14 @@ void Distribution::append_halo(Model& model, TravellingState& state,
   std::vector<LocalIndex> moved_to(n_all - n_owned);  // old ghost index − n_owned → new index
   for (std::size_t i = 0; i < order.size(); ++i)
     moved_to[order[i] - n_owned] = static_cast<LocalIndex>(n_owned + i);
+  const auto permute = [&](const auto& field, auto& values) {
+    permute_tail(values, static_cast<std::size_t>(field.components), n_owned, order);
+  };
   permute_tail(nodes.gid, 1, n_owned, order);
-  permute_tail(nodes.x, 3, n_owned, order);
-  permute_tail(nodes.x0, 3, n_owned, order);
-  permute_tail(nodes.v, 3, n_owned, order);
-  permute_tail(nodes.f, 3, n_owned, order);
-  permute_tail(nodes.mass, 1, n_owned, order);
-  permute_tail(nodes.piece, 1, n_owned, order);
-  permute_tail(nodes.constrained, 1, n_owned, order);
-  permute_tail(nodes.prescribed_velocity, 3, n_owned, order);
+  for_each_field_array(node_fields, nodes, permute);
+  for_each_field_array(travelling_node_fields, state, permute);
   permute_tail(node_owner_, 1, n_owned, order);
   permute_tail(node_first_tet_, 1, n_owned, order);
-  permute_tail(state.x_at_detection, 3, n_owned, order);
   for (LocalIndex& n : tets.nodes)
     if (static_cast<std::size_t>(n) >= n_owned) n = moved_to[static_cast<std::size_t>(n) - n_owned];
 
@@ -144,12 +142,9 @@ void Distribution::append_halo(Model& model, TravellingState& state,
               "the block's tets carry their groups and roles");
   open_rows(tets.gid, 1, t_old, t_all, lower);
   open_rows(tets.nodes, 4, t_old, t_all, lower);
-  open_rows(tets.dm_inv, 9, t_old, t_all, lower);
-  open_rows(tets.volume0, 1, t_old, t_all, lower);
-  open_rows(tets.material, 1, t_old, t_all, lower);
-  open_rows(tets.piece, 1, t_old, t_all, lower);
-  open_rows(tets.viscosity, 1, t_old, t_all, lower);
-  open_rows(tets.contact_group, 1, t_old, t_all, lower);
+  for_each_field_array(tet_fields, tets, [&](const auto& field, auto& values) {
+    open_rows(values, static_cast<std::size_t>(field.components), t_old, t_all, lower);
+  });
   open_rows(tets.owned, 1, t_old, t_all, lower);
   open_rows(tets.active, 1, t_old, t_all, lower);
   open_rows(tet_owner_, 1, t_old, t_all, lower);
@@ -159,11 +154,12 @@ void Distribution::append_halo(Model& model, TravellingState& state,
     FDEM_VERIFY(
         r.owner != comm_.rank() && (k < lower || t_old == 0 || r.gid > tets.gid[lower + t_old - 1]),
         "halo tets lie outside the block");
-    const bool touches_owned = store_tet_row(r, t, tets, tet_owner_, nodes);
+    const bool touches_owned = store_tet_row(rows, r, t, tets, tet_owner_, nodes, state);
     tets.owned[t] = 0;
     tets.active[t] = touches_owned;
   }
   rows.tets = std::vector<TetRow>{};
+  rows.tet_values = std::vector<unsigned char>{};
   build_tet_force_order(tets, model.tet_force_order);
   build_exchange(model);
 }

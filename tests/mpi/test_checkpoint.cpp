@@ -14,10 +14,13 @@
 #include <iterator>
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "core/error.hpp"
 #include "parallel/checkpoint.hpp"
+#include "parallel/checkpoint_fields.hpp"
 #include "parallel/checkpoint_seal.hpp"
 #include "parallel/communicator.hpp"
 
@@ -65,21 +68,18 @@ double node_value(int field, GlobalId gid, int component) {
   return std::sin(1.0 + 0.37 * static_cast<double>(gid) + 0.11 * component + 10.0 * field) *
          std::pow(10.0, field - 2);
 }
-double joint_value(int field, GlobalId gid) {
-  return std::cos(0.5 + 0.13 * static_cast<double>(gid) + field) * 1e-3;
-}
 std::uint8_t history_byte(GlobalId gid, std::size_t b) {
   return static_cast<std::uint8_t>((gid * 31 + static_cast<GlobalId>(b) * 7 + 1) & 0xff);
 }
 
-struct Scene {
+struct FileScene {
   std::int64_t n_nodes = 1000, n_joints = 300;
   std::size_t history_bytes = 12;
   int friction_per_writer = 3;
 };
 
 // The header every rank passes (the same everywhere).
-CheckpointHeader make_header(const Scene& scene) {
+CheckpointHeader make_header(const FileScene& scene) {
   CheckpointHeader h;
   h.n_nodes = scene.n_nodes;
   h.n_tets = 4321;
@@ -91,42 +91,55 @@ CheckpointHeader make_header(const Scene& scene) {
   return h;
 }
 
-void add_node(CheckpointRows& rows, GlobalId g) {
-  rows.node_gid.push_back(g);
-  for (int c = 0; c < 3; ++c) {
-    rows.node_x.push_back(node_value(0, g, c));
-    rows.node_v.push_back(node_value(1, g, c));
-    rows.node_x_at_detection.push_back(node_value(2, g, c));
-    rows.node_prescribed_velocity.push_back(node_value(3, g, c));
+// One row of `columns` (the k-th column's values from pattern k: doubles with the special cases,
+// integers and bytes from the gid).
+void add_row(std::vector<CheckpointColumn>& columns, GlobalId g) {
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    CheckpointColumn& column = columns[k];
+    const int field = static_cast<int>(k);
+    for (std::size_t i = 0; i < column.components; ++i)
+      std::visit(
+          [&](auto& values) {
+            using T = typename std::decay_t<decltype(values)>::value_type;
+            if constexpr (std::is_floating_point_v<T>)
+              values.push_back(node_value(field, g, static_cast<int>(i)));
+            else
+              values.push_back(static_cast<T>(history_byte(g + 1000 * field, i)));
+          },
+          column.values);
   }
+}
+void add_node(CheckpointRows& rows, GlobalId g) {
+  rows.nodes.gid.push_back(g);
+  add_row(rows.nodes.columns, g);
 }
 void add_joint(CheckpointRows& rows, GlobalId j) {
-  rows.joint_gid.push_back(j);
-  rows.joint_broken.push_back(static_cast<std::uint8_t>(j % 2));
-  rows.joint_mode.push_back(static_cast<std::uint8_t>(j % 3));
-  rows.joint_failure_time.push_back(j % 2 ? joint_value(0, j) : -1.0);
-  rows.joint_damage.push_back(joint_value(1, j));
-  for (std::size_t b = 0; b < rows.joint_history_bytes; ++b)
-    rows.joint_history.push_back(history_byte(j, b));
+  rows.joints.gid.push_back(j);
+  add_row(rows.joints.columns, j);
 }
 // Friction pairs of writer `w`: a deliberately not sorted, so the reader's sort is exercised.
-void add_friction(CheckpointRows& rows, const Scene& scene, int writer) {
+void add_friction(CheckpointRows& rows, const FileScene& scene, int writer) {
   for (int k = scene.friction_per_writer - 1; k >= 0; --k) {
     const GlobalId a = 900 - 10 * writer - k, b = a + 1 + k;
-    rows.friction_a.push_back(a);
-    rows.friction_b.push_back(b);
-    for (int c = 0; c < 3; ++c) rows.friction_spring.push_back(1e-6 * (a + c) - 1e-7 * b);
-    rows.friction_stiffness.push_back(1e6 + 1000.0 * a + b);
+    rows.pair_a.push_back(a);
+    rows.pair_b.push_back(b);
+    for (CheckpointColumn& column : rows.pair_columns)
+      for (std::size_t c = 0; c < column.components; ++c)
+        std::get<std::vector<double>>(column.values)
+            .push_back(1e-6 * (a + double(c)) - 1e-7 * b + double(column.components));
   }
+}
+// The columns fdem writes (parallel/checkpoint_fields), with joint records of `history_bytes`.
+CheckpointRows empty_rows(const FileScene& scene) {
+  return checkpoint_layout(scene.history_bytes);
 }
 
 // What `writer` of `writers` owns: nodes interleaved (gid % writers), joints by another pattern,
 // `owner_of` may leave some writers without rows.
 template <class NodeOwner, class JointOwner>
-CheckpointRows make_owned(const Scene& scene, int writer, NodeOwner node_owner,
+CheckpointRows make_owned(const FileScene& scene, int writer, NodeOwner node_owner,
                           JointOwner joint_owner) {
-  CheckpointRows rows;
-  rows.joint_history_bytes = scene.history_bytes;
+  CheckpointRows rows = empty_rows(scene);
   // Descending gid order, so the writer's own sort to file positions is exercised.
   for (GlobalId g = scene.n_nodes - 1; g >= 0; --g)
     if (node_owner(g) == writer) add_node(rows, g);
@@ -135,32 +148,35 @@ CheckpointRows make_owned(const Scene& scene, int writer, NodeOwner node_owner,
   add_friction(rows, scene, writer);
   return rows;
 }
-CheckpointRows interleaved(const Scene& scene, int writer, int writers) {
+CheckpointRows interleaved(const FileScene& scene, int writer, int writers) {
   return make_owned(
       scene, writer, [&](GlobalId g) { return static_cast<int>(g % writers); },
       [&](GlobalId j) { return static_cast<int>((j / 7) % writers); });
 }
 
 // Everything, sorted as read_checkpoint returns it, for `writers` writers with friction.
-CheckpointRows expected_rows(const Scene& scene, int writers) {
-  CheckpointRows all;
-  all.joint_history_bytes = scene.history_bytes;
+CheckpointRows expected_rows(const FileScene& scene, int writers) {
+  CheckpointRows all = empty_rows(scene);
   for (GlobalId g = 0; g < scene.n_nodes; ++g) add_node(all, g);
   for (GlobalId j = 0; j < scene.n_joints; ++j) add_joint(all, j);
-  CheckpointRows pairs;
+  CheckpointRows pairs = empty_rows(scene);
   for (int w = 0; w < writers; ++w) add_friction(pairs, scene, w);
-  std::vector<std::size_t> order(pairs.friction_a.size());
+  std::vector<std::size_t> order(pairs.pair_a.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
-    return std::make_pair(pairs.friction_a[i], pairs.friction_b[i]) <
-           std::make_pair(pairs.friction_a[j], pairs.friction_b[j]);
+    return std::make_pair(pairs.pair_a[i], pairs.pair_b[i]) <
+           std::make_pair(pairs.pair_a[j], pairs.pair_b[j]);
   });
   for (std::size_t i : order) {
-    all.friction_a.push_back(pairs.friction_a[i]);
-    all.friction_b.push_back(pairs.friction_b[i]);
-    for (std::size_t c = 0; c < 3; ++c)
-      all.friction_spring.push_back(pairs.friction_spring[3 * i + c]);
-    all.friction_stiffness.push_back(pairs.friction_stiffness[i]);
+    all.pair_a.push_back(pairs.pair_a[i]);
+    all.pair_b.push_back(pairs.pair_b[i]);
+    for (std::size_t k = 0; k < pairs.pair_columns.size(); ++k) {
+      const std::size_t width = pairs.pair_columns[k].components;
+      const auto& from = std::get<std::vector<double>>(pairs.pair_columns[k].values);
+      auto& to = std::get<std::vector<double>>(all.pair_columns[k].values);
+      to.insert(to.end(), from.begin() + static_cast<std::ptrdiff_t>(i * width),
+                from.begin() + static_cast<std::ptrdiff_t>((i + 1) * width));
+    }
   }
   return all;
 }
@@ -171,25 +187,33 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
          (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
+void check_columns_equal(const std::vector<CheckpointColumn>& got,
+                         const std::vector<CheckpointColumn>& want) {
+  CHECK(got.size() == want.size());
+  for (std::size_t k = 0; k < std::min(got.size(), want.size()); ++k) {
+    INFO("column " << want[k].name);
+    CHECK(got[k].name == want[k].name);
+    CHECK(got[k].components == want[k].components);
+    CHECK(got[k].type() == want[k].type());
+    if (got[k].type() == want[k].type())
+      std::visit(
+          [&](const auto& values) {
+            CHECK(same_bits(values, std::get<std::decay_t<decltype(values)>>(want[k].values)));
+          },
+          got[k].values);
+  }
+}
+
 void check_rows_equal(const CheckpointRows& got, const CheckpointRows& want) {
-  CHECK(got.node_gid == want.node_gid);
-  CHECK(std::is_sorted(got.node_gid.begin(), got.node_gid.end()));
-  CHECK(same_bits(got.node_x, want.node_x));
-  CHECK(same_bits(got.node_v, want.node_v));
-  CHECK(same_bits(got.node_x_at_detection, want.node_x_at_detection));
-  CHECK(same_bits(got.node_prescribed_velocity, want.node_prescribed_velocity));
-  CHECK(got.joint_gid == want.joint_gid);
-  CHECK(std::is_sorted(got.joint_gid.begin(), got.joint_gid.end()));
-  CHECK(got.joint_broken == want.joint_broken);
-  CHECK(got.joint_mode == want.joint_mode);
-  CHECK(same_bits(got.joint_failure_time, want.joint_failure_time));
-  CHECK(same_bits(got.joint_damage, want.joint_damage));
-  CHECK(got.joint_history_bytes == want.joint_history_bytes);
-  CHECK(got.joint_history == want.joint_history);
-  CHECK(got.friction_a == want.friction_a);
-  CHECK(got.friction_b == want.friction_b);
-  CHECK(same_bits(got.friction_spring, want.friction_spring));
-  CHECK(same_bits(got.friction_stiffness, want.friction_stiffness));
+  CHECK(got.nodes.gid == want.nodes.gid);
+  CHECK(std::is_sorted(got.nodes.gid.begin(), got.nodes.gid.end()));
+  check_columns_equal(got.nodes.columns, want.nodes.columns);
+  CHECK(got.joints.gid == want.joints.gid);
+  CHECK(std::is_sorted(got.joints.gid.begin(), got.joints.gid.end()));
+  check_columns_equal(got.joints.columns, want.joints.columns);
+  CHECK(got.pair_a == want.pair_a);
+  CHECK(got.pair_b == want.pair_b);
+  check_columns_equal(got.pair_columns, want.pair_columns);
 }
 
 void check_header_equal(const CheckpointHeader& got, const CheckpointHeader& want, int ranks) {
@@ -261,7 +285,7 @@ TEST_CASE("checkpoint: interleaved rows of every rank round-trip bit-exactly",
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());
   const SharedTempDir dir(comm);
-  const Scene scene;
+  const FileScene scene;
   const std::string path = dir.file("state.h5");
   const CheckpointHeader header = make_header(scene);
   const CheckpointRows owned = interleaved(scene, comm.rank(), comm.size());
@@ -271,9 +295,15 @@ TEST_CASE("checkpoint: interleaved rows of every rank round-trip bit-exactly",
   CHECK(caught([&] { back = read_checkpoint(path, comm); }) == "none");
   check_header_equal(back.first, header, comm.size());
   check_rows_equal(back.second, expected_rows(scene, comm.size()));
-  CHECK(back.second.node_gid.size() == 1000);
-  CHECK(back.second.joint_gid.size() == 300);
-  CHECK(back.second.friction_a.size() == static_cast<std::size_t>(3 * comm.size()));
+  CHECK(back.second.nodes.gid.size() == 1000);
+  CHECK(back.second.joints.gid.size() == 300);
+  CHECK(back.second.pair_a.size() == static_cast<std::size_t>(3 * comm.size()));
+  // The datasets are the field tables' (core/fields.hpp).
+  CHECK(back.second.field_list() ==
+        "nodes/x:float64[3] nodes/v:float64[3] nodes/prescribed_velocity:float64[3] "
+        "nodes/x_at_detection:float64[3] joints/broken:uint8[1] joints/mode:uint8[1] "
+        "joints/failure_time:float64[1] joints/damage:float64[1] joints/history:uint8[12] "
+        "friction/spring:float64[3] friction/stiffness:float64[1]");
 }
 
 TEST_CASE("checkpoint: a rank without rows takes part, empty joint and friction tables",
@@ -284,7 +314,7 @@ TEST_CASE("checkpoint: a rank without rows takes part, empty joint and friction 
   const int last = comm.size() - 1;
 
   SECTION("the last rank owns nothing (on one rank: it owns everything)") {
-    Scene scene;
+    FileScene scene;
     scene.friction_per_writer = 0;
     const int holders = std::max(1, comm.size() - 1);
     CheckpointRows owned = make_owned(
@@ -292,26 +322,26 @@ TEST_CASE("checkpoint: a rank without rows takes part, empty joint and friction 
         [&](GlobalId j) { return static_cast<int>((j * 5) % holders); });
     // The ranks that hold rows also hold the friction pairs, except the idle last rank.
     if (comm.size() == 1 || comm.rank() != last) {
-      Scene with_friction = scene;
+      FileScene with_friction = scene;
       with_friction.friction_per_writer = 2;
       add_friction(owned, with_friction, comm.rank());
     }
     if (comm.size() > 1 && comm.rank() == last) {
-      CHECK(owned.node_gid.empty());
-      CHECK(owned.joint_gid.empty());
-      CHECK(owned.friction_a.empty());
+      CHECK(owned.nodes.gid.empty());
+      CHECK(owned.joints.gid.empty());
+      CHECK(owned.pair_a.empty());
     }
     const std::string path = dir.file("idle.h5");
     CHECK(caught([&] { write_checkpoint(path, comm, make_header(scene), owned); }) == "none");
     std::pair<CheckpointHeader, CheckpointRows> back;
     CHECK(caught([&] { back = read_checkpoint(path, comm); }) == "none");
-    Scene expected_scene = scene;
+    FileScene expected_scene = scene;
     expected_scene.friction_per_writer = 2;
     check_rows_equal(back.second, expected_rows(expected_scene, holders));
   }
 
   SECTION("a scene without joints or friction: zero-size datasets") {
-    Scene scene;
+    FileScene scene;
     scene.n_joints = 0;
     scene.history_bytes = 0;
     scene.friction_per_writer = 0;
@@ -325,14 +355,14 @@ TEST_CASE("checkpoint: a rank without rows takes part, empty joint and friction 
     CHECK(caught([&] { back = read_checkpoint(path, comm); }) == "none");
     check_header_equal(back.first, header, comm.size());
     check_rows_equal(back.second, expected_rows(scene, comm.size()));
-    CHECK(back.second.joint_gid.empty());
-    CHECK(back.second.joint_history.empty());
-    CHECK(back.second.friction_a.empty());
-    CHECK(back.second.node_gid.size() == 1000);
+    CHECK(back.second.joints.gid.empty());
+    CHECK(back.second.joints.column("history").size() == 0);
+    CHECK(back.second.pair_a.empty());
+    CHECK(back.second.nodes.gid.size() == 1000);
   }
 
   SECTION("no nodes at all") {
-    Scene scene;
+    FileScene scene;
     scene.n_nodes = 0;
     scene.n_joints = 0;
     scene.history_bytes = 3;
@@ -342,9 +372,9 @@ TEST_CASE("checkpoint: a rank without rows takes part, empty joint and friction 
     CHECK(caught([&] { write_checkpoint(path, comm, make_header(scene), owned); }) == "none");
     std::pair<CheckpointHeader, CheckpointRows> back;
     CHECK(caught([&] { back = read_checkpoint(path, comm); }) == "none");
-    CHECK(back.second.node_gid.empty());
-    CHECK(back.second.node_x.empty());
-    CHECK(back.second.joint_history_bytes == 3);
+    CHECK(back.second.nodes.gid.empty());
+    CHECK(back.second.nodes.column("x").size() == 0);
+    CHECK(back.second.joints.column("history").components == 3);
     CHECK(back.first.n_tets == 4321);
   }
 }
@@ -354,7 +384,7 @@ TEST_CASE("checkpoint: a file written by one rank reads the same on all ranks",
   const Communicator world = Communicator::world();
   INFO("rank " << world.rank() << " of " << world.size());
   const SharedTempDir dir(world);
-  const Scene scene;
+  const FileScene scene;
   const CheckpointHeader header = make_header(scene);
   const std::string by_one = dir.file("by_one.h5"), by_all = dir.file("by_all.h5");
 
@@ -383,10 +413,9 @@ TEST_CASE("checkpoint: a file written by one rank reads the same on all ranks",
   check_rows_equal(one_writer.second, expected_rows(scene, 1));
   // Node and joint rows do not depend on how many ranks wrote them.
   CheckpointRows without_friction = all_writers.second;
-  without_friction.friction_a = one_writer.second.friction_a;
-  without_friction.friction_b = one_writer.second.friction_b;
-  without_friction.friction_spring = one_writer.second.friction_spring;
-  without_friction.friction_stiffness = one_writer.second.friction_stiffness;
+  without_friction.pair_a = one_writer.second.pair_a;
+  without_friction.pair_b = one_writer.second.pair_b;
+  without_friction.pair_columns = one_writer.second.pair_columns;
   check_rows_equal(without_friction, one_writer.second);
 }
 
@@ -395,7 +424,7 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());
   const SharedTempDir dir(comm);
-  Scene scene;
+  FileScene scene;
   scene.n_nodes = 40;
   scene.n_joints = 10;
   const CheckpointHeader header = make_header(scene);
@@ -473,15 +502,31 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
     CHECK(message.find("/joints/damage") != std::string::npos);
   }
   SECTION("another format version") {
-    const std::string path = good_copy("version1.h5");
+    const std::string path = good_copy("version2.h5");
     alter(path, [](hid_t file) {
       const hid_t attr = H5Aopen(file, "version", H5P_DEFAULT);
-      const std::int32_t one = 1;  // before checksums
-      CHECK(H5Awrite(attr, H5T_NATIVE_INT32, &one) >= 0);
+      const std::int32_t two = 2;  // fixed datasets, before the field tables
+      CHECK(H5Awrite(attr, H5T_NATIVE_INT32, &two) >= 0);
       H5Aclose(attr);
     });
     const std::string message = read_error(path);
-    CHECK(message.find("version 1") != std::string::npos);
+    CHECK(message.find("format version 2; this fdem reads version 3") != std::string::npos);
+    CHECK(message.find("older fdem") != std::string::npos);
+  }
+  SECTION("datasets other than the ones this build restores") {
+    const std::string path = good_copy("other_fields.h5");
+    // A reader whose joint records are 16 bytes, where the file's are 12.
+    FileScene other = scene;
+    other.history_bytes = 16;
+    const CheckpointRows layout = empty_rows(other);
+    const std::string result = caught([&] { read_checkpoint(path, comm, nullptr, {}, &layout); });
+    CHECK(same_on_all_ranks(comm, result));
+    CHECK(result.rfind("input:", 0) == 0);
+    CHECK(result.find("the file has joints/history:uint8[12] where this fdem restores "
+                      "joints/history:uint8[16]") != std::string::npos);
+    // The same layout as the file's reads.
+    const CheckpointRows same = empty_rows(scene);
+    CHECK(caught([&] { read_checkpoint(path, comm, nullptr, {}, &same); }) == "none");
   }
   // Flips bit 4 of the byte at `offset` of the file (rank 0), then waits for it.
   auto flip = [&](const std::string& path, std::uint64_t offset) {
@@ -573,7 +618,7 @@ TEST_CASE("checkpoint: written through a temporary name, other files untouched",
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());
   const SharedTempDir dir(comm);
-  Scene scene;
+  FileScene scene;
   scene.n_nodes = 60;
   scene.n_joints = 20;
   CheckpointHeader header = make_header(scene);
