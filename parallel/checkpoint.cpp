@@ -393,14 +393,9 @@ void write_checkpoint(const std::string& path, const Communicator& comm,
                            CheckpointTable& to) {
     to.gid.resize(run.count);
     std::iota(to.gid.begin(), to.gid.end(), GlobalId(run.start));
-    for (const CheckpointColumn& c : from.columns) {
-      CheckpointColumn& column = to.columns.emplace_back();
-      column.name = c.name;
-      column.components = c.components;
-      column.values = std::visit(
-          [&](const auto& v) { return CheckpointValues(exchange.to_block(v, c.components)); },
-          c.values);
-    }
+    for (const CheckpointColumn& c : from.columns)
+      to.columns.push_back(
+          c.with_values([&](const auto& v) { return exchange.to_block(v, c.components); }));
   };
   to_block(node_exchange, owned.nodes, block.nodes, rows.nodes);
   to_block(joint_exchange, owned.joints, block.joints, rows.joints);
@@ -480,13 +475,8 @@ CheckpointRows CheckpointRows::layout() const {
   CheckpointRows empty;
   const auto strip = [](const std::vector<CheckpointColumn>& from) {
     std::vector<CheckpointColumn> out;
-    for (const CheckpointColumn& c : from) {
-      CheckpointColumn& column = out.emplace_back();
-      column.name = c.name;
-      column.components = c.components;
-      column.values = std::visit(
-          [](const auto& v) { return CheckpointValues(std::decay_t<decltype(v)>{}); }, c.values);
-    }
+    for (const CheckpointColumn& c : from)
+      out.push_back(c.with_values([](const auto& v) { return std::decay_t<decltype(v)>{}; }));
     return out;
   };
   empty.nodes.columns = strip(nodes.columns);

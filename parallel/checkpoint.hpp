@@ -33,6 +33,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -72,6 +73,15 @@ struct CheckpointColumn {
   }
   // "name:type[components]", as the root attribute `fields` lists it.
   std::string description() const;
+  // The same dataset with the values f(values) (f maps a std::vector<T> to a std::vector<T>).
+  template <class F>
+  CheckpointColumn with_values(F&& f) const {
+    CheckpointColumn out;
+    out.name = name;
+    out.components = components;
+    out.values = std::visit([&](const auto& v) { return CheckpointValues(f(v)); }, values);
+    return out;
+  }
 };
 
 // A group of rows: their keys and one column per dataset.

@@ -535,14 +535,9 @@ std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(
                          const std::vector<GlobalId>& gids, CheckpointTable& out) {
     const BlockFetch fetcher(comm, GidBlocks{n, comm.size()}, gids);
     out.gid = gids;
-    for (const CheckpointColumn& c : block.columns) {
-      CheckpointColumn& column = out.columns.emplace_back();
-      column.name = c.name;
-      column.components = c.components;
-      column.values = std::visit(
-          [&](const auto& v) { return CheckpointValues(fetcher.fetch(v, c.components)); },
-          c.values);
-    }
+    for (const CheckpointColumn& c : block.columns)
+      out.columns.push_back(
+          c.with_values([&](const auto& v) { return fetcher.fetch(v, c.components); }));
   };
   fetch(in.nodes, header.n_nodes, wanted->nodes, rows.nodes);
   fetch(in.joints, header.n_joints, wanted->joints, rows.joints);
@@ -556,12 +551,9 @@ std::pair<CheckpointHeader, CheckpointRows> read_checkpoint(
       for (std::size_t i = 0; i < c.components; ++i)
         slice[k].value[at++] = std::get<std::vector<double>>(c.values)[k * c.components + i];
   }
-  for (const CheckpointColumn& c : in.pair_columns) {
-    CheckpointColumn& column = rows.pair_columns.emplace_back();
-    column.name = c.name;
-    column.components = c.components;
-    column.values = std::vector<double>{};
-  }
+  for (const CheckpointColumn& c : in.pair_columns)
+    rows.pair_columns.push_back(
+        c.with_values([](const auto& v) { return std::decay_t<decltype(v)>{}; }));
   blocks = FileBlocks{};  // the blocks are no longer needed
   for (const FrictionRow& row : deliver_friction(comm, header.n_tets, slice, wanted->tets)) {
     rows.pair_a.push_back(row.a);

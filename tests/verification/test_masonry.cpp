@@ -19,37 +19,6 @@ namespace {
 
 constexpr double deg = M_PI / 180;
 
-// A block b (x) × 0.2 (y) × h (z) generated as a one-block tower on a fixed base.
-// Contact penalty p = 4E.  A penalty contact is a compliant foundation: near the tipping point
-// the contact zone shrinks towards the edge and the pivot sits inside it, so the block tips early
-// by about (N/(p·d))^(1/3) (N the weight, d the depth); with E = 1e8, p = 4e8 this is ~0.5° of
-// tilt.
-Scene block_on_base(double b, double h, double friction, double end_time, double young = 1e8) {
-  Scene scene = basic_scene(end_time);
-  scene.materials.push_back(elastic_material(2000, young, 0.2));
-  MaterialSpec& m = scene.materials[0];
-  m.contact.friction = friction;
-  m.contact.damping = 0.5;
-  m.contact.auto_penalty = false;
-  m.contact.penalty = 4 * young;
-  m.damping = 0.5;
-  scene.time.safety = 0.5;
-  scene.bodies.push_back(box_body("base", Vec3(-0.6, -0.3, -0.1), Vec3(0.6, 0.3, 0), 6, 3, 1));
-  scene.bodies[0].fixed = true;
-  BodySpec block;
-  block.name = "block";
-  block.material = 0;
-  block.mesh.kind = MeshSpec::Kind::tower;
-  block.mesh.tower.block = Vec3(b, 0.2, h);
-  block.mesh.tower.blocks = 1;
-  block.mesh.tower.cells[0] = 2;
-  block.mesh.tower.cells[1] = 2;
-  block.mesh.tower.cells[2] = static_cast<int>(std::lround(2 * h / b));
-  block.mesh.tower.origin = Vec3(-0.5 * b, -0.1, 0);
-  scene.bodies.push_back(block);
-  return scene;
-}
-
 // Tilting table (gravity turned about +y, towards −x): the block settles 0.2 s on the table
 // tilted `first` degrees below `angle`, which then tilts at 30°/s to 2° below `angle` and at
 // 4°/s on to `angle`, held 0.4 s.  (A start far from tipping saves steps; a block that may slide

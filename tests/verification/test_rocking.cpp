@@ -50,39 +50,19 @@ TEST_CASE(
     "equation says, within 1 % (docs/references.md 13, Housner)",
     "[verification][masonry]") {
   // Block 0.25 × 0.2 × 1.0 m (b/h = 0.25) on a fixed base, μ = 0.8 (no sliding at the toe).
-  const double b = 0.25, d = 0.2, h = 1.0, g = 9.81, young = 1e9;
+  const double b = 0.25, h = 1.0, g = 9.81, young = 1e9;
   const double R = 0.5 * std::hypot(b, h), alpha = std::atan(b / h);
   const double p = std::sqrt(3 * g / (4 * R));
   const double omega0 = 0.5 * p * alpha;
   const RigidRocking continuum = rigid_rocking(p, alpha, omega0);
 
-  Scene scene = basic_scene(1.5 * continuum.return_time);
+  Scene scene = block_on_base(b, h, 0.8, 1.5 * continuum.return_time, young);
   scene.gravity = Vec3(0, 0, -g);
-  scene.materials.push_back(elastic_material(2000, young, 0.2));
-  MaterialSpec& m = scene.materials[0];
-  m.contact.friction = 0.8;
-  m.contact.damping = 0.5;
-  m.contact.auto_penalty = false;
-  m.contact.penalty = 4 * young;
-  m.damping = 0.5;
-  scene.time.safety = 0.5;
-  scene.bodies.push_back(box_body("base", Vec3(-0.4, -0.25, -0.1), Vec3(0.4, 0.25, 0), 4, 2, 1));
-  scene.bodies[0].fixed = true;
-  BodySpec block;
-  block.name = "block";
-  block.material = 0;
-  block.mesh.kind = MeshSpec::Kind::tower;
-  block.mesh.tower.block = Vec3(b, d, h);
-  block.mesh.tower.blocks = 1;
-  block.mesh.tower.cells[0] = 2;
-  block.mesh.tower.cells[1] = 2;
-  block.mesh.tower.cells[2] = 8;
-  block.mesh.tower.origin = Vec3(-0.5 * b, -0.5 * d, 0);
+  BodySpec& block = scene.bodies[1];
   // Rigid rotation about the toe edge (x = b/2, z = 0, along y): ω × (x − toe) = ω × (x − c) +
   // ω × (c − toe), the centroid c = (0, 0, h/2).
   block.angular_velocity = Vec3(0, omega0, 0);
   block.velocity = Vec3(0, omega0, 0).cross(Vec3(-0.5 * b, 0, 0.5 * h));
-  scene.bodies.push_back(block);
 
   auto sim = quiet_simulation(scene);
   // The rigid-block equation with the model's own mass moments about the toe: lumped nodal
