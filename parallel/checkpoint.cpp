@@ -471,18 +471,4 @@ std::string CheckpointRows::field_list() const {
   return text;
 }
 
-CheckpointRows CheckpointRows::layout() const {
-  CheckpointRows empty;
-  const auto strip = [](const std::vector<CheckpointColumn>& from) {
-    std::vector<CheckpointColumn> out;
-    for (const CheckpointColumn& c : from)
-      out.push_back(c.with_values([](const auto& v) { return std::decay_t<decltype(v)>{}; }));
-    return out;
-  };
-  empty.nodes.columns = strip(nodes.columns);
-  empty.joints.columns = strip(joints.columns);
-  empty.pair_columns = strip(pair_columns);
-  return empty;
-}
-
 }  // namespace fdem

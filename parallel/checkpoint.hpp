@@ -100,8 +100,6 @@ struct CheckpointRows {
 
   // The datasets' list (the root attribute `fields`): the same for every rank of one write.
   std::string field_list() const;
-  // The same columns with no rows: what a reader asks for.
-  CheckpointRows layout() const;
 };
 
 // Collective.  Writes `path` via `path + ".tmp"` (MPI-IO on comm.handle()), flushes and closes

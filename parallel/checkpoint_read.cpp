@@ -218,13 +218,11 @@ class BlockFetch {
   std::vector<int> askers_;
 };
 
-// One friction pair as it travels between ranks: its tets and up to four values (the pair
-// columns' components, in column order).
-constexpr std::size_t max_pair_values = 4;
-struct FrictionRow {
-  GlobalId a, b;
-  double value[max_pair_values];
-};
+// A friction pair travels between ranks as the record the contact stage keeps
+// (core/travelling_state.hpp): its tets and its values, the pair columns' components in column
+// order.
+constexpr std::size_t max_pair_values = sizeof(PairRecord::value) / sizeof(double);
+using FrictionRow = PairRecord;
 
 bool pair_less(const FrictionRow& p, const FrictionRow& q) {
   return p.a != q.a ? p.a < q.a : p.b < q.b;

@@ -146,8 +146,9 @@ void Distribution::start_exchange(std::vector<Neighbour>& plan, const NodeArrays
   for (Neighbour& nb : plan)
     if (!nb.send.empty()) {
       double* out = nb.send_buffer.data();
+      const std::vector<HaloField>& fields = halo_fields();
       for (LocalIndex n : nb.send)
-        for (const HaloField& field : halo_fields())
+        for (const HaloField& field : fields)
           out = std::copy_n((nodes.*field.member).data() + field.components * std::size_t(n),
                             field.components, out);
       requests_.emplace_back();
@@ -162,8 +163,9 @@ void Distribution::finish_exchange(const std::vector<Neighbour>& plan, NodeArray
   requests_.clear();
   for (const Neighbour& nb : plan) {
     const double* in = nb.receive_buffer.data();
+    const std::vector<HaloField>& fields = halo_fields();
     for (LocalIndex n : nb.receive)
-      for (const HaloField& field : halo_fields()) {
+      for (const HaloField& field : fields) {
         std::copy_n(in, field.components,
                     (nodes.*field.member).data() + field.components * std::size_t(n));
         in += field.components;
