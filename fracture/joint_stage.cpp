@@ -54,7 +54,16 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
   NodeArrays& nodes = model.nodes;
   const LocalIndex n = joints.size();
   const TetArrays& tets = model.tets;
+  // Face B's nodes belong to the neighbouring tet, often far from face A's in memory: fetched
+  // ahead, they are in cache when the joint is computed.
+  constexpr LocalIndex ahead = 8;
   for (LocalIndex j = 0; j < n; ++j) {
+    if (j + ahead < n)
+      for (int i = 3; i < 6; i += 2) {
+        const LocalIndex node = joints.nodes[6 * static_cast<std::size_t>(j + ahead) + i];
+        __builtin_prefetch(nodes.x.data() + 3 * static_cast<std::size_t>(node));
+        __builtin_prefetch(nodes.f.data() + 3 * static_cast<std::size_t>(node), 1);
+      }
     if (joints.broken[j]) continue;
     const LocalIndex tet_a = joints.tets[2 * j], tet_b = joints.tets[2 * j + 1];
     if (!tets.is_active(tet_a) && !tets.is_active(tet_b)) continue;  // other ranks compute it

@@ -116,8 +116,10 @@ TEST_CASE("enclosed tets stay out of contact, change no force, and return when a
     if (model.pieces.body_of(model.nodes.piece[n]) == 0)
       for (int d = 0; d < 3; ++d) model.nodes.x[3 * n + d] += shake(random);
   const double buffer = 0.025;
-  ContactStage skipping(model, ContactSettings{buffer, true});
-  ContactStage all(model, ContactSettings{buffer, false});
+  // Narrowed by face planes only: the exact distance would drop the enclosed tets' pairs of
+  // this scene too (test_tet_distance.cpp), leaving nothing for the skip to show.
+  ContactStage skipping(model, ContactSettings{buffer, true, false});
+  ContactStage all(model, ContactSettings{buffer, false, false});
   for (ContactStage* stage : {&skipping, &all}) {
     stage->set_bonds(model.tets.size(), bonds(model));
     stage->enclose(model.tets.enclosed);
