@@ -29,8 +29,6 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
     penalty_.push_back(m.contact.auto_penalty ? auto_penalty_factor * m.young : m.contact.penalty);
     friction_coefficient_.push_back(m.contact.friction);
     damping_ratio_.push_back(m.contact.damping);
-    any_friction_ = any_friction_ || m.contact.friction > 0.0;
-    any_damping_ = any_damping_ || m.contact.damping > 0.0;
   }
   x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   skip_enclosed_ = settings.skip_enclosed;
@@ -400,18 +398,24 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   out.candidate_pairs = static_cast<std::int64_t>(pairs_.size());  // held here, not unique
   overlapping_.assign(pairs_.size(), 0);
   may_hold_friction_.resize(pairs_.size(), 1);
-  // The friction and dashpot force arrays are cleared only when the last step wrote to them (a
-  // scene at rest or apart leaves them zero and their work zero without a pass over the nodes).
-  const auto clear = [&](bool wanted, std::vector<double>& force, bool& written) {
-    if (!wanted) return;
-    if (force.size() != 3 * static_cast<std::size_t>(nodes.size()))
-      force.assign(3 * static_cast<std::size_t>(nodes.size()), 0.0);
+  // The friction and dashpot force arrays (3 per node) exist from the first step that writes to
+  // them and are cleared only after a step that did: bodies apart or at rest cost neither memory
+  // nor a pass over the nodes.
+  const std::size_t values = 3 * static_cast<std::size_t>(nodes.size());
+  const auto clear = [&](std::vector<double>& force, bool& written) {
+    if (force.size() != values && !force.empty())
+      force.clear();  // the local nodes changed (redistribution)
     else if (written)
       std::fill(force.begin(), force.end(), 0.0);
     written = false;
   };
-  clear(any_friction_, friction_force_, friction_written_);
-  clear(any_damping_, damping_force_, damping_written_);
+  const auto writable = [&](std::vector<double>& force, bool& written) {
+    if (force.empty()) force.assign(values, 0.0);
+    written = true;
+    return force.data();
+  };
+  clear(friction_force_, friction_written_);
+  clear(damping_force_, damping_written_);
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
     const CandidatePair& pair = pairs_[index];
     TetCorners a, b;
@@ -466,15 +470,15 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       const double v_n = relative_velocity_at_centroid(r, va, vb).dot(r.normal);
       const double f_n = std::max(-2.0 * xi * std::sqrt(k * m) * v_n,
                                   -r.normal_force);  // on the contactor, along n
+      double* damping_force = writable(damping_force_, damping_written_);
       for (int c = 0; c < 4; ++c) {
         const Vec3 on_a = r.centroid_weights_contactor[c] * f_n * r.normal;
         const Vec3 on_b = -r.centroid_weights_target[c] * f_n * r.normal;
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += on_a;
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += on_b;
-        vec3_at(damping_force_.data(), tets.nodes[4 * pair.a + c]) += on_a;
-        vec3_at(damping_force_.data(), tets.nodes[4 * pair.b + c]) += on_b;
+        vec3_at(damping_force, tets.nodes[4 * pair.a + c]) += on_a;
+        vec3_at(damping_force, tets.nodes[4 * pair.b + c]) += on_b;
       }
-      damping_written_ = true;
     }
     Vec3 tangential = Vec3::Zero();
     if (mu > 0.0) {
@@ -488,13 +492,13 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       FrictionHistory& history = pair_friction.history;
       const FrictionResult f =
           coulomb_friction(law, r, relative_velocity_at_centroid(r, va, vb), dt, history);
+      double* friction_force = writable(friction_force_, friction_written_);
       for (int c = 0; c < 4; ++c) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += f.force_target[c];
-        vec3_at(friction_force_.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
-        vec3_at(friction_force_.data(), tets.nodes[4 * pair.b + c]) += f.force_target[c];
+        vec3_at(friction_force, tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
+        vec3_at(friction_force, tets.nodes[4 * pair.b + c]) += f.force_target[c];
       }
-      friction_written_ = true;
       out.friction_spring_energy += share * f.spring_energy;
       tangential = f.tangential_force;
     }

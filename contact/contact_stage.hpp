@@ -188,9 +188,8 @@ class ContactStage {
   std::unordered_map<PairId, PairFriction, PairIdHash> friction_;
   std::vector<double> friction_coefficient_, damping_ratio_;
   // Friction and dashpot forces of the last add_forces per local node (N, xyz), for their work;
-  // empty when no material has friction / contact damping.
+  // empty until a step writes such a force.
   std::vector<double> friction_force_, damping_force_;
-  bool any_friction_ = false, any_damping_ = false;
   bool friction_written_ = false, damping_written_ = false;  // by the last add_forces
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
   using JointState = TetJointState;
