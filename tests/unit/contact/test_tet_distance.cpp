@@ -9,6 +9,7 @@
 #include "contact/contact_stage.hpp"
 #include "contact/tet_distance.hpp"
 #include "core/model_builder.hpp"
+#include "jointed_cube.hpp"
 
 using namespace fdem;
 
@@ -43,54 +44,13 @@ double sampled_distance(const Vec3 (&a)[4], const Vec3 (&b)[4], int k) {
   return std::sqrt(best);
 }
 
-// A cube [0, n·h]³ of n³ cells of 6 Kuhn tets each (diagonal 0–7).
-BodyMesh kuhn_cube(int n, double h) {
-  BodyMesh mesh;
-  mesh.source = "test";
-  const auto id = [&](int i, int j, int k) {
-    return static_cast<LocalIndex>(i + (n + 1) * (j + (n + 1) * k));
-  };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) mesh.coords.insert(mesh.coords.end(), {i * h, j * h, k * h});
-  const LocalIndex kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
-                                 {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        LocalIndex corner[8];
-        for (int c = 0; c < 8; ++c) corner[c] = id(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
-        for (const auto& t : kuhn)
-          for (int c = 0; c < 4; ++c) mesh.tets.push_back(corner[t[c]]);
-      }
-  return mesh;
-}
-
+// The jointed cube's scene and a plain body "lid" of the same rock.
 Scene two_body_scene() {
-  Scene scene;
-  scene.source_path = "test";
-  MaterialSpec rock;
-  rock.name = "rock";
-  rock.density = 2500;
-  rock.elastic.young = 1e9;
-  rock.elastic.poisson = 0.25;
-  rock.contact.friction = 0.5;
-  FractureSpec fracture;
-  fracture.tensile_strength = 1e6;
-  fracture.cohesion = 2e6;
-  fracture.friction_angle_deg = 30.0;
-  fracture.energy_I = 10.0;
-  fracture.energy_II = 50.0;
-  rock.fracture = fracture;
-  scene.materials.push_back(rock);
-  BodySpec body;
-  body.name = "cube";
-  body.material = 0;
-  body.joints = JointPlacement::all;
-  scene.bodies.push_back(body);
-  body.name = "lid";
-  body.joints = JointPlacement::none;
-  scene.bodies.push_back(body);
+  Scene scene = testing::jointed_scene();
+  BodySpec lid = scene.bodies[0];
+  lid.name = "lid";
+  lid.joints = JointPlacement::none;
+  scene.bodies.push_back(lid);
   return scene;
 }
 
@@ -165,9 +125,9 @@ TEST_CASE(
   // A jointed 5³-cell cube (its surface tets near each other but not sharing a node are what the
   // face planes cannot drop) and a plain block pressed 1 mm into its top, the cube shaken by
   // 0.5 % of a cell.
-  BodyMesh block = kuhn_cube(1, 0.3);
+  BodyMesh block = testing::kuhn_cube(1, 0.3);
   for (std::size_t i = 0; i < block.coords.size(); ++i) block.coords[i] += i % 3 == 2 ? 0.499 : 0.1;
-  Model model = build_model(two_body_scene(), {kuhn_cube(5, 0.1), block});
+  Model model = build_model(two_body_scene(), {testing::kuhn_cube(5, 0.1), block});
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> shake(-5e-4, 5e-4);
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
