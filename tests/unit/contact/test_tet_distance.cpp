@@ -44,16 +44,6 @@ double sampled_distance(const Vec3 (&a)[4], const Vec3 (&b)[4], int k) {
   return std::sqrt(best);
 }
 
-// The jointed cube's scene and a plain body "lid" of the same rock.
-Scene two_body_scene() {
-  Scene scene = testing::jointed_scene();
-  BodySpec lid = scene.bodies[0];
-  lid.name = "lid";
-  lid.joints = JointPlacement::none;
-  scene.bodies.push_back(lid);
-  return scene;
-}
-
 std::set<std::pair<LocalIndex, LocalIndex>> pairs_of(const ContactStage& stage) {
   std::set<std::pair<LocalIndex, LocalIndex>> out;
   for (const CandidatePair& p : stage.candidates()) out.emplace(p.a, p.b);
@@ -125,20 +115,11 @@ TEST_CASE(
   // A jointed 5³-cell cube (its surface tets near each other but not sharing a node are what the
   // face planes cannot drop) and a plain block pressed 1 mm into its top, the cube shaken by
   // 0.5 % of a cell.
-  BodyMesh block = testing::kuhn_cube(1, 0.3);
-  for (std::size_t i = 0; i < block.coords.size(); ++i) block.coords[i] += i % 3 == 2 ? 0.499 : 0.1;
-  Model model = build_model(two_body_scene(), {testing::kuhn_cube(5, 0.1), block});
-  std::mt19937_64 random(7);
-  std::uniform_real_distribution<double> shake(-5e-4, 5e-4);
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces.body_of(model.nodes.piece[n]) == 0)
-      for (int d = 0; d < 3; ++d) model.nodes.x[3 * n + d] += shake(random);
+  Model model = testing::pressed_jointed_cube();
   const double buffer = 0.025;
   ContactStage exact(model, ContactSettings{buffer, true, true});
   ContactStage planes(model, ContactSettings{buffer, true, false});
-  std::vector<std::pair<LocalIndex, LocalIndex>> bonds;
-  for (LocalIndex j = 0; j < model.joints.size(); ++j)
-    bonds.emplace_back(model.joints.tets[2 * j], model.joints.tets[2 * j + 1]);
+  const auto bonds = testing::joint_bonds(model);
   for (ContactStage* stage : {&exact, &planes}) {
     stage->set_bonds(model.tets.size(), bonds);
     stage->enclose(model.tets.enclosed);
