@@ -194,20 +194,16 @@ void ContactStage::mark_left_out(const Model& model) {
       }
 }
 
-void ContactStage::run_detection(const Model& model, const double* x) {
-  ++broad_phase_passes_;
-  compute_boxes(model, x);
+// Whether detection keeps the pair (a, b) whose inflated boxes overlap, at positions x.
+bool ContactStage::keeps(const Model& model, const double* x, LocalIndex a, LocalIndex b) const {
   const TetArrays& tets = model.tets;
-  const bool all_active = tets.active.empty();
-  mark_left_out(model);
-  const auto eligible = [&](LocalIndex a, LocalIndex b) {
-    if (left_out_[a] || left_out_[b]) return false;
-    // A pair between two tets this rank does not compute is left to the ranks that do.
-    if (!all_active && !tets.active[a] && !tets.active[b]) return false;
-    if (tets.group_of(a) == tets.group_of(b) ||
-        (piece_fixed(model, tets.piece[a]) && piece_fixed(model, tets.piece[b])))
-      return false;
-    if (bonds_.empty()) return true;
+  if (left_out_[a] || left_out_[b]) return false;
+  // A pair between two tets this rank does not compute is left to the ranks that do.
+  if (!tets.active.empty() && !tets.active[a] && !tets.active[b]) return false;
+  if (tets.group_of(a) == tets.group_of(b) ||
+      (piece_fixed(model, tets.piece[a]) && piece_fixed(model, tets.piece[b])))
+    return false;
+  if (!bonds_.empty()) {
     const LocalIndex* bonded = bonds_.data() + 4 * static_cast<std::size_t>(a);
     if (bonded[0] == b || bonded[1] == b || bonded[2] == b || bonded[3] == b) return false;
     // Tets of one jointed continuum that met at a mesh node at t = 0 (their nodes were split
@@ -216,27 +212,72 @@ void ContactStage::run_detection(const Model& model, const double* x) {
     const auto holds = [&](LocalIndex t) {
       return joint_state_[t] == JointState::intact || joint_state_[t] == JointState::enclosed;
     };
-    if (holds(a) && holds(b)) return !share_reference_node(model, a, b);
-    return true;
-  };
+    if (holds(a) && holds(b) && share_reference_node(model, a, b)) return false;
+  }
   // Narrowed as the boxes are tested, so that only kept pairs are ever stored (box overlaps of
   // sliver tets across a joint between blocks outnumber the kept pairs several times): every
   // point of a tet stays within buffer/2 of where it was at detection (a convex combination of
   // node moves ≤ buffer/2), so a pair whose tets are now more than `buffer` apart cannot touch
   // before the next detection.
-  const auto keep = [&](LocalIndex a, LocalIndex b) {
-    if (!eligible(a, b) || tets_farther_than(model, x, a, b, buffer_)) return false;
-    if (!exact_narrowing_) return true;
-    // No face plane separates them by a buffer; their exact distance may (tets of one jointed
-    // body near its surface, sliver tets across an interface): kept pairs cost every step.
-    Vec3 corners[2][4];
-    for (int c = 0; c < 4; ++c) {
-      corners[0][c] = vec3_at(x, tets.nodes[4 * a + c]);
-      corners[1][c] = vec3_at(x, tets.nodes[4 * b + c]);
+  if (tets_farther_than(model, x, a, b, buffer_)) return false;
+  if (!exact_narrowing_) return true;
+  // No face plane separates them by a buffer; their exact distance may (tets of one jointed
+  // body near its surface, sliver tets across an interface): kept pairs cost every step.
+  Vec3 corners[2][4];
+  for (int c = 0; c < 4; ++c) {
+    corners[0][c] = vec3_at(x, tets.nodes[4 * a + c]);
+    corners[1][c] = vec3_at(x, tets.nodes[4 * b + c]);
+  }
+  return tets_within(corners[0], corners[1], buffer_);
+}
+
+void ContactStage::run_detection(const Model& model, const double* x) {
+  ++broad_phase_passes_;
+  compute_boxes(model, x);
+  mark_left_out(model);
+  const auto keep = [&](LocalIndex a, LocalIndex b) { return keeps(model, x, a, b); };
+  detector_.detect(lo_.data(), hi_.data(), model.tets.size(), buffer_, pairs_, keep);
+  may_hold_friction_.assign(pairs_.size(), 1);
+}
+
+// The pairs a detection at the positions of the last one would add after the eligibility of the
+// `changed` tets widened (and no other's): each changed tet's inflated box against every box,
+// the same box overlap and keeps() as the detector, merged into the sorted list.  A few tets'
+// pairs cost a pass over the boxes each; many, a detection.
+void ContactStage::add_pairs_of(const Model& model, const std::vector<LocalIndex>& changed) {
+  const LocalIndex n = model.tets.size();
+  if (changed.size() > 64) {
+    run_detection(model, x_at_detection_.data());
+    return;
+  }
+  const double* x = x_at_detection_.data();
+  compute_boxes(model, x);
+  const double half = 0.5 * buffer_;
+  const auto box_of = [&](LocalIndex t, double(&box)[6]) {
+    for (int k = 0; k < 3; ++k) {
+      box[k] = lo_[3 * t + k] - half;
+      box[3 + k] = hi_[3 * t + k] + half;
     }
-    return tets_within(corners[0], corners[1], buffer_);
   };
-  detector_.detect(lo_.data(), hi_.data(), tets.size(), buffer_, pairs_, keep);
+  std::vector<CandidatePair> added;
+  for (const LocalIndex c : changed) {
+    double box_c[6], box_t[6];
+    box_of(c, box_c);
+    for (LocalIndex t = 0; t < n; ++t) {
+      box_of(t, box_t);
+      if (t == c || !boxes_overlap(box_c, box_t)) continue;
+      const CandidatePair pair{std::min(c, t), std::max(c, t)};
+      if (!std::binary_search(pairs_.begin(), pairs_.end(), pair) &&
+          keeps(model, x, pair.a, pair.b))
+        added.push_back(pair);
+    }
+  }
+  std::sort(added.begin(), added.end());
+  added.erase(std::unique(added.begin(), added.end()), added.end());
+  const std::size_t old_size = pairs_.size();
+  pairs_.insert(pairs_.end(), added.begin(), added.end());
+  std::inplace_merge(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(old_size),
+                     pairs_.end());
   may_hold_friction_.assign(pairs_.size(), 1);
 }
 
@@ -370,24 +411,30 @@ void ContactStage::crack_body(std::int32_t body) {
 
 void ContactStage::release_bonds(const Model& model,
                                  const std::vector<std::pair<LocalIndex, LocalIndex>>& pairs) {
-  bool changed = false;
+  std::vector<LocalIndex> changed;  // tets whose eligibility widened
   for (const auto& [a, b] : pairs)
     for (int side = 0; side < 2; ++side) {
       const LocalIndex t = side == 0 ? a : b, other = side == 0 ? b : a;
       if (t < 0) continue;  // that tet is not held here (parallel runs)
+      bool widened = false;
       if (!joint_state_.empty() && joint_state_[t] != JointState::cracked) {
-        joint_state_[t] = JointState::cracked;
-        changed = true;
-      }
-      if (bonds_.empty() || other < 0) continue;  // a bond is held with both its tets
-      for (int k = 0; k < 4; ++k)
-        if (bonds_[4 * static_cast<std::size_t>(t) + k] == other) {
-          bonds_[4 * static_cast<std::size_t>(t) + k] = -1;
-          changed = true;
+        if (!left_out_.empty() && left_out_[t]) {  // enclosed, and its body had not cracked
+          left_out_[t] = 0;
+          --left_out_count_;
         }
+        joint_state_[t] = JointState::cracked;
+        widened = true;
+      }
+      if (!bonds_.empty() && other >= 0)  // a bond is held with both its tets
+        for (int k = 0; k < 4; ++k)
+          if (bonds_[4 * static_cast<std::size_t>(t) + k] == other) {
+            bonds_[4 * static_cast<std::size_t>(t) + k] = -1;
+            widened = true;
+          }
+      if (widened) changed.push_back(t);
     }
   // Only widened eligibility at unchanged positions: every pair of the list is found again.
-  if (changed && detected_) run_detection(model, x_at_detection_.data());
+  if (!changed.empty() && detected_) add_pairs_of(model, changed);
 }
 
 ContactForceSummary ContactStage::add_forces(Model& model, double dt) {

@@ -155,6 +155,8 @@ class ContactStage {
   void compute_boxes(const Model& model, const double* x);
   ContactWork work_against(const Model& model, double dt) const;
   void run_detection(const Model& model, const double* x);
+  bool keeps(const Model& model, const double* x, LocalIndex a, LocalIndex b) const;
+  void add_pairs_of(const Model& model, const std::vector<LocalIndex>& changed);
 
   double buffer_ = 0.0;
   std::vector<double> penalty_;
