@@ -29,10 +29,14 @@ struct FrictionEntry {
   GlobalId a = 0, b = 0;
   Vec3 spring = Vec3::Zero();  // stick spring (m)
   double stiffness = 0.0;      // N/m
+  // The spring's anchors: barycentric weights in tet a and in tet b (FrictionHistory).
+  double anchor_a[4] = {0.0, 0.0, 0.0, 0.0};
+  double anchor_b[4] = {0.0, 0.0, 0.0, 0.0};
 };
 
 // Friction entries as the pair records that travel with their first tet (TravellingState), and
-// back: spring (m) in values 0–2, stiffness (N/m) in value 3.
+// back: spring (m) in values 0–2, stiffness (N/m) in value 3, anchors in values 4–7 (tet a) and
+// 8–11 (tet b).
 std::vector<PairRecord> friction_records(const std::vector<FrictionEntry>& entries);
 std::vector<FrictionEntry> friction_entries(const std::vector<PairRecord>& records);
 
