@@ -7,6 +7,7 @@
 
 #include "contact/detection.hpp"
 #include "contact/potential_contact_kernels.hpp"
+#include "contact/tet_distance.hpp"
 #include "core/error.hpp"
 #include "core/tet_kernels.hpp"
 
@@ -35,11 +36,10 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
     penalty_.push_back(m.contact.auto_penalty ? auto_penalty_factor * m.young : m.contact.penalty);
     friction_coefficient_.push_back(m.contact.friction);
     damping_ratio_.push_back(m.contact.damping);
-    any_friction_ = any_friction_ || m.contact.friction > 0.0;
-    any_damping_ = any_damping_ || m.contact.damping > 0.0;
   }
   x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   skip_enclosed_ = settings.skip_enclosed;
+  exact_narrowing_ = settings.exact_narrowing;
   body_cracked_.assign(static_cast<std::size_t>(std::max(model.pieces.bodies(), 0)), 0);
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
@@ -232,7 +232,16 @@ void ContactStage::run_detection(const Model& model, const double* x) {
   // node moves ≤ buffer/2), so a pair whose tets are now more than `buffer` apart cannot touch
   // before the next detection.
   const auto keep = [&](LocalIndex a, LocalIndex b) {
-    return eligible(a, b) && !tets_farther_than(model, x, a, b, buffer_);
+    if (!eligible(a, b) || tets_farther_than(model, x, a, b, buffer_)) return false;
+    if (!exact_narrowing_) return true;
+    // No face plane separates them by a buffer; their exact distance may (tets of one jointed
+    // body near its surface, sliver tets across an interface): kept pairs cost every step.
+    Vec3 corners[2][4];
+    for (int c = 0; c < 4; ++c) {
+      corners[0][c] = vec3_at(x, tets.nodes[4 * a + c]);
+      corners[1][c] = vec3_at(x, tets.nodes[4 * b + c]);
+    }
+    return !(tet_distance(corners[0], corners[1]) > buffer_);
   };
   detector_.detect(lo_.data(), hi_.data(), tets.size(), buffer_, pairs_, keep);
   may_hold_friction_.assign(pairs_.size(), 1);
@@ -400,8 +409,24 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   out.candidate_pairs = static_cast<std::int64_t>(pairs_.size());  // held here, not unique
   overlapping_.assign(pairs_.size(), 0);
   may_hold_friction_.resize(pairs_.size(), 1);
-  if (any_friction_) friction_force_.assign(3 * static_cast<std::size_t>(nodes.size()), 0.0);
-  if (any_damping_) damping_force_.assign(3 * static_cast<std::size_t>(nodes.size()), 0.0);
+  // The friction and dashpot force arrays (3 per node) exist from the first step that writes to
+  // them and are cleared only after a step that did: bodies apart or at rest cost neither memory
+  // nor a pass over the nodes.
+  const std::size_t values = 3 * static_cast<std::size_t>(nodes.size());
+  const auto clear = [&](std::vector<double>& force, bool& written) {
+    if (force.size() != values && !force.empty())
+      force.clear();  // the local nodes changed (redistribution)
+    else if (written)
+      std::fill(force.begin(), force.end(), 0.0);
+    written = false;
+  };
+  const auto writable = [&](std::vector<double>& force, bool& written) {
+    if (force.empty()) force.assign(values, 0.0);
+    written = true;
+    return force.data();
+  };
+  clear(friction_force_, friction_written_);
+  clear(damping_force_, damping_written_);
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
     const CandidatePair& pair = pairs_[index];
     TetCorners a, b;
@@ -456,13 +481,14 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       const double v_n = relative_velocity_at_centroid(r, va, vb).dot(r.normal);
       const double f_n = std::max(-2.0 * xi * std::sqrt(k * m) * v_n,
                                   -r.normal_force);  // on the contactor, along n
+      double* damping_force = writable(damping_force_, damping_written_);
       for (int c = 0; c < 4; ++c) {
         const Vec3 on_a = r.centroid_weights_contactor[c] * f_n * r.normal;
         const Vec3 on_b = -r.centroid_weights_target[c] * f_n * r.normal;
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += on_a;
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += on_b;
-        vec3_at(damping_force_.data(), tets.nodes[4 * pair.a + c]) += on_a;
-        vec3_at(damping_force_.data(), tets.nodes[4 * pair.b + c]) += on_b;
+        vec3_at(damping_force, tets.nodes[4 * pair.a + c]) += on_a;
+        vec3_at(damping_force, tets.nodes[4 * pair.b + c]) += on_b;
       }
     }
     Vec3 tangential = Vec3::Zero();
@@ -489,11 +515,12 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       const FrictionResult f =
           coulomb_friction(law, r, point, relative_velocity_at(point, va, vb), dt, history);
       if (f.slipping && history.attached()) slide_anchors(history, a, b, f.slip);
+      double* friction_force = writable(friction_force_, friction_written_);
       for (int c = 0; c < 4; ++c) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += f.force_target[c];
-        vec3_at(friction_force_.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
-        vec3_at(friction_force_.data(), tets.nodes[4 * pair.b + c]) += f.force_target[c];
+        vec3_at(friction_force, tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
+        vec3_at(friction_force, tets.nodes[4 * pair.b + c]) += f.force_target[c];
       }
       out.friction_spring_energy += share * f.spring_energy;
       tangential = f.tangential_force;
@@ -515,9 +542,9 @@ ContactWork ContactStage::work_against(const Model& model, double dt) const {
   ContactWork w;
   const double* v = model.nodes.v.data();
   const std::size_t n = 3 * static_cast<std::size_t>(model.nodes.n_owned);
-  if (any_friction_)
+  if (friction_written_)
     for (std::size_t i = 0; i < n; ++i) w.friction -= 0.5 * dt * friction_force_[i] * v[i];
-  if (any_damping_)
+  if (damping_written_)
     for (std::size_t i = 0; i < n; ++i) w.damping -= 0.5 * dt * damping_force_[i] * v[i];
   return w;
 }

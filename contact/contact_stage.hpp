@@ -21,6 +21,9 @@ struct ContactSettings {
   // Leave enclosed tets out of contact while their body's joints hold (scene key
   // contact.skip_enclosed; false keeps them in, the previous algorithm, for benchmarks).
   bool skip_enclosed = true;
+  // Narrow the detected pairs by the tets' exact distance as well as by their face planes (scene
+  // key contact.narrowing: exact; face_planes is the previous algorithm, for benchmarks).
+  bool exact_narrowing = true;
 };
 
 // Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with
@@ -189,13 +192,14 @@ class ContactStage {
   std::unordered_map<PairId, PairFriction, PairIdHash> friction_;
   std::vector<double> friction_coefficient_, damping_ratio_;
   // Friction and dashpot forces of the last add_forces per local node (N, xyz), for their work;
-  // empty when no material has friction / contact damping.
+  // empty until a step writes such a force.
   std::vector<double> friction_force_, damping_force_;
-  bool any_friction_ = false, any_damping_ = false;
+  bool friction_written_ = false, damping_written_ = false;  // by the last add_forces
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
   using JointState = TetJointState;
   std::vector<JointState> joint_state_;
   bool skip_enclosed_ = true;
+  bool exact_narrowing_ = true;
   std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;

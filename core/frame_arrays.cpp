@@ -57,47 +57,45 @@ std::vector<LocalIndex> owned_tets(const TetArrays& tets) {
   return cells;
 }
 
-std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<LocalIndex>& cells,
-                                         const std::vector<LocalIndex>& points,
-                                         const std::vector<std::string>& fields,
-                                         const std::vector<FrameField>& extra) {
+void for_each_tet_frame_array(const Model& model, const std::vector<LocalIndex>& cells,
+                              const std::vector<LocalIndex>& points,
+                              const std::vector<std::string>& fields,
+                              const std::vector<FrameField>& extra,
+                              const std::function<void(FrameArray&)>& take) {
   const NodeArrays& nodes = model.nodes;
   const TetArrays& tets = model.tets;
   const auto wants = [&](const char* f) {
     return std::find(fields.begin(), fields.end(), f) != fields.end();
   };
   const std::size_t n_points = points.size(), n_cells = cells.size();
-  std::vector<FrameArray> arrays;
 
   FrameArray node_gid = integer_array("gid", false, FrameValue::i64, n_points);
   for (std::size_t p = 0; p < n_points; ++p) node_gid.integer[p] = nodes.gid[points[p]];
-  arrays.push_back(std::move(node_gid));
+  take(node_gid);
   if (wants("displacement")) {
     FrameArray u = real_array("displacement", false, 3, n_points);
     for (std::size_t p = 0; p < n_points; ++p)
       for (int k = 0; k < 3; ++k)
         u.real[3 * p + k] = nodes.x[3 * points[p] + k] - nodes.x0[3 * points[p] + k];
-    arrays.push_back(std::move(u));
+    take(u);
   }
   if (wants("velocity")) {
     FrameArray v = real_array("velocity", false, 3, n_points);
     for (std::size_t p = 0; p < n_points; ++p)
       for (int k = 0; k < 3; ++k) v.real[3 * p + k] = nodes.v[3 * points[p] + k];
-    arrays.push_back(std::move(v));
+    take(v);
   }
 
-  FrameArray tet_gid = integer_array("gid", true, FrameValue::i64, n_cells);
-  FrameArray piece = integer_array("piece", true, FrameValue::i32, n_cells);
-  FrameArray body = integer_array("body", true, FrameValue::i32, n_cells);
-  FrameArray material = integer_array("material", true, FrameValue::i32, n_cells);
-  for (std::size_t c = 0; c < n_cells; ++c) {
-    const LocalIndex t = cells[c];
-    tet_gid.integer[c] = tets.gid[t];
-    piece.integer[c] = tets.piece[t];
-    body.integer[c] = model.pieces.body_of(tets.piece[t]);
-    material.integer[c] = tets.material[t];
-  }
-  for (FrameArray* a : {&tet_gid, &piece, &body, &material}) arrays.push_back(std::move(*a));
+  const auto cell_integers = [&](const char* name, FrameValue type, auto value_of) {
+    FrameArray a = integer_array(name, true, type, n_cells);
+    for (std::size_t c = 0; c < n_cells; ++c) a.integer[c] = value_of(cells[c]);
+    take(a);
+  };
+  cell_integers("gid", FrameValue::i64, [&](LocalIndex t) { return tets.gid[t]; });
+  cell_integers("piece", FrameValue::i32, [&](LocalIndex t) { return tets.piece[t]; });
+  cell_integers("body", FrameValue::i32,
+                [&](LocalIndex t) { return model.pieces.body_of(tets.piece[t]); });
+  cell_integers("material", FrameValue::i32, [&](LocalIndex t) { return tets.material[t]; });
 
   if (wants("stress")) {
     FrameArray sigma = real_array("stress", true, 9, n_cells);
@@ -109,12 +107,23 @@ std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<L
       const Mat3 dev = cauchy - cauchy.trace() / 3.0 * Mat3::Identity();
       mises.real[c] = std::sqrt(1.5 * dev.squaredNorm());
     }
-    arrays.push_back(std::move(sigma));
-    arrays.push_back(std::move(mises));
+    take(sigma);
+    take(mises);
   }
-  for (const FrameField& f : extra)
-    arrays.push_back(f.per_cell ? filtered(f, static_cast<std::size_t>(tets.size()), cells)
-                                : filtered(f, static_cast<std::size_t>(nodes.size()), points));
+  for (const FrameField& f : extra) {
+    FrameArray a = f.per_cell ? filtered(f, static_cast<std::size_t>(tets.size()), cells)
+                              : filtered(f, static_cast<std::size_t>(nodes.size()), points);
+    take(a);
+  }
+}
+
+std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<LocalIndex>& cells,
+                                         const std::vector<LocalIndex>& points,
+                                         const std::vector<std::string>& fields,
+                                         const std::vector<FrameField>& extra) {
+  std::vector<FrameArray> arrays;
+  for_each_tet_frame_array(model, cells, points, fields, extra,
+                           [&](FrameArray& a) { arrays.push_back(std::move(a)); });
   return arrays;
 }
 

@@ -310,8 +310,9 @@ struct Scene {
   std::vector<InitialStressSpec> initial_stress;
   QuasiStaticSpec quasi_static;
   OutputSpec output;
-  double contact_buffer = -1.0;       // m; < 0: automatic
-  bool contact_skip_enclosed = true;  // contact.skip_enclosed (ContactSettings::skip_enclosed)
+  double contact_buffer = -1.0;         // m; < 0: automatic
+  bool contact_skip_enclosed = true;    // contact.skip_enclosed (ContactSettings::skip_enclosed)
+  bool contact_exact_narrowing = true;  // contact.narrowing (ContactSettings::exact_narrowing)
   ParallelSpec parallel;
   LimitsSpec limits;
 };

@@ -75,14 +75,44 @@ inline FailureMode classify_failure(const JointHistory& h, const CohesiveLaw& la
   return share >= 0.5 ? FailureMode::mixed_tension : FailureMode::mixed_shear;
 }
 
-// Fast path of joint_force for a joint whose three points are intact (no damage, no slip) and
-// stay below strength: φ = ½k_t|Δ|² + ½(k_n − k_t)(Δ·n)², which depends on the frame only through
-// n, so t1, t2 are not needed.  Returns false (and changes nothing) when it does not apply.
-inline bool joint_intact_step(const Vec3 (&x)[6], const Vec3& n, double inv_n_len, const Vec3& e,
-                              const Vec3& g, double w, const CohesiveLaw& law,
-                              JointHistory& history, JointForce& out) {
-  for (const auto& p : history.point)
+// What a pristine joint (no point ever past its peak opening or slipping) keeps between steps:
+// the opening and shear of its three points at the last update, for the energy increments of the
+// update in which it first damages or slips.  The rest of its JointHistory is zero.
+struct IntactJointState {
+  double previous_opening[3] = {0.0, 0.0, 0.0};   // m
+  double previous_shear_sq[3] = {0.0, 0.0, 0.0};  // Pa²
+};
+
+inline bool pristine(const JointHistory& h) {
+  for (const auto& p : h.point)
     if (p.max_opening_ratio != 0.0 || p.slip_length != 0.0) return false;
+  return true;
+}
+
+// The current mid-surface of a joint: m_i = (a_i + b_i)/2, e = m1 − m0, g = m2 − m0, unit normal
+// n ∥ e × g.  False when it has no area.
+struct JointFrame {
+  Vec3 e, g, n;
+  double n_len = 0.0, inv_n_len = 0.0;
+};
+inline bool joint_frame(const Vec3 (&x)[6], JointFrame& frame) {
+  const Vec3 m0 = 0.5 * (x[0] + x[3]);
+  frame.e = 0.5 * (x[1] + x[4]) - m0;
+  frame.g = 0.5 * (x[2] + x[5]) - m0;
+  const Vec3 normal_raw = frame.e.cross(frame.g);
+  frame.n_len = normal_raw.norm();
+  if (!(frame.n_len > 0.0)) return false;
+  frame.inv_n_len = 1.0 / frame.n_len;
+  frame.n = normal_raw * frame.inv_n_len;
+  return true;
+}
+
+// Fast path of joint_force for a pristine joint whose points stay below strength:
+// φ = ½k_t|Δ|² + ½(k_n − k_t)(Δ·n)², which depends on the frame only through n, so t1, t2 are not
+// needed.  Returns false (and changes nothing) when a point reaches its strength.
+inline bool joint_intact_step(const Vec3 (&x)[6], const JointFrame& frame, double w,
+                              const CohesiveLaw& law, IntactJointState& state, JointForce& out) {
+  const Vec3& n = frame.n;
   const double k_n = law.normal_stiffness(), k_t = law.tangential_stiffness();
   const double peak = law.peak_opening(), cohesion = law.cohesion();
   const double friction = k_n * law.tan_friction();  // σc·tanφ = −dn·k_n·tanφ
@@ -102,11 +132,12 @@ inline bool joint_intact_step(const Vec3 (&x)[6], const Vec3& n, double inv_n_le
     out.force[3 + i] -= w * traction;
     v += (w * (k_n - k_t) * dn[i]) * (gap[i] - dn[i] * n);
     out.stored_energy += w * (0.5 * k_n * dn[i] * dn[i] + 0.5 * shear_sq[i] / k_t);
-    history.point[i].previous_opening = std::max(dn[i], 0.0);
-    history.point[i].previous_shear_sq = shear_sq[i];
+    state.previous_opening[i] = std::max(dn[i], 0.0);
+    state.previous_shear_sq[i] = shear_sq[i];
   }
   // δψ = v·δn = v·δN/|N| with δN = δe × g + e × δg.
-  const Vec3 grad_e = g.cross(v) * inv_n_len, grad_g = v.cross(e) * inv_n_len;
+  const Vec3 grad_e = frame.g.cross(v) * frame.inv_n_len,
+             grad_g = v.cross(frame.e) * frame.inv_n_len;
   const Vec3 grad_m[3] = {-grad_e - grad_g, grad_e, grad_g};
   for (int i = 0; i < 3; ++i) {
     out.force[i] -= 0.5 * grad_m[i];
@@ -124,19 +155,24 @@ inline JointForce joint_force(const Vec3 (&x)[6], double area0, const CohesiveLa
   for (auto& f : out.force) f.setZero();
   if (history.broken) return out;
 
-  const Vec3 m0 = 0.5 * (x[0] + x[3]);
-  const Vec3 e = 0.5 * (x[1] + x[4]) - m0;
-  const Vec3 g = 0.5 * (x[2] + x[5]) - m0;
-  const Vec3 normal_raw = e.cross(g);
-  const double n_len = normal_raw.norm();
-  if (!(n_len > 0.0)) {
+  JointFrame frame;
+  if (!joint_frame(x, frame)) {
     out.degenerate = true;
     return out;
   }
-  const double inv_n_len = 1.0 / n_len;
-  const Vec3 n = normal_raw * inv_n_len;
   const double w = area0 / 3.0;
-  if (joint_intact_step(x, n, inv_n_len, e, g, w, law, history, out)) return out;
+  if (pristine(history)) {
+    IntactJointState state;
+    if (joint_intact_step(x, frame, w, law, state, out)) {
+      for (int i = 0; i < 3; ++i) {
+        history.point[i].previous_opening = state.previous_opening[i];
+        history.point[i].previous_shear_sq = state.previous_shear_sq[i];
+      }
+      return out;
+    }
+  }
+  const Vec3 &e = frame.e, &g = frame.g, &n = frame.n;
+  const double n_len = frame.n_len;
 
   const double e_len = e.norm();
   const Vec3 t1 = e / e_len;

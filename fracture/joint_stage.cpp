@@ -33,18 +33,51 @@ JointStage::JointStage(const Model& model) {
       throw InputError(joint_law_message(model.joint_laws, i, *curve, e.what()));
     }
   }
-  history_.resize(model.joints.size());
   const JointArrays& joints = model.joints;
+  slot_.assign(static_cast<std::size_t>(joints.size()), -1);
+  intact_.assign(static_cast<std::size_t>(joints.size()), IntactJointState{});
   for (LocalIndex j = 0; j < joints.size(); ++j) {
     FDEM_VERIFY(joints.law[j] >= 0 && joints.law[j] < static_cast<int>(laws_.size()),
                 "joint law index");
     if (joints.broken[j]) {
-      history_[j].broken = true;
-      history_[j].mode = static_cast<FailureMode>(joints.mode[j]);
-      history_[j].failure_time = joints.failure_time[j];
+      JointHistory& h = live_[static_cast<std::size_t>(promote(j))];
+      h.broken = true;
+      h.mode = static_cast<FailureMode>(joints.mode[j]);
+      h.failure_time = joints.failure_time[j];
       ++broken_;
     }
   }
+}
+
+std::int32_t JointStage::promote(LocalIndex j) {
+  std::int32_t& slot = slot_[static_cast<std::size_t>(j)];
+  if (slot >= 0) return slot;
+  FDEM_VERIFY(live_.size() < static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()),
+              "joint history slots");
+  JointHistory h;
+  const IntactJointState& state = intact_[static_cast<std::size_t>(j)];
+  for (int i = 0; i < 3; ++i) {
+    h.point[i].previous_opening = state.previous_opening[i];
+    h.point[i].previous_shear_sq = state.previous_shear_sq[i];
+  }
+  slot = static_cast<std::int32_t>(live_.size());
+  live_.push_back(h);
+  return slot;
+}
+
+std::vector<JointHistory> JointStage::history() const {
+  std::vector<JointHistory> out(slot_.size());
+  for (std::size_t j = 0; j < slot_.size(); ++j) {
+    if (slot_[j] >= 0) {
+      out[j] = live_[static_cast<std::size_t>(slot_[j])];
+      continue;
+    }
+    for (int i = 0; i < 3; ++i) {
+      out[j].point[i].previous_opening = intact_[j].previous_opening[i];
+      out[j].point[i].previous_shear_sq = intact_[j].previous_shear_sq[i];
+    }
+  }
+  return out;
 }
 
 JointStepSummary JointStage::add_forces(Model& model, double time) {
@@ -54,7 +87,16 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
   NodeArrays& nodes = model.nodes;
   const LocalIndex n = joints.size();
   const TetArrays& tets = model.tets;
+  // Face B's nodes belong to the neighbouring tet, often far from face A's in memory: fetched
+  // ahead, they are in cache when the joint is computed.
+  constexpr LocalIndex ahead = 8;
   for (LocalIndex j = 0; j < n; ++j) {
+    if (j + ahead < n)
+      for (int i = 3; i < 6; i += 2) {
+        const LocalIndex node = joints.nodes[6 * static_cast<std::size_t>(j + ahead) + i];
+        __builtin_prefetch(nodes.x.data() + 3 * static_cast<std::size_t>(node));
+        __builtin_prefetch(nodes.f.data() + 3 * static_cast<std::size_t>(node), 1);
+      }
     if (joints.broken[j]) continue;
     const LocalIndex tet_a = joints.tets[2 * j], tet_b = joints.tets[2 * j + 1];
     if (!tets.is_active(tet_a) && !tets.is_active(tet_b)) continue;  // other ranks compute it
@@ -62,12 +104,25 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
     const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
     Vec3 x[6];
     for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[i]);
-    JointHistory& h = history_[j];
-    const JointForce f = joint_force(x, joints.area0[j], laws_[joints.law[j]], h);
+    const CohesiveLaw& law = laws_[joints.law[j]];
+    std::int32_t slot = slot_[static_cast<std::size_t>(j)];
+    JointForce f;
+    if (slot < 0) {  // pristine: the intact step on its 48-byte state, or it leaves that state
+      JointFrame frame;
+      for (auto& force : f.force) force.setZero();
+      if (!joint_frame(x, frame))
+        f.degenerate = true;
+      else if (!joint_intact_step(x, frame, joints.area0[j] / 3.0, law,
+                                  intact_[static_cast<std::size_t>(j)], f))
+        slot = promote(j);
+    }
+    if (slot >= 0) f = joint_force(x, joints.area0[j], law, live_[static_cast<std::size_t>(slot)]);
     for (int i = 0; i < 6; ++i) vec3_at(nodes.f.data(), id[i]) += f.force[i];
     out.stored_energy += share * f.stored_energy;
     out.fracture_dissipated += share * f.fracture_energy;
     out.friction_dissipated += share * f.friction_energy;
+    if (slot < 0) continue;  // damage stays 0, nothing broke
+    JointHistory& h = live_[static_cast<std::size_t>(slot)];
     joints.damage[j] = h.damage();
     if (f.newly_broken) {
       h.failure_time = time;
@@ -91,14 +146,32 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
 void JointStage::rebind(const Model& model, std::vector<JointHistory> history) {
   FDEM_VERIFY(history.size() == static_cast<std::size_t>(model.joints.size()),
               "one history per local joint");
-  history_ = std::move(history);
+  slot_.assign(history.size(), -1);
+  intact_.assign(history.size(), IntactJointState{});
+  live_.clear();
+  for (std::size_t j = 0; j < history.size(); ++j) {
+    const JointHistory& h = history[j];
+    bool zero = pristine(h) && !h.broken && h.mode == FailureMode::none;
+    for (const auto& p : h.point)
+      zero = zero && p.damage == 0.0 && p.plastic_slip[0] == 0.0 && p.plastic_slip[1] == 0.0;
+    if (!zero) {
+      slot_[j] = static_cast<std::int32_t>(live_.size());
+      live_.push_back(h);
+      continue;
+    }
+    for (int i = 0; i < 3; ++i) {
+      intact_[j].previous_opening[i] = h.point[i].previous_opening;
+      intact_[j].previous_shear_sq[i] = h.point[i].previous_shear_sq;
+    }
+  }
+  live_.shrink_to_fit();
   newly_broken_.clear();
 }
 
 void JointStage::mark_broken(Model& model, LocalIndex j, double time, std::uint8_t mode) {
   JointArrays& joints = model.joints;
   if (joints.broken[j]) return;
-  JointHistory& h = history_[j];
+  JointHistory& h = live_[static_cast<std::size_t>(promote(j))];
   h.broken = true;
   h.mode = static_cast<FailureMode>(mode);
   h.failure_time = time;

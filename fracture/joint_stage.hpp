@@ -2,8 +2,11 @@
 // nodes in ascending joint gid, and the fracture bookkeeping — newly broken joints get their
 // failure time and mode, and the caller hands their two tets over to contact.
 //
-// The cohesive history of every integration point lives here (one JointHistory per joint); the
-// model's JointArrays mirror what other parts read: broken flag, mode, failure time, damage.
+// The cohesive history of every integration point lives here, sized to what is live: a pristine
+// joint (no point past its peak or slipping, the common case in an intact body) keeps only its
+// IntactJointState (48 bytes); the first update that damages or slips it gives it a full
+// JointHistory (184 bytes) in a pool.  The model's JointArrays mirror what other parts read:
+// broken flag, mode, failure time, damage.
 #pragma once
 
 #include <vector>
@@ -58,11 +61,19 @@ class JointStage {
   void mark_broken(Model& model, LocalIndex joint, double time, std::uint8_t mode);
 
   const std::vector<CohesiveLaw>& laws() const { return laws_; }
-  const std::vector<JointHistory>& history() const { return history_; }
+  // Every local joint's history, in the model's joint order (pristine ones written out in full).
+  std::vector<JointHistory> history() const;
+  // Joints that hold a full history (the others are pristine).
+  std::size_t live_histories() const { return live_.size(); }
 
  private:
+  // Gives joint j a full history made from its intact state; returns its slot in live_.
+  std::int32_t promote(LocalIndex j);
+
   std::vector<CohesiveLaw> laws_;
-  std::vector<JointHistory> history_;
+  std::vector<std::int32_t> slot_;        // per joint: index in live_, or −1 (pristine)
+  std::vector<IntactJointState> intact_;  // per joint: its state while pristine
+  std::vector<JointHistory> live_;        // histories of the joints that left the pristine state
   std::vector<LocalIndex> newly_broken_;
   LocalIndex broken_ = 0;
 };

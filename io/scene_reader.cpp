@@ -711,9 +711,12 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   check_intervals(r, root["output"], scene);
 
   if (const YAML::Node contact = root["contact"]) {
-    r.check_keys(contact, "contact", {"buffer", "skip_enclosed"});
+    r.check_keys(contact, "contact", {"buffer", "skip_enclosed", "narrowing"});
     if (contact["skip_enclosed"])
       scene.contact_skip_enclosed = r.boolean(contact["skip_enclosed"], "contact.skip_enclosed");
+    if (contact["narrowing"])
+      scene.contact_exact_narrowing =
+          r.choice(contact["narrowing"], "contact.narrowing", {"exact", "face_planes"}) == "exact";
     if (contact["buffer"] && !r.is_auto(contact["buffer"]))
       scene.contact_buffer =
           r.positive(contact["buffer"], "contact.buffer", "contact detection buffer (m) or 'auto'");

@@ -170,12 +170,13 @@ vtkSmartPointer<vtkUnstructuredGrid> owned_tet_grid(const Model& model,
                               renumbered[tets.nodes[4 * t + 2]], renumbered[tets.nodes[4 * t + 3]]};
     grid->InsertNextCell(VTK_TETRA, 4, ids);
   }
-  for (const FrameArray& f : tet_frame_arrays(model, cells, points, fields, extra)) {
+  // One frame array at a time, freed once copied: the frame's peak holds the VTK arrays only.
+  for_each_tet_frame_array(model, cells, points, fields, extra, [&](FrameArray& f) {
     if (f.per_cell)
       grid->GetCellData()->AddArray(vtk_array(f));
     else
       grid->GetPointData()->AddArray(vtk_array(f));
-  }
+  });
   return grid;
 }
 

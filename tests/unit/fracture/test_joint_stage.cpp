@@ -139,3 +139,71 @@ TEST_CASE(
                     model.nodes.f.size() * sizeof(double)) == 0);
   CHECK(std::memcmp(&a.stored_energy, &b.stored_energy, sizeof(double)) == 0);
 }
+
+TEST_CASE(
+    "joint stage: pristine joints keep 48 bytes, those that damage get a full history, and the "
+    "forces and energies equal joint_force on full histories bit for bit",
+    "[fracture][stage]") {
+  Model model = jointed_column();
+  JointStage stage(model);
+  CHECK(stage.live_histories() == 0);
+  // Reference: every joint computed by joint_force with a full JointHistory of its own.
+  JointStage full_laws(model);
+  std::vector<JointHistory> reference(static_cast<std::size_t>(model.joints.size()));
+  const auto reference_forces = [&](double& stored, double& fracture) {
+    std::vector<double> f(model.nodes.f.size(), 0.0);
+    stored = fracture = 0.0;
+    for (LocalIndex j = 0; j < model.joints.size(); ++j) {
+      if (reference[j].broken) continue;
+      Vec3 x[6];
+      for (int i = 0; i < 6; ++i)
+        x[i] = vec3_at(model.nodes.x.data(), model.joints.nodes[6 * j + i]);
+      const JointForce jf = joint_force(x, model.joints.area0[j],
+                                        full_laws.laws()[model.joints.law[j]], reference[j]);
+      for (int i = 0; i < 6; ++i) vec3_at(f.data(), model.joints.nodes[6 * j + i]) += jf.force[i];
+      stored += jf.stored_energy;
+      fracture += jf.fracture_energy;
+    }
+    return f;
+  };
+  // The upper cell pulled up in 2.5 µm steps: the joints between the cells stay below their peak
+  // opening in the first steps, then damage and break; the joints inside the cells stay pristine.
+  std::size_t live_before_break = 0;
+  for (int step = 1; step <= 120; ++step) {
+    for (LocalIndex t = 0; t < model.tets.size(); ++t)
+      if (upper(model, t))
+        for (int c = 0; c < 4; ++c)
+          model.nodes.x[3 * static_cast<std::size_t>(model.tets.nodes[4 * t + c]) + 2] += 2.5e-6;
+    double stored = 0.0, fracture = 0.0;
+    const std::vector<double> f_reference = reference_forces(stored, fracture);
+    std::fill(model.nodes.f.begin(), model.nodes.f.end(), 0.0);
+    const JointStepSummary s = stage.add_forces(model, 0.001 * step);
+    for (LocalIndex j : stage.newly_broken()) reference[j].broken = true;
+    INFO("step " << step);
+    REQUIRE(std::memcmp(model.nodes.f.data(), f_reference.data(),
+                        f_reference.size() * sizeof(double)) == 0);
+    CHECK(std::memcmp(&s.stored_energy, &stored, sizeof(double)) == 0);
+    CHECK(std::memcmp(&s.fracture_dissipated, &fracture, sizeof(double)) == 0);
+    if (step == 1) CHECK(stage.live_histories() == 0);
+    if (s.broken == 0) live_before_break = stage.live_histories();
+  }
+  // Only the joints between the cells left the pristine state; history() writes all of them out.
+  long across = 0;
+  for (LocalIndex j = 0; j < model.joints.size(); ++j)
+    across += upper(model, model.joints.tets[2 * j]) != upper(model, model.joints.tets[2 * j + 1]);
+  CHECK(std::count_if(reference.begin(), reference.end(),
+                      [](const JointHistory& h) { return h.broken; }) == across);
+  CHECK(live_before_break == static_cast<std::size_t>(across));
+  CHECK(stage.live_histories() == static_cast<std::size_t>(across));
+  CHECK(stage.live_histories() < static_cast<std::size_t>(model.joints.size()));
+  const std::vector<JointHistory> written = stage.history();
+  REQUIRE(written.size() == reference.size());
+  for (std::size_t j = 0; j < written.size(); ++j) {
+    CHECK(written[j].broken == reference[j].broken);
+    for (int i = 0; i < 3; ++i) {
+      CHECK(written[j].point[i].damage == reference[j].point[i].damage);
+      CHECK(written[j].point[i].previous_opening == reference[j].point[i].previous_opening);
+      CHECK(written[j].point[i].previous_shear_sq == reference[j].point[i].previous_shear_sq);
+    }
+  }
+}

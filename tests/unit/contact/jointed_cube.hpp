@@ -1,0 +1,57 @@
+// Test scenes of the contact tests: a cube meshed by Kuhn cells, and a rock scene with one
+// jointed body (`joints: all`).
+#pragma once
+
+#include "core/model_builder.hpp"
+
+namespace fdem::testing {
+
+// A cube [0, n·h]³ of n³ cells of 6 Kuhn tets each (diagonal 0–7, positively oriented).
+inline BodyMesh kuhn_cube(int n, double h) {
+  BodyMesh mesh;
+  mesh.source = "test";
+  const auto id = [&](int i, int j, int k) {
+    return static_cast<LocalIndex>(i + (n + 1) * (j + (n + 1) * k));
+  };
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) mesh.coords.insert(mesh.coords.end(), {i * h, j * h, k * h});
+  const LocalIndex kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
+                                 {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        LocalIndex corner[8];
+        for (int c = 0; c < 8; ++c) corner[c] = id(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
+        for (const auto& t : kuhn)
+          for (int c = 0; c < 4; ++c) mesh.tets.push_back(corner[t[c]]);
+      }
+  return mesh;
+}
+
+inline Scene jointed_scene() {
+  Scene scene;
+  scene.source_path = "test";
+  MaterialSpec rock;
+  rock.name = "rock";
+  rock.density = 2500;
+  rock.elastic.young = 1e9;
+  rock.elastic.poisson = 0.25;
+  rock.contact.friction = 0.5;
+  FractureSpec fracture;
+  fracture.tensile_strength = 1e6;
+  fracture.cohesion = 2e6;
+  fracture.friction_angle_deg = 30.0;
+  fracture.energy_I = 10.0;
+  fracture.energy_II = 50.0;
+  rock.fracture = fracture;
+  scene.materials.push_back(rock);
+  BodySpec body;
+  body.name = "cube";
+  body.material = 0;
+  body.joints = JointPlacement::all;
+  scene.bodies.push_back(body);
+  return scene;
+}
+
+}  // namespace fdem::testing
