@@ -241,7 +241,7 @@ void ContactStage::run_detection(const Model& model, const double* x) {
       corners[0][c] = vec3_at(x, tets.nodes[4 * a + c]);
       corners[1][c] = vec3_at(x, tets.nodes[4 * b + c]);
     }
-    return !(tet_distance(corners[0], corners[1]) > buffer_);
+    return tets_within(corners[0], corners[1], buffer_);
   };
   detector_.detect(lo_.data(), hi_.data(), tets.size(), buffer_, pairs_, keep);
   may_hold_friction_.assign(pairs_.size(), 1);

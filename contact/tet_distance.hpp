@@ -133,4 +133,30 @@ inline double tet_distance(const Vec3 (&a)[4], const Vec3 (&b)[4]) {
   return std::sqrt(nearest);
 }
 
+// Whether the two tetrahedra are within `distance` (m) of each other: tet_distance(a, b) <=
+// distance, decided with early exits for narrowing, where most pairs tested touch or nearly
+// touch (tets across a crack, blocks resting on each other).  A corner pair, then a corner–face
+// and an edge–edge pair within reach settle it (each is an upper bound on the distance); only
+// when none is within reach must the separating-axis test tell disjoint tets (farther) from
+// intersecting ones (distance 0, e.g. one inside the other).
+inline bool tets_within(const Vec3 (&a)[4], const Vec3 (&b)[4], double distance) {
+  using tet_distance_detail::edge;
+  const double reach_sq = distance * distance;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      if ((a[i] - b[j]).squaredNorm() <= reach_sq) return true;
+  for (int k = 0; k < 4; ++k) {
+    const int i = (k + 1) % 4, j = (k + 2) % 4, l = (k + 3) % 4;
+    for (int c = 0; c < 4; ++c)
+      if (point_triangle_distance_sq(a[c], b[i], b[j], b[l]) <= reach_sq ||
+          point_triangle_distance_sq(b[c], a[i], a[j], a[l]) <= reach_sq)
+        return true;
+  }
+  for (const auto& ea : edge)
+    for (const auto& eb : edge)
+      if (segment_segment_distance_sq(a[ea[0]], a[ea[1]], b[eb[0]], b[eb[1]]) <= reach_sq)
+        return true;
+  return !tets_disjoint(a, b);
+}
+
 }  // namespace fdem

@@ -2,10 +2,11 @@
 # and its output contains every string of EXPECT (a list).
 # -D MPIEXEC, NP_FLAG, NP, FDEM, SCENE, WORK, EXPECT (list), ARGS (list, optional),
 #    RESTART_FROM (optional: a scene run first on one rank; the run under test restarts from its
-#    earliest checkpoint)
+#    earliest checkpoint), FIRST_ARGS (list, optional: for that first run)
 file(REMOVE_RECURSE ${WORK})
 if(RESTART_FROM)
   execute_process(COMMAND ${MPIEXEC} ${NP_FLAG} 1 ${FDEM} run ${RESTART_FROM} -o ${WORK}-first -q
+                          ${FIRST_ARGS}
                   RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
   file(GLOB checkpoints ${WORK}-first/checkpoint_*.h5)
   list(SORT checkpoints)

@@ -2,6 +2,10 @@
 // jointed body (`joints: all`).
 #pragma once
 
+#include <random>
+#include <utility>
+#include <vector>
+
 #include "core/model_builder.hpp"
 
 namespace fdem::testing {
@@ -52,6 +56,34 @@ inline Scene jointed_scene() {
   body.joints = JointPlacement::all;
   scene.bodies.push_back(body);
   return scene;
+}
+
+// A jointed 5³-cell cube of 0.1 m cells and a plain 0.3 m block ("lid", same rock) pressed 1 mm
+// into its top; the cube's nodes shaken by up to 0.5 % of a cell (seed 7), so its tets press into
+// each other across the joints.
+inline Model pressed_jointed_cube() {
+  Scene scene = jointed_scene();
+  BodySpec lid = scene.bodies[0];
+  lid.name = "lid";
+  lid.joints = JointPlacement::none;
+  scene.bodies.push_back(lid);
+  BodyMesh block = kuhn_cube(1, 0.3);
+  for (std::size_t i = 0; i < block.coords.size(); ++i) block.coords[i] += i % 3 == 2 ? 0.499 : 0.1;
+  Model model = build_model(scene, {kuhn_cube(5, 0.1), block});
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> shake(-5e-4, 5e-4);
+  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
+    if (model.pieces.body_of(model.nodes.piece[n]) == 0)
+      for (int d = 0; d < 3; ++d) model.nodes.x[3 * n + d] += shake(random);
+  return model;
+}
+
+// The tet pairs bonded by the model's joints.
+inline std::vector<std::pair<LocalIndex, LocalIndex>> joint_bonds(const Model& model) {
+  std::vector<std::pair<LocalIndex, LocalIndex>> out;
+  for (LocalIndex j = 0; j < model.joints.size(); ++j)
+    out.emplace_back(model.joints.tets[2 * j], model.joints.tets[2 * j + 1]);
+  return out;
 }
 
 }  // namespace fdem::testing

@@ -17,13 +17,6 @@ using fdem::testing::kuhn_cube;
 
 namespace {
 
-std::vector<std::pair<LocalIndex, LocalIndex>> bonds(const Model& model) {
-  std::vector<std::pair<LocalIndex, LocalIndex>> out;
-  for (LocalIndex j = 0; j < model.joints.size(); ++j)
-    out.emplace_back(model.joints.tets[2 * j], model.joints.tets[2 * j + 1]);
-  return out;
-}
-
 std::set<std::pair<LocalIndex, LocalIndex>> pairs_of(const ContactStage& stage) {
   std::set<std::pair<LocalIndex, LocalIndex>> out;
   for (const CandidatePair& p : stage.candidates()) out.emplace(p.a, p.b);
@@ -57,26 +50,14 @@ TEST_CASE("enclosed tets stay out of contact, change no force, and return when a
           "[contact][enclosed]") {
   // The jointed cube and a plain block pressed 1 mm into its top face; the cube's nodes shaken
   // by 0.5 % of a cell, so its tets press into each other across the joints.
-  Scene scene = jointed_scene();
-  BodySpec lid = scene.bodies[0];
-  lid.name = "lid";
-  lid.joints = JointPlacement::none;
-  scene.bodies.push_back(lid);
-  BodyMesh block = kuhn_cube(1, 0.3);
-  for (std::size_t i = 0; i < block.coords.size(); ++i) block.coords[i] += i % 3 == 2 ? 0.499 : 0.1;
-  Model model = build_model(scene, {kuhn_cube(5, 0.1), block});
-  std::mt19937_64 random(7);
-  std::uniform_real_distribution<double> shake(-5e-4, 5e-4);
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces.body_of(model.nodes.piece[n]) == 0)
-      for (int d = 0; d < 3; ++d) model.nodes.x[3 * n + d] += shake(random);
+  Model model = testing::pressed_jointed_cube();
   const double buffer = 0.025;
   // Narrowed by face planes only: the exact distance would drop the enclosed tets' pairs of
   // this scene too (test_tet_distance.cpp), leaving nothing for the skip to show.
   ContactStage skipping(model, ContactSettings{buffer, true, false});
   ContactStage all(model, ContactSettings{buffer, false, false});
   for (ContactStage* stage : {&skipping, &all}) {
-    stage->set_bonds(model.tets.size(), bonds(model));
+    stage->set_bonds(model.tets.size(), testing::joint_bonds(model));
     stage->enclose(model.tets.enclosed);
     stage->detect(model);
   }

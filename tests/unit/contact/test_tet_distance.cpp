@@ -44,16 +44,6 @@ double sampled_distance(const Vec3 (&a)[4], const Vec3 (&b)[4], int k) {
   return std::sqrt(best);
 }
 
-// The jointed cube's scene and a plain body "lid" of the same rock.
-Scene two_body_scene() {
-  Scene scene = testing::jointed_scene();
-  BodySpec lid = scene.bodies[0];
-  lid.name = "lid";
-  lid.joints = JointPlacement::none;
-  scene.bodies.push_back(lid);
-  return scene;
-}
-
 std::set<std::pair<LocalIndex, LocalIndex>> pairs_of(const ContactStage& stage) {
   std::set<std::pair<LocalIndex, LocalIndex>> out;
   for (const CandidatePair& p : stage.candidates()) out.emplace(p.a, p.b);
@@ -62,6 +52,20 @@ std::set<std::pair<LocalIndex, LocalIndex>> pairs_of(const ContactStage& stage) 
 
 void corners_of(const Model& model, LocalIndex t, Vec3 (&x)[4]) {
   for (int c = 0; c < 4; ++c) x[c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * t + c]);
+}
+
+// Whether p lies inside the tet, off its faces: the four sub-tets p forms with the faces have
+// the orientation of the tet.
+bool strictly_inside(const Vec3 (&x)[4], const Vec3& p) {
+  const auto volume = [](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+    return (b - a).cross(c - a).dot(d - a);
+  };
+  const double whole = volume(x[0], x[1], x[2], x[3]);
+  const double parts[4] = {volume(p, x[1], x[2], x[3]), volume(x[0], p, x[2], x[3]),
+                           volume(x[0], x[1], p, x[3]), volume(x[0], x[1], x[2], p)};
+  for (double part : parts)
+    if (!(part * whole > 0.0)) return false;
+  return true;
 }
 
 }  // namespace
@@ -103,7 +107,7 @@ TEST_CASE("tet distance: random pairs lie between the sampled bound less its spa
       a[c] = Vec3(u(random), u(random), u(random));
       b[c] = Vec3(u(random), u(random), u(random)) + Vec3(0.8 * u(random), 0.8 * u(random), 1.0);
     }
-    const int k = 24;
+    const int k = 12;  // 455 points per tet: seconds under the sanitizers
     const double d = tet_distance(a, b), sampled = sampled_distance(a, b, k);
     double longest = 0.0;  // the grid's spacing is at most the longest edge / k on each tet
     for (int i = 0; i < 4; ++i)
@@ -118,6 +122,45 @@ TEST_CASE("tet distance: random pairs lie between the sampled bound less its spa
   CHECK(intersecting > 50);
 }
 
+TEST_CASE("tets within a distance: the early-exit test agrees with the exact distance",
+          "[contact][tet_distance]") {
+  // Random pairs from apart to nested (a small tet inside a large one: every corner–face and
+  // edge–edge distance exceeds the reach, only the separating-axis test keeps it), each asked at
+  // reaches just below and just above its distance and at 0 and a large reach.
+  std::mt19937_64 random(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int apart = 0, intersecting = 0, nested = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    Corners a, b;
+    for (int c = 0; c < 4; ++c) a[c] = 2.0 * Vec3(u(random), u(random), u(random));
+    const bool small = trial % 4 == 0;  // every 4th pair: b a small tet near a's centroid
+    const Vec3 centre =
+        small ? 0.25 * (a[0] + a[1] + a[2] + a[3]) + 0.1 * Vec3(u(random), u(random), u(random))
+              : Vec3(0.6 * u(random), 0.6 * u(random), 2.5 * u(random));
+    for (int c = 0; c < 4; ++c)
+      b[c] = centre + (small ? 0.05 : 1.0) * Vec3(u(random), u(random), u(random));
+    const double d = tet_distance(a, b);
+    INFO("trial " << trial << ": distance " << d);
+    if (d > 0.0) {
+      ++apart;
+      CHECK_FALSE(tets_within(a, b, 0.999 * d));
+      CHECK(tets_within(a, b, 1.001 * d));
+      CHECK_FALSE(tets_within(b, a, 0.999 * d));
+    } else {
+      ++intersecting;
+      CHECK(tets_within(a, b, 0.0));
+      CHECK(tets_within(b, a, 0.0));
+      bool b_inside_a = true;  // then at reach 0 only the separating-axis test can keep it
+      for (int c = 0; c < 4; ++c) b_inside_a = b_inside_a && strictly_inside(a, b[c]);
+      nested += b_inside_a;
+    }
+    CHECK(tets_within(a, b, 10.0));
+  }
+  CHECK(apart > 200);
+  CHECK(intersecting > 200);
+  CHECK(nested > 20);
+}
+
 TEST_CASE(
     "exact narrowing keeps a subset of the face-plane pairs, drops only pairs farther than "
     "the buffer, and changes no force",
@@ -125,20 +168,11 @@ TEST_CASE(
   // A jointed 5³-cell cube (its surface tets near each other but not sharing a node are what the
   // face planes cannot drop) and a plain block pressed 1 mm into its top, the cube shaken by
   // 0.5 % of a cell.
-  BodyMesh block = testing::kuhn_cube(1, 0.3);
-  for (std::size_t i = 0; i < block.coords.size(); ++i) block.coords[i] += i % 3 == 2 ? 0.499 : 0.1;
-  Model model = build_model(two_body_scene(), {testing::kuhn_cube(5, 0.1), block});
-  std::mt19937_64 random(7);
-  std::uniform_real_distribution<double> shake(-5e-4, 5e-4);
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.pieces.body_of(model.nodes.piece[n]) == 0)
-      for (int d = 0; d < 3; ++d) model.nodes.x[3 * n + d] += shake(random);
+  Model model = testing::pressed_jointed_cube();
   const double buffer = 0.025;
   ContactStage exact(model, ContactSettings{buffer, true, true});
   ContactStage planes(model, ContactSettings{buffer, true, false});
-  std::vector<std::pair<LocalIndex, LocalIndex>> bonds;
-  for (LocalIndex j = 0; j < model.joints.size(); ++j)
-    bonds.emplace_back(model.joints.tets[2 * j], model.joints.tets[2 * j + 1]);
+  const auto bonds = testing::joint_bonds(model);
   for (ContactStage* stage : {&exact, &planes}) {
     stage->set_bonds(model.tets.size(), bonds);
     stage->enclose(model.tets.enclosed);
