@@ -17,13 +17,6 @@ namespace {
 // Auto penalty: 10 E keeps the kinetic energy recovered in an impact above 99 % (docs/references.md
 // 2) and the penetration under 10 % of the element size at the material's strength scale.
 constexpr double auto_penalty_factor = 10.0;
-// Lag (s) with which a stick spring's anchors follow the overlap centroid (friction_kernels.hpp):
-// long against the contact's vibrations (following the centroid at once, a column of blocks on
-// an incline rings at ~600 Hz ever louder and breaks away; with 0.01 s its vibration still grows,
-// slowly), short against the shift of a rocking block's load onto its toe (never following, a
-// block at 0.975 μ on a tilting table turns about the normal and slides).  docs/verification.md,
-// "Static friction on an incline".
-constexpr double friction_anchor_lag = 0.05;
 
 // From the piece's body: no table per piece (a rank may not know every piece of the model).
 bool piece_fixed(const Model& model, std::int32_t piece) {
@@ -40,6 +33,13 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   skip_enclosed_ = settings.skip_enclosed;
   exact_narrowing_ = settings.exact_narrowing;
+  // The anchors' lag: long against the contact's vibrations (following the centroid at once, a
+  // column of blocks on an incline rings at ~600 Hz ever louder and breaks away; with 0.01 s its
+  // vibration still grows, slowly), short against the shift of a rocking block's load onto its
+  // toe (never following, a block at 0.975 μ on a tilting table turns about the normal and
+  // slides).  docs/verification.md, "Static friction on an incline".
+  FDEM_VERIFY(settings.friction_anchor_lag > 0.0, "friction anchor lag > 0");
+  friction_anchor_lag_ = settings.friction_anchor_lag;
   body_cracked_.assign(static_cast<std::size_t>(std::max(model.pieces.bodies(), 0)), 0);
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
@@ -508,7 +508,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         if (!history.attached())
           history.attach(r);
         else
-          history.follow(r, -std::expm1(-dt / friction_anchor_lag));
+          history.follow(r, -std::expm1(-dt / friction_anchor_lag_));
       }
       FrictionPoint point = centroid_point(r);
       if (history.attached()) spring_point(history, a, b, point);
