@@ -33,6 +33,13 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   skip_enclosed_ = settings.skip_enclosed;
   exact_narrowing_ = settings.exact_narrowing;
+  // The anchors' lag: long against the contact's vibrations (following the centroid at once, a
+  // column of blocks on an incline rings at ~600 Hz ever louder and breaks away; with 0.01 s its
+  // vibration still grows, slowly), short against the shift of a rocking block's load onto its
+  // toe (never following, a block at 0.975 μ on a tilting table turns about the normal and
+  // slides).  docs/verification.md, "Static friction on an incline".
+  FDEM_VERIFY(settings.friction_anchor_lag > 0.0, "friction anchor lag > 0");
+  friction_anchor_lag_ = settings.friction_anchor_lag;
   body_cracked_.assign(static_cast<std::size_t>(std::max(model.pieces.bodies(), 0)), 0);
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
@@ -305,6 +312,8 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
   for (const FrictionEntry& e : friction) {
     PairFriction& pf = friction_[PairId{e.a, e.b}];
     pf.history.tangential_spring = e.spring;
+    std::copy_n(e.anchor_a, 4, pf.history.anchor_contactor);
+    std::copy_n(e.anchor_b, 4, pf.history.anchor_target);
     pf.stiffness = e.stiffness;
     const auto it = local.find(e.a);
     pf.owned = it != local.end() && tets.is_owned(it->second);
@@ -360,6 +369,8 @@ std::vector<FrictionEntry> ContactStage::friction_entries() const {
     e.b = key.b;
     e.spring = pf.history.tangential_spring;
     e.stiffness = pf.stiffness;
+    std::copy_n(pf.history.anchor_contactor, 4, e.anchor_a);
+    std::copy_n(pf.history.anchor_target, 4, e.anchor_b);
     out.push_back(e);
   }
   std::sort(out.begin(), out.end(), [](const FrictionEntry& p, const FrictionEntry& q) {
@@ -537,8 +548,20 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       pair_friction.stiffness = law.tangential_stiffness;
       pair_friction.owned = share > 0.0;
       FrictionHistory& history = pair_friction.history;
+      // The spring joins two material points, anchored at the first real overlap's centroid (a
+      // round-off sliver's centroid is noise) and following the centroid with a lag; it acts
+      // midway between them (friction_kernels.hpp).
+      if (r.overlap_volume > sliver) {
+        if (!history.attached())
+          history.attach(r);
+        else
+          history.follow(r, -std::expm1(-dt / friction_anchor_lag_));
+      }
+      FrictionPoint point = centroid_point(r);
+      if (history.attached()) spring_point(history, a, b, point);
       const FrictionResult f =
-          coulomb_friction(law, r, relative_velocity_at_centroid(r, va, vb), dt, history);
+          coulomb_friction(law, r, point, relative_velocity_at(point, va, vb), dt, history);
+      if (f.slipping && history.attached()) slide_anchors(history, a, b, f.slip);
       double* friction_force = writable(friction_force_, friction_written_);
       for (int c = 0; c < 4; ++c) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
@@ -577,7 +600,15 @@ std::vector<PairRecord> friction_records(const std::vector<FrictionEntry>& entri
   std::vector<PairRecord> records(entries.size());
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const FrictionEntry& e = entries[i];
-    records[i] = {e.a, e.b, {e.spring.x(), e.spring.y(), e.spring.z(), e.stiffness}};
+    PairRecord& r = records[i];
+    r.a = e.a;
+    r.b = e.b;
+    r.value[0] = e.spring.x();
+    r.value[1] = e.spring.y();
+    r.value[2] = e.spring.z();
+    r.value[3] = e.stiffness;
+    std::copy_n(e.anchor_a, 4, r.value + 4);
+    std::copy_n(e.anchor_b, 4, r.value + 8);
   }
   return records;
 }
@@ -590,6 +621,8 @@ std::vector<FrictionEntry> friction_entries(const std::vector<PairRecord>& recor
     entries[i].b = r.b;
     entries[i].spring = Vec3(r.value[0], r.value[1], r.value[2]);
     entries[i].stiffness = r.value[3];
+    std::copy_n(r.value + 4, 4, entries[i].anchor_a);
+    std::copy_n(r.value + 8, 4, entries[i].anchor_b);
   }
   return entries;
 }

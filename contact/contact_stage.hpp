@@ -24,6 +24,9 @@ struct ContactSettings {
   // Narrow the detected pairs by the tets' exact distance as well as by their face planes (scene
   // key contact.narrowing: exact; face_planes is the previous algorithm, for benchmarks).
   bool exact_narrowing = true;
+  // Time (s) with which a stick spring's anchors follow the overlap centroid (scene key
+  // contact.friction_anchor_lag; friction_kernels.hpp, docs/verification.md).
+  double friction_anchor_lag = 0.05;
 };
 
 // Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with
@@ -32,10 +35,14 @@ struct FrictionEntry {
   GlobalId a = 0, b = 0;
   Vec3 spring = Vec3::Zero();  // stick spring (m)
   double stiffness = 0.0;      // N/m
+  // The spring's anchors: barycentric weights in tet a and in tet b (FrictionHistory).
+  double anchor_a[4] = {0.0, 0.0, 0.0, 0.0};
+  double anchor_b[4] = {0.0, 0.0, 0.0, 0.0};
 };
 
 // Friction entries as the pair records that travel with their first tet (TravellingState), and
-// back: spring (m) in values 0–2, stiffness (N/m) in value 3.
+// back: spring (m) in values 0–2, stiffness (N/m) in value 3, anchors in values 4–7 (tet a) and
+// 8–11 (tet b).
 std::vector<PairRecord> friction_records(const std::vector<FrictionEntry>& entries);
 std::vector<FrictionEntry> friction_entries(const std::vector<PairRecord>& records);
 
@@ -198,6 +205,7 @@ class ContactStage {
   std::vector<JointState> joint_state_;
   bool skip_enclosed_ = true;
   bool exact_narrowing_ = true;
+  double friction_anchor_lag_ = 0.05;       // s
   std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;

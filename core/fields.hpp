@@ -168,12 +168,14 @@ inline const std::array<Field<TravellingState>, 1> travelling_tet_fields = {{
 }};
 
 // The contact stage's per-pair state, in PairRecord::value in this order: a friction pair's stick
-// spring (m) and its stiffness (N/m).  Pairs travel with their first tet and are checkpointed.
+// spring (m), its stiffness (N/m) and its anchors (barycentric weights in tet a, then in tet b).
+// Pairs travel with their first tet and are checkpointed.
 struct PairField {
   const char* name;
   int components;
 };
-inline constexpr std::array<PairField, 2> pair_record_fields = {{{"spring", 3}, {"stiffness", 1}}};
+inline constexpr std::array<PairField, 4> pair_record_fields = {
+    {{"spring", 3}, {"stiffness", 1}, {"anchor_a", 4}, {"anchor_b", 4}}};
 constexpr int pair_record_values() {
   int values = 0;
   for (const PairField& field : pair_record_fields) values += field.components;

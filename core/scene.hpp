@@ -313,6 +313,7 @@ struct Scene {
   double contact_buffer = -1.0;         // m; < 0: automatic
   bool contact_skip_enclosed = true;    // contact.skip_enclosed (ContactSettings::skip_enclosed)
   bool contact_exact_narrowing = true;  // contact.narrowing (ContactSettings::exact_narrowing)
+  double contact_friction_anchor_lag = 0.05;  // s, contact.friction_anchor_lag
   ParallelSpec parallel;
   LimitsSpec limits;
 };

@@ -23,7 +23,7 @@ enum class TetJointState : std::uint8_t { none, intact, cracked, enclosed };
 // (N/m)).
 struct PairRecord {
   GlobalId a = 0, b = 0;
-  double value[4] = {0.0, 0.0, 0.0, 0.0};
+  double value[12] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
 };
 
 // A candidate pair of the last contact detection by global ids (a < b); travels with tet a.

@@ -711,7 +711,12 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   check_intervals(r, root["output"], scene);
 
   if (const YAML::Node contact = root["contact"]) {
-    r.check_keys(contact, "contact", {"buffer", "skip_enclosed", "narrowing"});
+    r.check_keys(contact, "contact",
+                 {"buffer", "skip_enclosed", "narrowing", "friction_anchor_lag"});
+    if (contact["friction_anchor_lag"])
+      scene.contact_friction_anchor_lag =
+          r.positive(contact["friction_anchor_lag"], "contact.friction_anchor_lag",
+                     "time (s) with which stick springs' anchors follow the contact");
     if (contact["skip_enclosed"])
       scene.contact_skip_enclosed = r.boolean(contact["skip_enclosed"], "contact.skip_enclosed");
     if (contact["narrowing"])

@@ -46,8 +46,8 @@ namespace fdem {
 
 // Format version written into and required from every checkpoint file.
 // 2: checksums; 3: datasets from the field tables (core/fields.hpp), listed in the root
-// attribute `fields`.
-constexpr int checkpoint_format_version = 3;
+// attribute `fields`; 4: friction pairs carry their stick springs' anchors.
+constexpr int checkpoint_format_version = 4;
 
 // The run state a restart needs, beside the rows: named scalars chosen by the driver.
 struct CheckpointHeader {

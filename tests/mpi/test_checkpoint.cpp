@@ -303,7 +303,8 @@ TEST_CASE("checkpoint: interleaved rows of every rank round-trip bit-exactly",
         "nodes/x:float64[3] nodes/v:float64[3] nodes/prescribed_velocity:float64[3] "
         "nodes/x_at_detection:float64[3] joints/broken:uint8[1] joints/mode:uint8[1] "
         "joints/failure_time:float64[1] joints/damage:float64[1] joints/history:uint8[12] "
-        "friction/spring:float64[3] friction/stiffness:float64[1]");
+        "friction/spring:float64[3] friction/stiffness:float64[1] friction/anchor_a:float64[4] "
+        "friction/anchor_b:float64[4]");
 }
 
 TEST_CASE("checkpoint: a rank without rows takes part, empty joint and friction tables",
@@ -510,7 +511,7 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
       H5Aclose(attr);
     });
     const std::string message = read_error(path);
-    CHECK(message.find("format version 2; this fdem reads version 3") != std::string::npos);
+    CHECK(message.find("format version 2; this fdem reads version 4") != std::string::npos);
     CHECK(message.find("older fdem") != std::string::npos);
   }
   SECTION("datasets other than the ones this build restores") {

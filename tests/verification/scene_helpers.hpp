@@ -51,8 +51,9 @@ struct HoldResult {
   double balance = 0;
 };
 
-// Steps `sim` to its end; the hold starts at `hold_start`.  Piece 1 is the block.
-inline HoldResult run_hold(Simulation& sim, double hold_start) {
+// Steps `sim` to its end; the hold starts at `hold_start`.  `piece` is the block (piece 1 unless
+// told).
+inline HoldResult run_hold(Simulation& sim, double hold_start, int piece = 1) {
   HoldResult r;
   const auto clock = std::chrono::steady_clock::now();
   Vec3 x0 = Vec3::Zero(), turn0 = Vec3::Zero();
@@ -60,13 +61,13 @@ inline HoldResult run_hold(Simulation& sim, double hold_start) {
   while (sim.time() < sim.scene().time.end - 1e-12) {
     sim.step();
     if (!held && sim.time() >= hold_start) {
-      const PieceMotion m = piece_motions(sim.model())[1];
+      const PieceMotion m = piece_motions(sim.model())[piece];
       x0 = m.centroid;
       turn0 = m.rotation;
       held = true;
     }
   }
-  const PieceMotion m = piece_motions(sim.model())[1];
+  const PieceMotion m = piece_motions(sim.model())[piece];
   r.slid = std::abs(m.centroid.x() - x0.x());
   r.turned = (m.rotation - turn0).norm();
   r.balance = sim.energy().balance_error();

@@ -202,6 +202,8 @@ TEST_CASE("omitted optional keys take the documented defaults", "[io]") {
   CHECK(s.output.every == 0.0);
   CHECK(s.output.fields == std::vector<std::string>{"displacement", "velocity", "stress"});
   CHECK(s.contact_buffer < 0.0);  // automatic
+  CHECK(s.contact_exact_narrowing);
+  CHECK(s.contact_friction_anchor_lag == 0.05);
   CHECK(s.parallel.rebalance_threshold == 1.10);
   CHECK(s.parallel.redistribute_every == 0);
 
@@ -414,6 +416,16 @@ TEST_CASE("impossible values are rejected with the valid range", "[io]") {
     CHECK_THAT(msg, StartsWith("scene.yaml:5:"));
     CHECK_THAT(msg, Contains("materials.rock.fracture.friction_angle: 90 is impossible"));
     CHECK_THAT(msg, Contains("0 <= angle < 90"));
+  }
+  SECTION("friction anchors that never follow the contact") {
+    const std::string msg =
+        input_error(minimal_with(1, "time: {end: 0.1}") + "contact: {friction_anchor_lag: 0}\n");
+    CHECK_THAT(msg, Contains("contact.friction_anchor_lag: 0 is impossible"));
+    CHECK_THAT(msg, Contains("must be > 0"));
+    const fdem::Scene s = fdem::parse_scene(
+        minimal_with(1, "time: {end: 0.1}") + "contact: {friction_anchor_lag: 0.2}\n",
+        "scene.yaml");
+    CHECK(s.contact_friction_anchor_lag == 0.2);
   }
 }
 
