@@ -159,6 +159,7 @@ class ContactStage {
   const std::vector<ContactRecord>& records() const { return records_; }
 
  private:
+  static bool piece_fixed(const Model& model, std::int32_t piece);
   void compute_boxes(const Model& model, const double* x);
   ContactWork work_against(const Model& model, double dt) const;
   void run_detection(const Model& model, const double* x);
