@@ -1,11 +1,13 @@
 // Test scenes of the contact tests: a cube meshed by Kuhn cells, and a rock scene with one
-// jointed body (`joints: all`).
+// jointed body (`joints: all`); a stage's pairs as a set.
 #pragma once
 
 #include <random>
+#include <set>
 #include <utility>
 #include <vector>
 
+#include "contact/contact_stage.hpp"
 #include "core/model_builder.hpp"
 
 namespace fdem::testing {
@@ -83,6 +85,13 @@ inline std::vector<std::pair<LocalIndex, LocalIndex>> joint_bonds(const Model& m
   std::vector<std::pair<LocalIndex, LocalIndex>> out;
   for (LocalIndex j = 0; j < model.joints.size(); ++j)
     out.emplace_back(model.joints.tets[2 * j], model.joints.tets[2 * j + 1]);
+  return out;
+}
+
+// The stage's candidate pairs (a, b) as a set.
+inline std::set<std::pair<LocalIndex, LocalIndex>> pairs_of(const ContactStage& stage) {
+  std::set<std::pair<LocalIndex, LocalIndex>> out;
+  for (const CandidatePair& p : stage.candidates()) out.emplace(p.a, p.b);
   return out;
 }
 

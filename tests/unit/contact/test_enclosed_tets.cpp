@@ -14,16 +14,7 @@
 using namespace fdem;
 using fdem::testing::jointed_scene;
 using fdem::testing::kuhn_cube;
-
-namespace {
-
-std::set<std::pair<LocalIndex, LocalIndex>> pairs_of(const ContactStage& stage) {
-  std::set<std::pair<LocalIndex, LocalIndex>> out;
-  for (const CandidatePair& p : stage.candidates()) out.emplace(p.a, p.b);
-  return out;
-}
-
-}  // namespace
+using fdem::testing::pairs_of;
 
 TEST_CASE("build_model marks the jointed tets with no corner on the mesh boundary as enclosed",
           "[contact][enclosed]") {

@@ -12,6 +12,7 @@
 #include "jointed_cube.hpp"
 
 using namespace fdem;
+using fdem::testing::pairs_of;
 
 namespace {
 
@@ -42,12 +43,6 @@ double sampled_distance(const Vec3 (&a)[4], const Vec3 (&b)[4], int k) {
   for (const Vec3& p : pa)
     for (const Vec3& q : pb) best = std::min(best, (p - q).squaredNorm());
   return std::sqrt(best);
-}
-
-std::set<std::pair<LocalIndex, LocalIndex>> pairs_of(const ContactStage& stage) {
-  std::set<std::pair<LocalIndex, LocalIndex>> out;
-  for (const CandidatePair& p : stage.candidates()) out.emplace(p.a, p.b);
-  return out;
 }
 
 void corners_of(const Model& model, LocalIndex t, Vec3 (&x)[4]) {
@@ -198,52 +193,4 @@ TEST_CASE(
   CHECK(s_exact.active_pairs == s_planes.active_pairs);
   CHECK(s_exact.energy == s_planes.energy);
   CHECK(model.nodes.f == f_planes);
-}
-
-TEST_CASE(
-    "joints released one by one add the pairs a detection at the same positions would find, "
-    "and many at once run that detection",
-    "[contact][tet_distance]") {
-  // The shaken jointed cube and its lid; the stage under test detects once, then its bonds are
-  // released in batches (1 to 3 joints, then 100) at moved positions; after each batch its list
-  // must equal that of a stage given the same bonds and releases before its one detection, at the
-  // positions of the first.
-  const Model model = testing::pressed_jointed_cube();
-  Model moved = model;
-  for (double& x : moved.nodes.x) x += 2e-4;
-  const double buffer = 0.025;
-  const auto bonds = testing::joint_bonds(model);
-  const auto prepared = [&](ContactStage& stage) {
-    stage.set_bonds(model.tets.size(), bonds);
-    stage.enclose(model.tets.enclosed);
-  };
-  ContactStage stage(model, ContactSettings{buffer, true, true});
-  prepared(stage);
-  stage.detect(model);
-  const long detections = stage.detections();
-  std::vector<std::pair<LocalIndex, LocalIndex>> released;
-  std::mt19937_64 random(5);
-  std::vector<std::size_t> order(bonds.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::shuffle(order.begin(), order.end(), random);
-  std::size_t next = 0;
-  std::size_t before = stage.candidates().size();
-  for (const std::size_t batch : {1, 2, 3, 1, 1, 2, 3, 3, 100}) {
-    std::vector<std::pair<LocalIndex, LocalIndex>> now;
-    for (std::size_t i = 0; i < batch; ++i) now.push_back(bonds[order[next++]]);
-    released.insert(released.end(), now.begin(), now.end());
-    stage.release_bonds(moved, now);
-    ContactStage reference(model, ContactSettings{buffer, true, true});
-    prepared(reference);
-    reference.release_bonds(model, released);
-    reference.detect(model);
-    INFO("after " << released.size() << " joints released: " << stage.candidates().size()
-                  << " pairs, detection " << reference.candidates().size());
-    CHECK(pairs_of(stage) == pairs_of(reference));
-    CHECK(stage.tet_joint_states() == reference.tet_joint_states());
-    CHECK(stage.left_out() == reference.left_out());
-  }
-  CHECK(stage.candidates().size() > before);
-  CHECK(stage.detections() == detections);
-  CHECK_FALSE(stage.detection_due(moved));
 }
