@@ -143,49 +143,86 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes) {
     for (int k = 0; k < 3; ++k) nodes.f[3 * n + k] += nodes.mass[n] * gravity[k];
 }
 
-IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
-                                                double local_damping) {
-  IntegrationSummary out;
+namespace {
+
+// The step's sums over nodes, in node order (the same order whatever the branches below take).
+struct IntegrationSums {
   double kinetic2 = 0.0, kinetic_half2 = 0.0, max_dx2 = 0.0;
   double damping_power_old = 0.0, damping_power_new = 0.0;  // W, Σ f_d·v⁻ and Σ f_d·v⁺
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    const double m = nodes.mass[n];
-    const std::uint8_t mask = nodes.constrained[n];
-    double dx2 = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      const std::size_t i = 3 * static_cast<std::size_t>(n) + k;
-      const double v_old = nodes.v[i];
-      double v_new = v_old + dt * nodes.f[i] / m;
-      if (local_damping > 0.0 && !(mask & (1u << k)) && v_old != 0.0) {
-        // The damping force opposes v⁻; v⁻ = 0 (a node at rest) gets none.
-        const double f_damping = -local_damping * std::abs(nodes.f[i]) * (v_old > 0 ? 1.0 : -1.0);
-        v_new += dt * f_damping / m;
-        damping_power_old += f_damping * v_old;
-        damping_power_new += f_damping * v_new;
-      }
-      if (mask & (1u << k)) {
-        v_new = nodes.prescribed_velocity[i];
-        const double reaction = m * (v_new - v_old) / dt - nodes.f[i];
-        out.constraint_work_before += 0.5 * reaction * dt * v_old;
-        out.constraint_work_after += 0.5 * reaction * dt * v_new;
-      }
-      kinetic2 += m * v_old * v_new;
-      kinetic_half2 += m * v_new * v_new;
-      out.momentum_before[k] += m * v_old;
-      out.momentum_after[k] += m * v_new;
-      nodes.v[i] = v_new;
-      const double dx = dt * v_new;
-      nodes.x[i] += dx;
-      dx2 += dx * dx;
+  double constraint_work_before = 0.0, constraint_work_after = 0.0;
+  double momentum_before[3] = {0.0, 0.0, 0.0}, momentum_after[3] = {0.0, 0.0, 0.0};
+};
+
+// One node of the central-difference step.  `damped` and `constrained` are known per call, so the
+// common node (undamped, free) runs without a test per component.
+template <bool damped, bool constrained>
+inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, double local_damping,
+                           IntegrationSums& sum) {
+  const double m = nodes.mass[n];
+  const std::uint8_t mask = constrained ? nodes.constrained[n] : 0;
+  double dx2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const std::size_t i = 3 * static_cast<std::size_t>(n) + k;
+    const bool prescribed = constrained && (mask & (1u << k));
+    const double v_old = nodes.v[i];
+    double v_new = v_old + dt * nodes.f[i] / m;
+    if (damped && !prescribed && v_old != 0.0) {
+      // The damping force opposes v⁻; v⁻ = 0 (a node at rest) gets none.
+      const double f_damping = -local_damping * std::abs(nodes.f[i]) * (v_old > 0 ? 1.0 : -1.0);
+      v_new += dt * f_damping / m;
+      sum.damping_power_old += f_damping * v_old;
+      sum.damping_power_new += f_damping * v_new;
     }
-    max_dx2 = std::max(max_dx2, dx2);
+    if (prescribed) {
+      v_new = nodes.prescribed_velocity[i];
+      const double reaction = m * (v_new - v_old) / dt - nodes.f[i];
+      sum.constraint_work_before += 0.5 * reaction * dt * v_old;
+      sum.constraint_work_after += 0.5 * reaction * dt * v_new;
+    }
+    sum.kinetic2 += m * v_old * v_new;
+    sum.kinetic_half2 += m * v_new * v_new;
+    sum.momentum_before[k] += m * v_old;
+    sum.momentum_after[k] += m * v_new;
+    nodes.v[i] = v_new;
+    const double dx = dt * v_new;
+    nodes.x[i] += dx;
+    dx2 += dx * dx;
   }
-  out.local_damping_work_before = 0.5 * dt * damping_power_old;
-  out.local_damping_work_after = 0.5 * dt * damping_power_new;
-  out.kinetic_energy = 0.5 * kinetic2;
-  out.kinetic_energy_half_step = 0.5 * kinetic_half2;
-  out.max_displacement_increment = std::sqrt(max_dx2);
-  out.finite = std::isfinite(kinetic2);
+  sum.max_dx2 = std::max(sum.max_dx2, dx2);
+}
+
+template <bool damped>
+void integrate_nodes(double dt, NodeArrays& nodes, double local_damping, IntegrationSums& sum) {
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
+    if (nodes.constrained[n])
+      integrate_node<damped, true>(dt, nodes, n, local_damping, sum);
+    else
+      integrate_node<damped, false>(dt, nodes, n, local_damping, sum);
+  }
+}
+
+}  // namespace
+
+IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
+                                                double local_damping) {
+  IntegrationSums sum;
+  if (local_damping > 0.0)
+    integrate_nodes<true>(dt, nodes, local_damping, sum);
+  else
+    integrate_nodes<false>(dt, nodes, local_damping, sum);
+  IntegrationSummary out;
+  out.constraint_work_before = sum.constraint_work_before;
+  out.constraint_work_after = sum.constraint_work_after;
+  for (int k = 0; k < 3; ++k) {
+    out.momentum_before[k] = sum.momentum_before[k];
+    out.momentum_after[k] = sum.momentum_after[k];
+  }
+  out.local_damping_work_before = 0.5 * dt * sum.damping_power_old;
+  out.local_damping_work_after = 0.5 * dt * sum.damping_power_new;
+  out.kinetic_energy = 0.5 * sum.kinetic2;
+  out.kinetic_energy_half_step = 0.5 * sum.kinetic_half2;
+  out.max_displacement_increment = std::sqrt(sum.max_dx2);
+  out.finite = std::isfinite(sum.kinetic2);
   return out;
 }
 

@@ -28,6 +28,7 @@ JointStage::JointStage(const Model& model) {
         curve = curves.insert(curves.end(),
                               SofteningCurve(p.softening_a, p.softening_b, p.softening_c));
       laws_.emplace_back(p, *curve);
+      intact_laws_.emplace_back(laws_.back());
     } catch (const InputError& e) {
       if (curve == curves.end()) throw InputError(spec.origin + ": " + e.what());
       throw InputError(joint_law_message(model.joint_laws, i, *curve, e.what()));
@@ -87,49 +88,85 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
   NodeArrays& nodes = model.nodes;
   const LocalIndex n = joints.size();
   const TetArrays& tets = model.tets;
-  // Face B's nodes belong to the neighbouring tet, often far from face A's in memory: fetched
-  // ahead, they are in cache when the joint is computed.
-  constexpr LocalIndex ahead = 8;
-  for (LocalIndex j = 0; j < n; ++j) {
-    if (j + ahead < n)
-      for (int i = 3; i < 6; i += 2) {
-        const LocalIndex node = joints.nodes[6 * static_cast<std::size_t>(j + ahead) + i];
-        __builtin_prefetch(nodes.x.data() + 3 * static_cast<std::size_t>(node));
-        __builtin_prefetch(nodes.f.data() + 3 * static_cast<std::size_t>(node), 1);
-      }
-    if (joints.broken[j]) continue;
-    const LocalIndex tet_a = joints.tets[2 * j], tet_b = joints.tets[2 * j + 1];
-    if (!tets.is_active(tet_a) && !tets.is_active(tet_b)) continue;  // other ranks compute it
-    const double share = tets.is_owned(tet_a) ? 1.0 : 0.0;           // the owner of A reports it
-    const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
-    Vec3 x[6];
-    for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[i]);
-    const CohesiveLaw& law = laws_[joints.law[j]];
-    std::int32_t slot = slot_[static_cast<std::size_t>(j)];
-    JointForce f;
-    if (slot < 0) {  // pristine: the intact step on its 48-byte state, or it leaves that state
-      JointFrame frame;
-      for (auto& force : f.force) force.setZero();
-      if (!joint_frame(x, frame))
-        f.degenerate = true;
-      else if (!joint_intact_step(x, frame, joints.area0[j] / 3.0, law,
-                                  intact_[static_cast<std::size_t>(j)], f))
-        slot = promote(j);
+  // Joints go in chunks of `lanes`: the pristine ones of a chunk take their intact step together
+  // (intact_joint_steps), then every joint of the chunk adds its forces in joint order, so each
+  // node receives its contributions in the same order as one joint at a time.
+  constexpr int lanes = intact_lanes;
+  constexpr LocalIndex prefetch_ahead = 2 * lanes;
+  enum Kind : unsigned char { elsewhere, pristine, live };
+  IntactJointBatch batch;
+  Kind kind[lanes];
+  double share[lanes];  // 1 where this rank reports the joint's energies (it owns tet A)
+  for (LocalIndex start = 0; start < n; start += lanes) {
+    const int count = static_cast<int>(std::min<LocalIndex>(lanes, n - start));
+    int first_pristine = -1;
+    for (int l = 0; l < count; ++l) {
+      const LocalIndex j = start + l;
+      // Face B's nodes belong to the neighbouring tet, often far from face A's in memory: fetched
+      // ahead, they are in cache when the joint is computed.
+      if (j + prefetch_ahead < n)
+        for (int i = 3; i < 6; i += 2) {
+          const LocalIndex node =
+              joints.nodes[6 * static_cast<std::size_t>(j + prefetch_ahead) + i];
+          __builtin_prefetch(nodes.x.data() + 3 * static_cast<std::size_t>(node));
+          __builtin_prefetch(nodes.f.data() + 3 * static_cast<std::size_t>(node), 1);
+        }
+      const LocalIndex tet_a = joints.tets[2 * j], tet_b = joints.tets[2 * j + 1];
+      kind[l] = joints.broken[j] || (!tets.is_active(tet_a) && !tets.is_active(tet_b))
+                    ? elsewhere  // broken, or computed by other ranks
+                : slot_[static_cast<std::size_t>(j)] < 0 ? pristine
+                                                         : live;
+      share[l] = tets.is_owned(tet_a) ? 1.0 : 0.0;
+      if (kind[l] != pristine) continue;
+      set_lane(batch, l, nodes.x.data(), joints.nodes.data() + 6 * static_cast<std::size_t>(j),
+               joints.area0[j] / 3.0, intact_laws_[joints.law[j]]);
+      if (first_pristine < 0) first_pristine = l;
     }
-    if (slot >= 0) f = joint_force(x, joints.area0[j], law, live_[static_cast<std::size_t>(slot)]);
-    for (int i = 0; i < 6; ++i) vec3_at(nodes.f.data(), id[i]) += f.force[i];
-    out.stored_energy += share * f.stored_energy;
-    out.fracture_dissipated += share * f.fracture_energy;
-    out.friction_dissipated += share * f.friction_energy;
-    if (slot < 0) continue;  // damage stays 0, nothing broke
-    JointHistory& h = live_[static_cast<std::size_t>(slot)];
-    joints.damage[j] = h.damage();
-    if (f.newly_broken) {
-      h.failure_time = time;
-      joints.broken[j] = 1;
-      joints.mode[j] = static_cast<std::uint8_t>(h.mode);
-      joints.failure_time[j] = time;
-      newly_broken_.push_back(j);
+    if (first_pristine >= 0) {
+      for (int l = 0; l < lanes; ++l)  // lanes without a pristine joint compute a copy
+        if (l >= count || kind[l] != pristine) copy_lane(batch, first_pristine, l);
+      intact_joint_steps_for_this_cpu(batch);
+    }
+    for (int l = 0; l < count; ++l) {
+      if (kind[l] == elsewhere) continue;
+      const LocalIndex j = start + l;
+      const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
+      if (kind[l] == pristine && batch.step[l] != IntactStep::leaves) {
+        for (int i = 0; i < 6; ++i) {
+          double* node_force = nodes.f.data() + 3 * static_cast<std::size_t>(id[i]);
+          for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][l];
+        }
+        out.stored_energy += share[l] * batch.stored_energy[l];
+        out.fracture_dissipated += share[l] * 0.0;  // as the full law's sums, to the last bit
+        out.friction_dissipated += share[l] * 0.0;
+        if (batch.step[l] == IntactStep::done) {
+          IntactJointState& state = intact_[static_cast<std::size_t>(j)];
+          for (int i = 0; i < 3; ++i) {
+            state.previous_opening[i] = batch.opening[i][l];
+            state.previous_shear_sq[i] = batch.shear_sq[i][l];
+          }
+        }
+        continue;  // damage stays 0, nothing broke
+      }
+      // A joint with a full history, or a pristine one that reached its strength in this step.
+      const std::int32_t slot = promote(j);
+      Vec3 x[6];
+      for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[i]);
+      const JointForce f = joint_force(x, joints.area0[j], laws_[joints.law[j]],
+                                       live_[static_cast<std::size_t>(slot)]);
+      for (int i = 0; i < 6; ++i) vec3_at(nodes.f.data(), id[i]) += f.force[i];
+      out.stored_energy += share[l] * f.stored_energy;
+      out.fracture_dissipated += share[l] * f.fracture_energy;
+      out.friction_dissipated += share[l] * f.friction_energy;
+      JointHistory& h = live_[static_cast<std::size_t>(slot)];
+      joints.damage[j] = h.damage();
+      if (f.newly_broken) {
+        h.failure_time = time;
+        joints.broken[j] = 1;
+        joints.mode[j] = static_cast<std::uint8_t>(h.mode);
+        joints.failure_time[j] = time;
+        newly_broken_.push_back(j);
+      }
     }
   }
   // Count the ones this rank reports (tet A owned); the ranks that hold a joint without computing

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/model.hpp"
+#include "fracture/intact_joint_kernel.hpp"
 #include "fracture/joint_kernels.hpp"
 
 namespace fdem {
@@ -71,9 +72,10 @@ class JointStage {
   std::int32_t promote(LocalIndex j);
 
   std::vector<CohesiveLaw> laws_;
-  std::vector<std::int32_t> slot_;        // per joint: index in live_, or −1 (pristine)
-  std::vector<IntactJointState> intact_;  // per joint: its state while pristine
-  std::vector<JointHistory> live_;        // histories of the joints that left the pristine state
+  std::vector<IntactJointLaw> intact_laws_;  // what the pristine joints' step reads, per law
+  std::vector<std::int32_t> slot_;           // per joint: index in live_, or −1 (pristine)
+  std::vector<IntactJointState> intact_;     // per joint: its state while pristine
+  std::vector<JointHistory> live_;           // histories of the joints that left the pristine state
   std::vector<LocalIndex> newly_broken_;
   LocalIndex broken_ = 0;
 };

@@ -4,9 +4,12 @@
 #include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdio>
+#include <random>
 
 #include "core/dynamics.hpp"
 #include "core/model_builder.hpp"
+#include "core/tet_kernels.hpp"
 #include "core/time_step.hpp"
 #include "one_body_scene.hpp"
 
@@ -83,4 +86,76 @@ TEST_CASE("critical step of one tet: 2/ω_max of its lumped-mass stiffness, the 
   const double unstable = run(model, 1.02 * exact, v0, 200, 150);
   CHECK(stable < 2.0 * early);    // bounded
   CHECK(unstable > 1e6 * early);  // |λ| ≈ 1.5 per step: grows without bound
+}
+
+namespace {
+
+// A cube of n³ cells of `size` (m), 6 Kuhn tets each, nodes moved at random by up to `jitter`
+// cells; `split` gives every tet its own four nodes, as in a body with joints on every face.
+Model kuhn_cube(int n, double size, double jitter, bool split, double poisson, double damping,
+                unsigned seed) {
+  Scene scene = test::one_rock_body("cube", damping);
+  scene.materials[0].elastic.poisson = poisson;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const int m = n + 1;
+  std::vector<double> grid;
+  for (int k = 0; k < m; ++k)
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i)
+        for (const int c : {i, j, k}) grid.push_back(size * (c + jitter * unit(rng)));
+  const auto corner = [&](int i, int j, int k, int bit) {
+    return (i + (bit & 1)) + m * ((j + ((bit >> 1) & 1)) + m * (k + ((bit >> 2) & 1)));
+  };
+  const int paths[6][2] = {{1, 3}, {1, 5}, {2, 3}, {2, 6}, {4, 5}, {4, 6}};
+  BodyMesh mesh;
+  mesh.source = "test";
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (const auto& path : paths) {
+          int tet[4] = {corner(i, j, k, 0), corner(i, j, k, path[0]), corner(i, j, k, path[1]),
+                        corner(i, j, k, 7)};
+          Vec3 x[4];
+          for (int c = 0; c < 4; ++c)
+            x[c] = Vec3(grid[3 * tet[c]], grid[3 * tet[c] + 1], grid[3 * tet[c] + 2]);
+          if (tet_reference(x).volume < 0.0) std::swap(tet[2], tet[3]);
+          for (const int node : tet) {
+            if (!split) {
+              mesh.tets.push_back(node);
+              continue;
+            }
+            mesh.tets.push_back(static_cast<int>(mesh.coords.size() / 3));
+            for (int c = 0; c < 3; ++c) mesh.coords.push_back(grid[3 * node + c]);
+          }
+        }
+  if (!split) mesh.coords = grid;
+  return build_model(scene, {mesh});
+}
+
+}  // namespace
+
+TEST_CASE("the cheap lower bound of the critical step is below the exact one and within 3× of it",
+          "[time_step]") {
+  double lowest = 1.0, highest = 0.0;
+  unsigned seed = 1;
+  for (const double poisson : {-0.3, 0.0, 0.25, 0.45})
+    for (const double damping : {0.0, 0.1})
+      for (const bool split : {false, true})
+        for (const double jitter : {0.0, 0.25}) {
+          Model model = kuhn_cube(3, 0.1, jitter, split, poisson, damping, ++seed);
+          const double exact = critical_time_step(model).dt;
+          const double bound = critical_time_step_lower_bound(model);
+          INFO("ν " << poisson << ", damping " << damping << ", split " << split << ", jitter "
+                    << jitter << ": bound " << bound << " s, exact " << exact << " s");
+          REQUIRE(bound <= exact);
+          REQUIRE(bound >= exact / 3.0);
+          // Each tet on its own: the bound holds tet by tet too (the minimum above could hide one).
+          Model moved = model;
+          for (double& x : moved.nodes.x) x *= 1.0 + 1e-3 * std::sin(x * 1e3);  // a deformed state
+          REQUIRE(critical_time_step_lower_bound(moved) <= critical_time_step(moved).dt);
+          lowest = std::min(lowest, bound / exact);
+          highest = std::max(highest, bound / exact);
+        }
+  std::printf("  lower bound / exact critical step: %.3f to %.3f\n", lowest, highest);
 }
