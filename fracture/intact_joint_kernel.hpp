@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "fracture/cohesive_law.hpp"
 #include "fracture/joint_kernels.hpp"
@@ -45,8 +46,8 @@ using Lanes = double __attribute__((vector_size(32)));
 using LaneMask = long long __attribute__((vector_size(32)));
 constexpr int intact_lanes = 4;
 
-// One batch: the caller fills the inputs of every lane (unused lanes with any valid joint, e.g.
-// a copy of lane 0) and reads the outputs of the lanes whose step is `done`.
+// One batch: the caller fills the inputs of every lane (set_lanes; an unused lane with any valid
+// joint, e.g. lane 0's) and reads the outputs of the lanes whose step is not `leaves`.
 struct IntactJointBatch {
   // Inputs.
   Lanes x[18];                               // a0, a1, a2, b0, b1, b2 (m), coordinate by coordinate
@@ -59,30 +60,24 @@ struct IntactJointBatch {
   Lanes opening[3], shear_sq[3];  // the new IntactJointState
 };
 
-// Lane `lane` gets the joint whose six nodes are node_x[3·id[0…5]] (m).
-inline void set_lane(IntactJointBatch& batch, int lane, const double* node_x, const LocalIndex* id,
-                     double w, const IntactJointLaw& law) {
+// The batch's inputs: lane l is the joint whose six nodes are node_x[3·id[l][0…5]] (m), with
+// w[l] = A0/3 (m²) and *law[l].  Each input vector is built in registers from its four values and
+// stored once (four scalar stores read back as one vector would stall the kernel's loads).
+inline void set_lanes(IntactJointBatch& b, const double* node_x,
+                      const LocalIndex* const (&id)[intact_lanes], const double (&w)[intact_lanes],
+                      const IntactJointLaw* const (&law)[intact_lanes]) {
+  static_assert(intact_lanes == 4, "the initialisers below name four lanes");
   for (int i = 0; i < 6; ++i) {
-    const double* xi = node_x + 3 * static_cast<std::size_t>(id[i]);
-    for (int k = 0; k < 3; ++k) batch.x[3 * i + k][lane] = xi[k];
+    const double* p[intact_lanes];
+    for (int l = 0; l < intact_lanes; ++l) p[l] = node_x + 3 * static_cast<std::size_t>(id[l][i]);
+    for (int k = 0; k < 3; ++k) b.x[3 * i + k] = Lanes{p[0][k], p[1][k], p[2][k], p[3][k]};
   }
-  batch.w[lane] = w;
-  batch.k_n[lane] = law.k_n;
-  batch.k_t[lane] = law.k_t;
-  batch.peak[lane] = law.peak;
-  batch.cohesion[lane] = law.cohesion;
-  batch.friction[lane] = law.friction;
-}
-
-// Lane `to` gets lane `from`'s inputs.
-inline void copy_lane(IntactJointBatch& batch, int from, int to) {
-  for (int c = 0; c < 18; ++c) batch.x[c][to] = batch.x[c][from];
-  batch.w[to] = batch.w[from];
-  batch.k_n[to] = batch.k_n[from];
-  batch.k_t[to] = batch.k_t[from];
-  batch.peak[to] = batch.peak[from];
-  batch.cohesion[to] = batch.cohesion[from];
-  batch.friction[to] = batch.friction[from];
+  b.w = Lanes{w[0], w[1], w[2], w[3]};
+  b.k_n = Lanes{law[0]->k_n, law[1]->k_n, law[2]->k_n, law[3]->k_n};
+  b.k_t = Lanes{law[0]->k_t, law[1]->k_t, law[2]->k_t, law[3]->k_t};
+  b.peak = Lanes{law[0]->peak, law[1]->peak, law[2]->peak, law[3]->peak};
+  b.cohesion = Lanes{law[0]->cohesion, law[1]->cohesion, law[2]->cohesion, law[3]->cohesion};
+  b.friction = Lanes{law[0]->friction, law[1]->friction, law[2]->friction, law[3]->friction};
 }
 
 inline void intact_joint_steps(IntactJointBatch& b) {

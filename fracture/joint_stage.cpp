@@ -97,6 +97,9 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
   IntactJointBatch batch;
   Kind kind[lanes];
   double share[lanes];  // 1 where this rank reports the joint's energies (it owns tet A)
+  const LocalIndex* id[lanes];
+  double w[lanes];
+  const IntactJointLaw* law[lanes];
   for (LocalIndex start = 0; start < n; start += lanes) {
     const int count = static_cast<int>(std::min<LocalIndex>(lanes, n - start));
     int first_pristine = -1;
@@ -117,23 +120,29 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
                 : slot_[static_cast<std::size_t>(j)] < 0 ? pristine
                                                          : live;
       share[l] = tets.is_owned(tet_a) ? 1.0 : 0.0;
+      id[l] = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
       if (kind[l] != pristine) continue;
-      set_lane(batch, l, nodes.x.data(), joints.nodes.data() + 6 * static_cast<std::size_t>(j),
-               joints.area0[j] / 3.0, intact_laws_[joints.law[j]]);
+      w[l] = joints.area0[j] / 3.0;
+      law[l] = &intact_laws_[joints.law[j]];
       if (first_pristine < 0) first_pristine = l;
     }
     if (first_pristine >= 0) {
-      for (int l = 0; l < lanes; ++l)  // lanes without a pristine joint compute a copy
-        if (l >= count || kind[l] != pristine) copy_lane(batch, first_pristine, l);
+      const LocalIndex* lane_id[lanes];
+      for (int l = 0; l < lanes; ++l) {  // a lane without a pristine joint computes a copy
+        const int from = l < count && kind[l] == pristine ? l : first_pristine;
+        lane_id[l] = id[from];
+        w[l] = w[from];
+        law[l] = law[from];
+      }
+      set_lanes(batch, nodes.x.data(), lane_id, w, law);
       intact_joint_steps_for_this_cpu(batch);
     }
     for (int l = 0; l < count; ++l) {
       if (kind[l] == elsewhere) continue;
       const LocalIndex j = start + l;
-      const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
       if (kind[l] == pristine && batch.step[l] != IntactStep::leaves) {
         for (int i = 0; i < 6; ++i) {
-          double* node_force = nodes.f.data() + 3 * static_cast<std::size_t>(id[i]);
+          double* node_force = nodes.f.data() + 3 * static_cast<std::size_t>(id[l][i]);
           for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][l];
         }
         out.stored_energy += share[l] * batch.stored_energy[l];
@@ -151,10 +160,10 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
       // A joint with a full history, or a pristine one that reached its strength in this step.
       const std::int32_t slot = promote(j);
       Vec3 x[6];
-      for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[i]);
+      for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[l][i]);
       const JointForce f = joint_force(x, joints.area0[j], laws_[joints.law[j]],
                                        live_[static_cast<std::size_t>(slot)]);
-      for (int i = 0; i < 6; ++i) vec3_at(nodes.f.data(), id[i]) += f.force[i];
+      for (int i = 0; i < 6; ++i) vec3_at(nodes.f.data(), id[l][i]) += f.force[i];
       out.stored_energy += share[l] * f.stored_energy;
       out.fracture_dissipated += share[l] * f.fracture_energy;
       out.friction_dissipated += share[l] * f.friction_energy;

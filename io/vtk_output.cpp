@@ -106,6 +106,11 @@ void SeriesWriter::write_pvd() const {
 
 namespace {
 
+// zlib level of the frames' arrays: 1 is the fastest.  Measured on the jointed bricks (11,520
+// tets, two frames): the output stage took a third of its time at zlib's default level (6),
+// 0.47 → 0.155 s, for frames 10–25 % larger (1.51 → 1.66 MB).
+constexpr int frame_compression_level = 1;
+
 vtkNew<vtkDoubleArray> make_array(const std::string& name, int components, vtkIdType tuples) {
   vtkNew<vtkDoubleArray> a;
   a->SetName(name.c_str());
@@ -256,6 +261,7 @@ void write_serial(const std::string& path, vtkDataObject* data) {
   writer->SetInputData(data);
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
+  writer->SetCompressionLevel(frame_compression_level);
   int system_error = 0;
   if (!write_succeeded(writer, system_error)) {
     const std::string reason = write_failure(writer, system_error);
@@ -354,6 +360,7 @@ void write_piece(const std::string& stem, const std::string& extension, vtkDataO
   writer->SetWriteToOutputString(rank == 0);  // the summary goes to a string, then atomically out
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
+  writer->SetCompressionLevel(frame_compression_level);
   int system_error = 0;
   if (!write_succeeded(writer, system_error))
     throw IoError("cannot write the frame piece " + frame_piece_name(stem, extension, rank) + ": " +

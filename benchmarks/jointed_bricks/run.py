@@ -6,7 +6,14 @@ contact.narrowing: exact — the default).
 
   benchmarks/jointed_bricks/run.py [--fdem build/drivers/fdem] [--repeats 2] [--scale 1]
                                    [--variants original,enclosed,exact]
+                                   [--baseline OLD_FDEM]
                                    [--csv docs/data/bench_jointed_bricks.csv]
+
+--baseline runs every variant also with another fdem binary, alternating with this one, and
+labels its rows `baseline:VARIANT`: the previous code of the same algorithm, e.g. built from an
+earlier commit with
+  git worktree add /tmp/fdem-base COMMIT && cmake -S /tmp/fdem-base -B /tmp/fdem-base/build \
+    -DCMAKE_BUILD_TYPE=Release && cmake --build /tmp/fdem-base/build -j2 --target fdem
 
 Prints per case the user CPU seconds (best of the repeats), tet-steps per CPU second, the
 contact- and joint-forces stages' shares, peak RSS and its bytes per tet, the speed-up against
@@ -39,6 +46,7 @@ def scene(case, variant, scale):
 
 
 def run(fdem, case, variant, scale, work):
+    variant = variant.split(":")[-1]
     path = os.path.join(work, f"{case}-{variant}.yaml")
     with open(path, "w") as f:
         f.write(scene(case, variant, scale))
@@ -62,6 +70,7 @@ def main():
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--scale", type=int, default=1)
     parser.add_argument("--variants", default="original,enclosed,exact")
+    parser.add_argument("--baseline", help="another fdem binary to run alternately")
     parser.add_argument("--csv", default=os.path.join(root, "docs", "data",
                                                       "bench_jointed_bricks.csv"))
     args = parser.parse_args()
@@ -69,13 +78,16 @@ def main():
     for v in variants:
         if v not in VARIANTS:
             sys.exit(f"unknown variant '{v}'; valid: {', '.join(VARIANTS)}")
+    if args.baseline:
+        variants = [w for v in variants for w in ("baseline:" + v, v)]
+    binary = {v: args.baseline if v.startswith("baseline:") else args.fdem for v in variants}
     rows = []
     with tempfile.TemporaryDirectory() as work:
         for case in ("apart", "contact"):
             best = {}
             for _ in range(args.repeats):
                 for v in variants:  # alternating: all see the same machine load
-                    r = run(args.fdem, case, v, args.scale, work)
+                    r = run(binary[v], case, v, args.scale, work)
                     if v not in best or r["user_s"] < best[v]["user_s"]:
                         best[v] = r
             for v in variants:
@@ -90,10 +102,10 @@ def main():
                              "bytes_per_tet": round(1024 * r["rss_kib"] / r["tets"]),
                              "speedup": round(best[variants[0]]["user_s"] / r["user_s"], 3),
                              "state_hash": r["hash"]})
-    print(f"{'case':8} {'variant':9} {'tets':>8} {'CPU s':>7} {'tet-steps/s':>12} {'contact':>8} "
+    print(f"{'case':8} {'variant':17} {'tets':>8} {'CPU s':>7} {'tet-steps/s':>12} {'contact':>8} "
           f"{'joints':>7} {'RSS MiB':>8} {'B/tet':>6} {'speed-up':>8}  state_hash")
     for r in rows:
-        print(f"{r['case']:8} {r['variant']:9} {r['tets']:8d} {r['cpu_seconds']:7.2f} "
+        print(f"{r['case']:8} {r['variant']:17} {r['tets']:8d} {r['cpu_seconds']:7.2f} "
               f"{r['tet_steps_per_cpu_second']:12.3e} {100 * r['contact_forces_share']:7.1f}% "
               f"{100 * r['joint_forces_share']:6.1f}% {r['peak_rss_kib'] / 1024:8.1f} "
               f"{r['bytes_per_tet']:6d} {r['speedup']:8.2f}  {r['state_hash']}")

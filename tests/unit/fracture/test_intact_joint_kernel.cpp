@@ -46,15 +46,22 @@ TEST_CASE(
   int verdicts[3] = {0, 0, 0};
   for (int round = 0; round < 4000; ++round) {
     IntactJointBatch batch;
-    double x[intact_lanes][18];
+    double x[intact_lanes][18];  // the lanes' six nodes, one after the other: node 6l + i
     int law_of[intact_lanes];
-    const LocalIndex ids[6] = {0, 1, 2, 3, 4, 5};
+    LocalIndex ids[intact_lanes][6];
+    const LocalIndex* id[intact_lanes];
+    double w[intact_lanes];
+    const IntactJointLaw* law[intact_lanes];
     for (int l = 0; l < intact_lanes; ++l) {
       const int kind = (round * intact_lanes + l) % 97 == 0 ? 1 : 0;
       random_joint(rng, scales[(round + l) % 5], kind, x[l]);
       law_of[l] = (round + 3 * l) % 2;
-      set_lane(batch, l, x[l], ids, 0.004 + 0.001 * l, intact_laws[law_of[l]]);
+      for (int i = 0; i < 6; ++i) ids[l][i] = 6 * l + i;
+      id[l] = ids[l];
+      w[l] = 0.004 + 0.001 * l;
+      law[l] = &intact_laws[law_of[l]];
     }
+    set_lanes(batch, &x[0][0], id, w, law);
     IntactJointBatch baseline = batch;
     intact_joint_steps(baseline);            // as compiled here (x86-64 baseline)
     intact_joint_steps_for_this_cpu(batch);  // the joint stage's (AVX2 where the CPU has it)
