@@ -25,8 +25,8 @@ FDEM_INLINE_CALLEES inline void add_tet_force(const TetArrays& tets, LocalIndex 
   Vec3 x[4], v[4];
   for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), corner_node[c]);
   // The kernel reads velocities only for viscous damping: skip that gather when undamped.
-  if (viscosity > 0.0)
-    for (int c = 0; c < 4; ++c) v[c] = vec3_at(nodes.v.data(), corner_node[c]);
+  for (int c = 0; c < 4; ++c)
+    v[c] = viscosity > 0.0 ? Vec3(vec3_at(nodes.v.data(), corner_node[c])) : Vec3::Zero();
   const Eigen::Map<const Mat3> dm_inv(tets.dm_inv.data() + 9 * static_cast<std::size_t>(t));
   const TetForce out = tet_internal_force(x, v, dm_inv, tets.volume0[t], material, viscosity);
   for (int c = 0; c < 4; ++c) scatter(c, corner_node[c], out.force[c]);

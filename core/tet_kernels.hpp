@@ -76,8 +76,9 @@ inline TetForce tet_internal_force(const Vec3 (&x)[4], const Vec3 (&v)[4], const
     out.damping_power = 0.0;
     return out;
   }
-  Mat3 P = material.first_piola(F);
-  out.strain_energy = material.energy_density(F) * volume0;
+  const StressAndEnergy elastic = material.stress_and_energy(F, out.jacobian);
+  Mat3 P = elastic.first_piola;
+  out.strain_energy = elastic.energy_density * volume0;
   out.damping_power = 0.0;
   if (viscosity > 0.0) {
     const Mat3 F_dot = edge_matrix(v) * dm_inv;
