@@ -9,21 +9,26 @@
 
 namespace fdem {
 
+namespace {
+
+// The current shape of tet t (recomputed in the second passes rather than stored: 80 B per tet).
+TetReference current_shape(const Model& model, LocalIndex t) {
+  Vec3 x[4];
+  for (int c = 0; c < 4; ++c) x[c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * t + c]);
+  return tet_reference(x);
+}
+
+}  // namespace
+
 CriticalStep critical_time_step(const Model& model) {
   const TetArrays& tets = model.tets;
   const NodeArrays& nodes = model.nodes;
   const LocalIndex n_tets = tets.size();
 
-  // The current shape of tet t (recomputed in pass 2 rather than stored: 80 B per tet).
-  const auto current_shape = [&](LocalIndex t) {
-    Vec3 x[4];
-    for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * t + c]);
-    return tet_reference(x);
-  };
   // Pass 1: each tet's stiffness weight (its largest K eigenvalue, N/m) and the weight per node.
   std::vector<double> weight(n_tets, 0.0), node_weight(nodes.size(), 0.0);
   for (LocalIndex t = 0; t < n_tets; ++t) {
-    const TetReference current = current_shape(t);
+    const TetReference current = current_shape(model, t);
     if (!(current.volume > 0.0)) continue;  // inverted: the force stage reports it
     weight[t] = tet_max_stiffness_eigenvalue(current.dm_inv, current.volume,
                                              model.materials[tets.material[t]].lame);
@@ -42,7 +47,7 @@ CriticalStep critical_time_step(const Model& model) {
       corner_mass[c] = nodes.mass[n] * weight[t] / node_weight[n];
     }
     const MaterialProperties& mat = model.materials[tets.material[t]];
-    const TetReference current = current_shape(t);
+    const TetReference current = current_shape(model, t);
     const double omega =
         std::sqrt(tet_max_eigenvalue(current.dm_inv, current.volume, mat.lame, corner_mass));
     const double dt = critical_step_for_frequency(omega, mat.damping_ratio);
@@ -90,18 +95,13 @@ double critical_time_step_lower_bound(const Model& model) {
   const TetArrays& tets = model.tets;
   const NodeArrays& nodes = model.nodes;
   const LocalIndex n_tets = tets.size();
-  const auto current_shape = [&](LocalIndex t) {
-    Vec3 x[4];
-    for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * t + c]);
-    return tet_reference(x);
-  };
   const double unit[4] = {1.0, 1.0, 1.0, 1.0};
   // Pass 1: bounds of each tet's weight (critical_time_step's λ_max with unit masses) and the sum
   // of the upper bounds at each node.
   std::vector<StiffnessBounds> weight(n_tets, StiffnessBounds{0.0, 0.0});
   std::vector<double> node_upper(nodes.size(), 0.0);
   for (LocalIndex t = 0; t < n_tets; ++t) {
-    const TetReference current = current_shape(t);
+    const TetReference current = current_shape(model, t);
     if (!(current.volume > 0.0)) continue;  // not in the exact split either
     weight[t] = stiffness_bounds(second_moments(shape_gradients(current.dm_inv), unit),
                                  current.volume, model.materials[tets.material[t]].lame);
@@ -119,7 +119,7 @@ double critical_time_step_lower_bound(const Model& model) {
       corner_mass[c] = nodes.mass[n] * weight[t].lower / (weight[t].lower + others);
     }
     const MaterialProperties& mat = model.materials[tets.material[t]];
-    const TetReference current = current_shape(t);
+    const TetReference current = current_shape(model, t);
     const double omega_sq =
         stiffness_bounds(second_moments(shape_gradients(current.dm_inv), corner_mass),
                          current.volume, mat.lame)
