@@ -81,6 +81,46 @@ std::vector<JointHistory> JointStage::history() const {
   return out;
 }
 
+void JointStage::add_intact(Model& model, LocalIndex j, const IntactJointBatch& batch, int lane,
+                            double share, JointStepSummary& out) {
+  const LocalIndex* id = model.joints.nodes.data() + 6 * static_cast<std::size_t>(j);
+  for (int i = 0; i < 6; ++i) {
+    double* node_force = model.nodes.f.data() + 3 * static_cast<std::size_t>(id[i]);
+    for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][lane];
+  }
+  out.stored_energy += share * batch.stored_energy[lane];
+  out.fracture_dissipated += share * 0.0;  // as the full law's sums, to the last bit
+  out.friction_dissipated += share * 0.0;
+  if (batch.step[lane] != IntactStep::done) return;  // degenerate: no force, state kept
+  IntactJointState& state = intact_[static_cast<std::size_t>(j)];
+  for (int i = 0; i < 3; ++i) {
+    state.previous_opening[i] = batch.opening[i][lane];
+    state.previous_shear_sq[i] = batch.shear_sq[i][lane];
+  }
+}
+
+void JointStage::add_full_law(Model& model, LocalIndex j, double share, double time,
+                              JointStepSummary& out) {
+  JointArrays& joints = model.joints;
+  const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
+  const std::int32_t slot = promote(j);
+  Vec3 x[6];
+  for (int i = 0; i < 6; ++i) x[i] = vec3_at(model.nodes.x.data(), id[i]);
+  JointHistory& h = live_[static_cast<std::size_t>(slot)];
+  const JointForce f = joint_force(x, joints.area0[j], laws_[joints.law[j]], h);
+  for (int i = 0; i < 6; ++i) vec3_at(model.nodes.f.data(), id[i]) += f.force[i];
+  out.stored_energy += share * f.stored_energy;
+  out.fracture_dissipated += share * f.fracture_energy;
+  out.friction_dissipated += share * f.friction_energy;
+  joints.damage[j] = h.damage();
+  if (!f.newly_broken) return;
+  h.failure_time = time;
+  joints.broken[j] = 1;
+  joints.mode[j] = static_cast<std::uint8_t>(h.mode);
+  joints.failure_time[j] = time;
+  newly_broken_.push_back(j);
+}
+
 JointStepSummary JointStage::add_forces(Model& model, double time) {
   JointStepSummary out;
   newly_broken_.clear();
@@ -138,44 +178,10 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
       intact_joint_steps_for_this_cpu(batch);
     }
     for (int l = 0; l < count; ++l) {
-      if (kind[l] == elsewhere) continue;
-      const LocalIndex j = start + l;
-      if (kind[l] == pristine && batch.step[l] != IntactStep::leaves) {
-        for (int i = 0; i < 6; ++i) {
-          double* node_force = nodes.f.data() + 3 * static_cast<std::size_t>(id[l][i]);
-          for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][l];
-        }
-        out.stored_energy += share[l] * batch.stored_energy[l];
-        out.fracture_dissipated += share[l] * 0.0;  // as the full law's sums, to the last bit
-        out.friction_dissipated += share[l] * 0.0;
-        if (batch.step[l] == IntactStep::done) {
-          IntactJointState& state = intact_[static_cast<std::size_t>(j)];
-          for (int i = 0; i < 3; ++i) {
-            state.previous_opening[i] = batch.opening[i][l];
-            state.previous_shear_sq[i] = batch.shear_sq[i][l];
-          }
-        }
-        continue;  // damage stays 0, nothing broke
-      }
-      // A joint with a full history, or a pristine one that reached its strength in this step.
-      const std::int32_t slot = promote(j);
-      Vec3 x[6];
-      for (int i = 0; i < 6; ++i) x[i] = vec3_at(nodes.x.data(), id[l][i]);
-      const JointForce f = joint_force(x, joints.area0[j], laws_[joints.law[j]],
-                                       live_[static_cast<std::size_t>(slot)]);
-      for (int i = 0; i < 6; ++i) vec3_at(nodes.f.data(), id[l][i]) += f.force[i];
-      out.stored_energy += share[l] * f.stored_energy;
-      out.fracture_dissipated += share[l] * f.fracture_energy;
-      out.friction_dissipated += share[l] * f.friction_energy;
-      JointHistory& h = live_[static_cast<std::size_t>(slot)];
-      joints.damage[j] = h.damage();
-      if (f.newly_broken) {
-        h.failure_time = time;
-        joints.broken[j] = 1;
-        joints.mode[j] = static_cast<std::uint8_t>(h.mode);
-        joints.failure_time[j] = time;
-        newly_broken_.push_back(j);
-      }
+      if (kind[l] == pristine && batch.step[l] != IntactStep::leaves)
+        add_intact(model, start + l, batch, l, share[l], out);
+      else if (kind[l] != elsewhere)  // a full history, or a pristine joint at its strength now
+        add_full_law(model, start + l, share[l], time, out);
     }
   }
   // Count the ones this rank reports (tet A owned); the ranks that hold a joint without computing

@@ -70,6 +70,12 @@ class JointStage {
  private:
   // Gives joint j a full history made from its intact state; returns its slot in live_.
   std::int32_t promote(LocalIndex j);
+  // Joint j's forces and energies from lane `lane` of a computed batch (its step not `leaves`).
+  void add_intact(Model& model, LocalIndex j, const IntactJointBatch& batch, int lane, double share,
+                  JointStepSummary& out);
+  // Joint j through the full law on a full history (promoted first when pristine); marks it broken
+  // at `time` when it breaks.
+  void add_full_law(Model& model, LocalIndex j, double share, double time, JointStepSummary& out);
 
   std::vector<CohesiveLaw> laws_;
   std::vector<IntactJointLaw> intact_laws_;  // what the pristine joints' step reads, per law
