@@ -2,10 +2,10 @@
 //
 // Same arithmetic, operation for operation, as joint_frame + joint_intact_step
 // (fracture/joint_kernels.hpp), so forces, energies and states are bit-identical to it (tested).
-// It is written as loops over `lanes` joints (coordinate-major arrays, no branches) so that the
-// compiler computes several joints per instruction: the reference version works on one joint's
-// Eigen 3-vectors, which leave most of a vector register empty and stall on packed stores
-// reloaded as scalars.  The reference stays the one joint_force uses and the tests compare with.
+// Four joints go side by side in vector lanes, without branches, so that one instruction computes
+// all four: the reference version works on one joint's Eigen 3-vectors, which leave most of a
+// vector register empty and stall on packed stores reloaded as scalars.  The reference stays the
+// one joint_force uses and the one the tests compare with.
 #pragma once
 
 #include <algorithm>
