@@ -145,21 +145,20 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes) {
 
 namespace {
 
-// The step's sums over nodes, in node order (the same order whatever the branches below take).
+// The step's sums over nodes that IntegrationSummary holds only once finished, in node order (the
+// same order whatever path a node takes).
 struct IntegrationSums {
   double kinetic2 = 0.0, kinetic_half2 = 0.0, max_dx2 = 0.0;
   double damping_power_old = 0.0, damping_power_new = 0.0;  // W, Σ f_d·v⁻ and Σ f_d·v⁺
-  double constraint_work_before = 0.0, constraint_work_after = 0.0;
-  double momentum_before[3] = {0.0, 0.0, 0.0}, momentum_after[3] = {0.0, 0.0, 0.0};
 };
 
-// One node of the central-difference step.  `damped` and `constrained` are known per call, so the
-// common node (undamped, free) runs without a test per component.
+// One node of the central-difference step; `mask` its prescribed components.  `damped` and
+// `constrained` are known per call, so the common node (undamped, free) runs without a test per
+// component.
 template <bool damped, bool constrained>
-inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, double local_damping,
-                           IntegrationSums& sum) {
+inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, std::uint8_t mask,
+                           double local_damping, IntegrationSums& sum, IntegrationSummary& out) {
   const double m = nodes.mass[n];
-  const std::uint8_t mask = constrained ? nodes.constrained[n] : 0;
   double dx2 = 0.0;
   for (int k = 0; k < 3; ++k) {
     const std::size_t i = 3 * static_cast<std::size_t>(n) + k;
@@ -176,13 +175,13 @@ inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, double lo
     if (prescribed) {
       v_new = nodes.prescribed_velocity[i];
       const double reaction = m * (v_new - v_old) / dt - nodes.f[i];
-      sum.constraint_work_before += 0.5 * reaction * dt * v_old;
-      sum.constraint_work_after += 0.5 * reaction * dt * v_new;
+      out.constraint_work_before += 0.5 * reaction * dt * v_old;
+      out.constraint_work_after += 0.5 * reaction * dt * v_new;
     }
     sum.kinetic2 += m * v_old * v_new;
     sum.kinetic_half2 += m * v_new * v_new;
-    sum.momentum_before[k] += m * v_old;
-    sum.momentum_after[k] += m * v_new;
+    out.momentum_before[k] += m * v_old;
+    out.momentum_after[k] += m * v_new;
     nodes.v[i] = v_new;
     const double dx = dt * v_new;
     nodes.x[i] += dx;
@@ -192,12 +191,14 @@ inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, double lo
 }
 
 template <bool damped>
-void integrate_nodes(double dt, NodeArrays& nodes, double local_damping, IntegrationSums& sum) {
+void integrate_nodes(double dt, NodeArrays& nodes, double local_damping, IntegrationSums& sum,
+                     IntegrationSummary& out) {
   for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
-    if (nodes.constrained[n])
-      integrate_node<damped, true>(dt, nodes, n, local_damping, sum);
+    const std::uint8_t mask = nodes.constrained[n];
+    if (mask)
+      integrate_node<damped, true>(dt, nodes, n, mask, local_damping, sum, out);
     else
-      integrate_node<damped, false>(dt, nodes, n, local_damping, sum);
+      integrate_node<damped, false>(dt, nodes, n, mask, local_damping, sum, out);
   }
 }
 
@@ -205,18 +206,12 @@ void integrate_nodes(double dt, NodeArrays& nodes, double local_damping, Integra
 
 IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
                                                 double local_damping) {
+  IntegrationSummary out;
   IntegrationSums sum;
   if (local_damping > 0.0)
-    integrate_nodes<true>(dt, nodes, local_damping, sum);
+    integrate_nodes<true>(dt, nodes, local_damping, sum, out);
   else
-    integrate_nodes<false>(dt, nodes, local_damping, sum);
-  IntegrationSummary out;
-  out.constraint_work_before = sum.constraint_work_before;
-  out.constraint_work_after = sum.constraint_work_after;
-  for (int k = 0; k < 3; ++k) {
-    out.momentum_before[k] = sum.momentum_before[k];
-    out.momentum_after[k] = sum.momentum_after[k];
-  }
+    integrate_nodes<false>(dt, nodes, local_damping, sum, out);
   out.local_damping_work_before = 0.5 * dt * sum.damping_power_old;
   out.local_damping_work_after = 0.5 * dt * sum.damping_power_new;
   out.kinetic_energy = 0.5 * sum.kinetic2;

@@ -1,7 +1,7 @@
 // Hyperelastic material laws as small value types with one interface:
 //   first_piola(F) -> P (Pa),  energy_density(F) -> W (J/m^3 of reference volume),
 //   stress_and_energy(F, J) -> both at once, sharing their work (J = det F, as F.determinant()
-//   gives it): the element kernel's call, with the same bits as the two separate ones.
+//   gives it): the element kernel's call; the two above are defined through it.
 // Both are objective (depend on F only through C = FᵀF), so rigid rotations give zero stress.
 #pragma once
 
@@ -32,16 +32,9 @@ struct StressAndEnergy {
 struct StVenantKirchhoff {
   LameParameters lame;
 
-  Mat3 first_piola(const Mat3& F) const {
-    const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
-    const Mat3 S = lame.lambda * E.trace() * Mat3::Identity() + 2.0 * lame.mu * E;
-    return F * S;
-  }
-  double energy_density(const Mat3& F) const {
-    const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
-    const double trE = E.trace();
-    return 0.5 * lame.lambda * trE * trE + lame.mu * E.squaredNorm();
-  }
+  // J is not used by this law.
+  Mat3 first_piola(const Mat3& F) const { return stress_and_energy(F, 0.0).first_piola; }
+  double energy_density(const Mat3& F) const { return stress_and_energy(F, 0.0).energy_density; }
   StressAndEnergy stress_and_energy(const Mat3& F, double /*J*/) const {
     const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
     const double trE = E.trace();
@@ -56,17 +49,12 @@ struct NeoHookean {
   LameParameters lame;
 
   Mat3 first_piola(const Mat3& F) const {
-    const double J = F.determinant();
-    const Mat3 F_inv_T = F.inverse().transpose();
-    return lame.mu * (F - F_inv_T) + lame.lambda * std::log(J) * F_inv_T;
+    return stress_and_energy(F, F.determinant()).first_piola;
   }
   double energy_density(const Mat3& F) const {
-    const double J = F.determinant();
-    const double logJ = std::log(J);
-    return 0.5 * lame.mu * (F.squaredNorm() - 3.0) - lame.mu * logJ +
-           0.5 * lame.lambda * logJ * logJ;
+    return stress_and_energy(F, F.determinant()).energy_density;
   }
-  // One logarithm and one determinant instead of two each (~15 % of the element kernel).
+  // Stress and energy share one logarithm (the element kernel calls this, with its det F).
   StressAndEnergy stress_and_energy(const Mat3& F, double J) const {
     const double logJ = std::log(J);
     const Mat3 F_inv_T = F.inverse().transpose();

@@ -88,10 +88,8 @@ void JointStage::add_intact(Model& model, LocalIndex j, const IntactJointBatch& 
     double* node_force = model.nodes.f.data() + 3 * static_cast<std::size_t>(id[i]);
     for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][lane];
   }
-  out.stored_energy += share * batch.stored_energy[lane];
-  out.fracture_dissipated += share * 0.0;  // as the full law's sums, to the last bit
-  out.friction_dissipated += share * 0.0;
-  if (batch.step[lane] != IntactStep::done) return;  // degenerate: no force, state kept
+  out.stored_energy += share * batch.stored_energy[lane];  // nothing dissipated while pristine
+  if (batch.step[lane] != IntactStep::done) return;        // degenerate: no force, state kept
   IntactJointState& state = intact_[static_cast<std::size_t>(j)];
   for (int i = 0; i < 3; ++i) {
     state.previous_opening[i] = batch.opening[i][lane];
