@@ -258,6 +258,56 @@ TEST_CASE("fdem check prints the scene contents and stages without stepping", "[
   }
 }
 
+// A block resting on a fixed base, with friction and no element damping.
+const char* block_on_base = R"(name: block-on-base
+time: {end: 0.05}
+gravity: [0, 0, -9.81]
+materials:
+  soft:
+    density: 1000
+    elastic: {young: 1.0e6, poisson: 0.25}
+    contact: {friction: 0.5}
+bodies:
+  - name: base
+    mesh: {box: {min: [-1, -1, -0.2], max: [1, 1, 0], cells: [2, 2, 1]}}
+    material: soft
+    fixed: true
+  - name: block
+    mesh: {box: {min: [-0.2, -0.2, 0], max: [0.2, 0.2, 0.2], cells: [1, 1, 1]}}
+    material: soft
+output:
+  every: 0.01
+)";
+
+TEST_CASE("fdem check advises element damping for sliding bodies with friction", "[cli]") {
+  TempDir dir;
+  write_text(dir / "scene.yaml", block_on_base);
+  const std::string advice =
+      "advice: material 'soft' has friction and no element damping: a body of it that slides";
+  const Outcome o = run_fdem(dir, "check scene.yaml");
+  CHECK(o.exit_code == 0);
+  CHECK_THAT(o.out, Contains(advice));
+  CHECK_THAT(o.out, Contains("docs/verification.md, \"Sliding too fast\""));
+  SECTION("not with element damping") {
+    const Outcome d = run_fdem(dir, "check scene.yaml --set materials.soft.damping=0.3");
+    CHECK(d.exit_code == 0);
+    CHECK_THAT(d.out, !Contains("advice:"));
+  }
+  SECTION("not without friction") {
+    const Outcome f = run_fdem(dir, "check scene.yaml --set materials.soft.contact.friction=0");
+    CHECK(f.exit_code == 0);
+    CHECK_THAT(f.out, !Contains("advice:"));
+  }
+  SECTION("not under local damping for the whole run, but when it ends before") {
+    write_text(dir / "qs.yaml",
+               std::string(block_on_base) + "quasi_static: {local_damping: 0.8}\n");
+    CHECK_THAT(run_fdem(dir, "check qs.yaml").out, !Contains("advice:"));
+    write_text(dir / "settle.yaml",
+               std::string(block_on_base) + "quasi_static: {local_damping: 0.8, until: 0.01}\n");
+    CHECK_THAT(run_fdem(dir, "check settle.yaml").out, Contains(advice));
+  }
+}
+
 TEST_CASE("fdem on a bad scene exits 2 with one located paragraph", "[cli]") {
   TempDir dir;
   std::string text = falling_box;
