@@ -5,6 +5,7 @@ from the start at `ratio` × the rigid-block threshold and held under local damp
 (quasi_static), and a monitor point says whether the structure settles or a mechanism runs.
 
   benchmarks/masonry_thresholds/run.py [--fdem build/drivers/fdem] [--cases all|NAME,...]
+                                       [--ratios all|R,...] [--hold-scale 1]
                                        [--csv docs/data/masonry_thresholds.csv]
   benchmarks/masonry_thresholds/run.py --references   # the rigid-block values only
 
@@ -198,7 +199,7 @@ def make_cases(refs):
         cases.append(("arch_min_thickness", ratio, hold, None,
                       lambda h, r=ratio: arch_scene(r * refs["arch_min_thickness"], 0.0, h,
                                                     None), 5e-6, 2e-5))
-    for ratio, hold in ((0.98, 0.6), (1.02, 0.6)):
+    for ratio, hold in ((0.92, 0.6), (0.95, 0.6), (0.98, 0.6), (1.02, 0.6)):
         cases.append(("arch_horizontal", ratio, hold, None,
                       lambda h, r=ratio: arch_scene(0.15, r * refs["arch_horizontal"], h,
                                                     None), 5e-6, 2e-5))
@@ -239,6 +240,7 @@ def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     p.add_argument("--fdem", default=os.path.join(root, "build", "drivers", "fdem"))
     p.add_argument("--cases", default="all")
+    p.add_argument("--ratios", default="all", help="only these ratios, e.g. 0.95,0.98")
     p.add_argument("--csv", default=os.path.join(root, "docs", "data", "masonry_thresholds.csv"))
     p.add_argument("--references", action="store_true")
     p.add_argument("--hold-scale", type=float, default=1.0,
@@ -252,11 +254,14 @@ def main():
     if a.references:
         return
     chosen = None if a.cases == "all" else set(a.cases.split(","))
+    ratios = None if a.ratios == "all" else [float(r) for r in a.ratios.split(",")]
     results = []
     print("%-20s %6s %6s %9s %8s %11s %11s  %s" % ("problem", "ratio", "hold", "steps", "cpu_s",
                                                    "|u| end", "last window", "outcome"))
     for name, ratio, hold, _, scene, still, moving in make_cases(refs):
         if chosen and name not in chosen:
+            continue
+        if ratios and not any(abs(ratio - r) < 1e-9 for r in ratios):
             continue
         hold *= a.hold_scale
         with tempfile.TemporaryDirectory() as workdir:
