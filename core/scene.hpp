@@ -288,6 +288,7 @@ struct QuasiStaticSpec {
   double local_damping = 0.0;  // α in [0, 1): the unbalanced force is damped by α·|f|; 0: off
   double until = HUGE_VAL;     // s: dynamic (undamped) from this time on, e.g. after settling
   bool active_at(double t) const { return local_damping > 0.0 && t < until; }
+  bool active_until(double end) const { return local_damping > 0.0 && until >= end; }  // whole run
 };
 
 // Ceilings between a valid scene and a runnable one (drivers/run_limits): checked by `fdem check`

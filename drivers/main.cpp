@@ -33,11 +33,6 @@ const char* usage =
     "  fdem prepare MESH.msh [-o MODEL.h5] [--block-rows N]   (a Gmsh mesh into a model file)\n"
     "  fdem --version\n";
 
-// Local damping for the whole run damps every vibration, the friction-induced one too.
-bool whole_run_quasi_static(const fdem::Scene& scene) {
-  return scene.quasi_static.local_damping > 0.0 && scene.quasi_static.until >= scene.time.end;
-}
-
 // Materials of free bodies with friction and no element damping: sliding, an elastic body
 // vibrates on its contact and its mean friction falls below μN (docs/verification.md, "Sliding
 // too fast").
@@ -94,7 +89,8 @@ int check(const fdem::Scene& scene) {
                   m + 1 < model.materials.size() ? "," : "");
     std::printf("\n");
   }
-  if (sim->contact_stage() && !whole_run_quasi_static(scene))
+  // Local damping for the whole run damps every vibration, the friction-induced one too.
+  if (sim->contact_stage() && !scene.quasi_static.active_until(scene.time.end))
     for (const std::string& line : sliding_advice(scene))
       std::printf("  advice: %s\n", line.c_str());
   if (model.joints.size() > 0)
