@@ -271,7 +271,7 @@ void print(const DiscResult& r) {
 }  // namespace
 
 TEST_CASE("Brazilian disc: centre stresses, split along the loaded diameter, peak load",
-          "[verification][fracture]") {
+          "[verification][fracture][long]") {
   const DiscSettings settings;
   const DiscResult r = run_brazilian_disc(settings);
   print(r);

@@ -214,7 +214,7 @@ double tilted_stick(double slope_deg, double friction_deg) {
 }  // namespace
 
 TEST_CASE("block on an incline slides with a = g(sinψ − cosψ·tanφ) (docs/references.md 6)",
-          "[verification][contact]") {
+          "[verification][contact][long]") {
   const double g = 10.0, psi = 40 * M_PI / 180, phi = 20 * M_PI / 180;
   const double expected = g * (std::sin(psi) - std::cos(psi) * std::tan(phi));  // 3.640 m/s²
   const InclineRun slide = incline(40, 20, 0.6);

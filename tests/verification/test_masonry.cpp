@@ -43,7 +43,7 @@ HoldResult tilt_and_hold(double b, double h, double friction, double angle, doub
 }  // namespace
 
 TEST_CASE("tilting table: a block slides at tanθ = μ when μ < b/h, topples at tanθ = b/h otherwise",
-          "[verification][masonry]") {
+          "[verification][masonry][long]") {
   const double b = 0.25, h = 0.5;                // b/h = 0.5
   const double topple = std::atan(b / h) / deg;  // 26.57°
   // Held below and above the closed-form angle (sliding ±0.5°, toppling ±1°): still below,

@@ -145,7 +145,7 @@ Scene settled(Scene scene, double settle) {
 }  // namespace
 
 TEST_CASE("static friction holds at τ/μσ = 0.95 for 2 s after settling, a sudden load slides",
-          "[verification][quasi_static]") {
+          "[verification][quasi_static][long]") {
   const double mu = 0.7, angle = std::atan(0.95 * mu);  // 33.6°
   const HoldResult held = hold(settled(incline(angle, mu, 2.05), 0.05), 0.05);
   // The same block without settling: the sudden load sets it rattling on the penalty springs and
@@ -159,7 +159,7 @@ TEST_CASE("static friction holds at τ/μσ = 0.95 for 2 s after settling, a sud
 }
 
 TEST_CASE("a column of three blocks at τ/μσ = 0.95 holds for 2 s after settling",
-          "[verification][quasi_static]") {
+          "[verification][quasi_static][long]") {
   // Settled 0.1 s under local damping, then 2 s of dynamics with 2 % contact damping; the top
   // block (piece 3) moves least freely: it rides on two interfaces.
   const double mu = 0.7, angle = std::atan(0.95 * mu);
@@ -172,7 +172,7 @@ TEST_CASE("a column of three blocks at τ/μσ = 0.95 holds for 2 s after settli
 }
 
 TEST_CASE("sliding on a tilting table starts between 0.995 and 1.005 tanθ = μ",
-          "[verification][quasi_static]") {
+          "[verification][quasi_static][long]") {
   // Settled 0.05 s at 2° below the slide angle, tilted at 10°/s to tanθ = ratio·μ under local
   // damping, settled 0.05 s more, then held undamped for 0.3 s.  Above μ the block slides at
   // a = g(sinθ − μcosθ) (0.5 % over: 0.028 m/s², 1.3 mm in 0.3 s).
@@ -198,7 +198,7 @@ TEST_CASE("sliding on a tilting table starts between 0.995 and 1.005 tanθ = μ"
 TEST_CASE(
     "quasi-static tilting table: a dry running-bond wall stands at 0.98 θc and turns its "
     "end wedge at 1.02 θc (docs/references.md 17)",
-    "[verification][quasi_static]") {
+    "[verification][quasi_static][long]") {
   // Each angle held from the start under local damping.  Below θc the wall settles elastically
   // (the top corner stops at ~48 µm by 0.15 s); above it the end wedge turns, accelerating at
   // (1 − α) of its unbalanced moment.  Measured (docs/verification.md): at 0.98 θc the corner
@@ -220,7 +220,7 @@ TEST_CASE(
 
 TEST_CASE(
     "a dry running-bond wall at τ/μσ = 0.95 holds for 2 s after settling and slides at 1.01 μ",
-    "[verification][quasi_static]") {
+    "[verification][quasi_static][long]") {
   // 3 courses of 3 units (108 tets) on the held lowest course, E = 0.1 GPa, μ = 0.5, contact
   // damping 0.02, settled 0.1 s under local damping, then dynamic.  Every bed joint carries
   // τ/σ = tan θ, so sliding governs: the end wedge of the 2 courses above the held one would
