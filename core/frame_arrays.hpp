@@ -37,6 +37,22 @@ struct FrameArray {
   std::size_t values() const { return type == FrameValue::f64 ? real.size() : integer.size(); }
 };
 
+// One array of a frame produced on demand, a range of rows at a time: a writer that streams it
+// in blocks holds neither the frame nor the whole array.  `fill_real` (f64) or `fill_integer`
+// (i32, i64) writes the components × count values of rows [first, first + count) to `out`.
+struct FrameColumn {
+  std::string name;
+  bool per_cell = true;
+  int components = 1;
+  FrameValue type = FrameValue::f64;
+  std::size_t rows = 0;
+  std::function<void(std::size_t first, std::size_t count, double* out)> fill_real;
+  std::function<void(std::size_t first, std::size_t count, std::int64_t* out)> fill_integer;
+
+  // The whole column as one array (for writers that take whole arrays).
+  FrameArray materialize() const;
+};
+
 // Local tets this rank writes in a frame: the owned ones (TetArrays::is_owned), ascending, so in
 // ascending gid (all of them on one rank).
 std::vector<LocalIndex> owned_tets(const TetArrays& tets);
@@ -53,6 +69,12 @@ std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<L
                                          const std::vector<LocalIndex>& points,
                                          const std::vector<std::string>& fields,
                                          const std::vector<FrameField>& extra);
+// The same arrays as columns, in the same order, computed when a writer asks for their rows;
+// they read `model`, `cells`, `points` and `extra`, which must outlive them.
+std::vector<FrameColumn> tet_frame_columns(const Model& model, const std::vector<LocalIndex>& cells,
+                                           const std::vector<LocalIndex>& points,
+                                           const std::vector<std::string>& fields,
+                                           const std::vector<FrameField>& extra);
 // The same arrays handed to `take` one at a time, each built just before and freed just after
 // (a writer that copies them keeps one at a time, not the whole frame twice).
 void for_each_tet_frame_array(const Model& model, const std::vector<LocalIndex>& cells,

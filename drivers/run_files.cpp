@@ -160,7 +160,7 @@ void RunFiles::write_xdmf_tet_frame(double time, const Model& model,
     for (int c = 0; c < 4; ++c) rows.tet_nodes.push_back(model.tets.nodes[4 * t + c]);
   std::vector<LocalIndex> points(static_cast<std::size_t>(nodes.n_owned));  // the owned nodes
   for (LocalIndex n = 0; n < nodes.n_owned; ++n) points[static_cast<std::size_t>(n)] = n;
-  rows.arrays = tet_frame_arrays(model, cells, points, fields_, extra);
+  rows.arrays = tet_frame_columns(model, cells, points, fields_, extra);  // read when written
   const Communicator comm = xdmf_->comm ? *xdmf_->comm : process_communicator();
   const std::string file = xdmf_series_->next_frame_file();
   const FrameFileInfo written = write_xdmf_frame(directory_, file, time, comm, rows, xdmf_->hints);

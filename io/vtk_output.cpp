@@ -4,18 +4,13 @@
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
 #include <vtkErrorCode.h>
-#include <vtkIntArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
-#include <vtkTypeInt64Array.h>
-#include <vtkUnstructuredGrid.h>
 #include <vtkXMLPPolyDataWriter.h>
-#include <vtkXMLPUnstructuredGridWriter.h>
 #include <vtkXMLPolyDataWriter.h>
-#include <vtkXMLUnstructuredGridWriter.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -27,6 +22,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/vtu_stream.hpp"
 
 namespace fdem {
 
@@ -126,64 +122,81 @@ vtkNew<vtkDoubleArray> full_array(const FrameField& f, vtkIdType tuples, const c
   return a;
 }
 
-template <class Array, class Value>
-vtkSmartPointer<vtkDataArray> typed_array(const FrameArray& f, const std::vector<Value>& values) {
-  auto a = vtkSmartPointer<Array>::New();
-  a->SetName(f.name.c_str());
-  a->SetNumberOfComponents(f.components);
-  a->SetNumberOfTuples(static_cast<vtkIdType>(values.size() / f.components));
-  for (std::size_t i = 0; i < values.size(); ++i) a->SetValue(static_cast<vtkIdType>(i), values[i]);
+// A frame column as a streamed .vtu array: f64 → Float64, i64 → Int64, i32 → Int32.
+VtuArray vtu_array(const FrameColumn& c) {
+  const char* type = c.type == FrameValue::f64   ? "Float64"
+                     : c.type == FrameValue::i64 ? "Int64"
+                                                 : "Int32";
+  VtuArray a{c.name, type, c.components, c.rows, {}};
+  const std::size_t n = static_cast<std::size_t>(c.components);
+  a.fill = [&c, n](std::size_t first, std::size_t count, unsigned char* out) {
+    if (c.type == FrameValue::f64) {
+      std::vector<double> values(count * n);
+      c.fill_real(first, count, values.data());
+      std::memcpy(out, values.data(), values.size() * sizeof(double));
+      return;
+    }
+    std::vector<std::int64_t> values(count * n);
+    c.fill_integer(first, count, values.data());
+    if (c.type == FrameValue::i64) {
+      std::memcpy(out, values.data(), values.size() * sizeof(std::int64_t));
+      return;
+    }
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const auto value = static_cast<std::int32_t>(values[i]);
+      std::memcpy(out + 4 * i, &value, 4);
+    }
+  };
   return a;
 }
 
-// A frame array as a VTK array of its type: f64 → Float64, i64 → Int64, i32 → Int32.
-vtkSmartPointer<vtkDataArray> vtk_array(const FrameArray& f) {
-  if (f.type == FrameValue::f64) return typed_array<vtkDoubleArray>(f, f.real);
-  if (f.type == FrameValue::i64) return typed_array<vtkTypeInt64Array>(f, f.integer);
-  return typed_array<vtkIntArray>(f, f.integer);
-}
-
 // The owned tets of `model` and the nodes they reference, renumbered in ascending local order
-// (on one rank with every node in a tet, the identity).
-vtkSmartPointer<vtkUnstructuredGrid> owned_tet_grid(const Model& model,
-                                                    const std::vector<std::string>& fields,
-                                                    const std::vector<FrameField>& extra) {
-  const NodeArrays& nodes = model.nodes;
-  const TetArrays& tets = model.tets;
-  const std::vector<LocalIndex> cells = owned_tets(tets);  // ascending, so ascending gid
-  std::vector<LocalIndex> renumbered(nodes.size(), -1);
-  for (const LocalIndex t : cells)
-    for (int c = 0; c < 4; ++c) renumbered[tets.nodes[4 * t + c]] = 0;
-  std::vector<LocalIndex> points;  // local nodes written, ascending
-  for (LocalIndex i = 0; i < nodes.size(); ++i)
-    if (renumbered[i] == 0) {
-      renumbered[i] = static_cast<LocalIndex>(points.size());
-      points.push_back(i);
-    }
-  const vtkIdType n_points = static_cast<vtkIdType>(points.size());
-  const vtkIdType n_cells = static_cast<vtkIdType>(cells.size());
-
-  auto grid = vtkSmartPointer<vtkUnstructuredGrid>::New();
-  vtkNew<vtkPoints> xyz;
-  xyz->SetDataTypeToDouble();
-  xyz->SetNumberOfPoints(n_points);
-  for (vtkIdType p = 0; p < n_points; ++p) xyz->SetPoint(p, &nodes.x[3 * points[p]]);
-  grid->SetPoints(xyz);
-  grid->Allocate(n_cells);
-  for (const LocalIndex t : cells) {
-    const vtkIdType ids[4] = {renumbered[tets.nodes[4 * t]], renumbered[tets.nodes[4 * t + 1]],
-                              renumbered[tets.nodes[4 * t + 2]], renumbered[tets.nodes[4 * t + 3]]};
-    grid->InsertNextCell(VTK_TETRA, 4, ids);
+// (on one rank with every node in a tet, the identity), as a streamed .vtu grid.  The grid's
+// arrays read the model and this object, which is neither copied nor moved.
+class OwnedTetGrid {
+ public:
+  OwnedTetGrid(const Model& model, const std::vector<std::string>& fields,
+               const std::vector<FrameField>& extra)
+      : cells_(owned_tets(model.tets)) {  // ascending, so ascending gid
+    const NodeArrays& nodes = model.nodes;
+    const TetArrays& tets = model.tets;
+    renumbered_.assign(static_cast<std::size_t>(nodes.size()), -1);
+    for (const LocalIndex t : cells_)
+      for (int c = 0; c < 4; ++c) renumbered_[tets.nodes[4 * t + c]] = 0;
+    for (LocalIndex i = 0; i < nodes.size(); ++i)
+      if (renumbered_[i] == 0) {
+        renumbered_[i] = static_cast<LocalIndex>(points_.size());
+        points_.push_back(i);
+      }
+    columns_ = tet_frame_columns(model, cells_, points_, fields, extra);
+    grid_.points = points_.size();
+    grid_.cells = cells_.size();
+    for (const FrameColumn& c : columns_)
+      (c.per_cell ? grid_.cell_data : grid_.point_data).push_back(vtu_array(c));
+    grid_.positions = {"Points", "Float64", 3, points_.size(),
+                       [this, &nodes](std::size_t first, std::size_t count, unsigned char* out) {
+                         for (std::size_t p = 0; p < count; ++p)
+                           std::memcpy(out + 24 * p, &nodes.x[3 * points_[first + p]], 24);
+                       }};
+    grid_.tet_corners = {"connectivity", "Int64", 4, cells_.size(),
+                         [this, &tets](std::size_t first, std::size_t count, unsigned char* out) {
+                           for (std::size_t c = 0; c < count; ++c)
+                             for (int k = 0; k < 4; ++k) {
+                               const LocalIndex n = tets.nodes[4 * cells_[first + c] + k];
+                               const auto point = static_cast<std::int64_t>(renumbered_[n]);
+                               std::memcpy(out + 32 * c + 8 * k, &point, 8);
+                             }
+                         }};
   }
-  // One frame array at a time, freed once copied: the frame's peak holds the VTK arrays only.
-  for_each_tet_frame_array(model, cells, points, fields, extra, [&](FrameArray& f) {
-    if (f.per_cell)
-      grid->GetCellData()->AddArray(vtk_array(f));
-    else
-      grid->GetPointData()->AddArray(vtk_array(f));
-  });
-  return grid;
-}
+  OwnedTetGrid(const OwnedTetGrid&) = delete;
+  OwnedTetGrid& operator=(const OwnedTetGrid&) = delete;
+  const VtuGrid& grid() const { return grid_; }
+
+ private:
+  std::vector<LocalIndex> cells_, renumbered_, points_;  // points: local nodes written, ascending
+  std::vector<FrameColumn> columns_;
+  VtuGrid grid_;
+};
 
 vtkSmartPointer<vtkPolyData> point_poly(const std::vector<double>& points,
                                         const std::vector<FrameField>& point_fields) {
@@ -252,6 +265,16 @@ std::string write_failure(vtkXMLWriter* writer, int system_error) {
   }
 }
 
+// `tmp` renamed to `path` (removed if that fails).
+void rename_into_place(const std::string& tmp, const std::string& path) {
+  std::error_code error;
+  std::filesystem::rename(tmp, path, error);
+  if (error) {
+    remove_partial(tmp);
+    throw IoError("cannot rename " + tmp + " to " + path + ": " + error.message());
+  }
+}
+
 // One-rank frame: `data` to `path` through `<path>.tmp`.
 template <class Writer>
 void write_serial(const std::string& path, vtkDataObject* data) {
@@ -268,12 +291,7 @@ void write_serial(const std::string& path, vtkDataObject* data) {
     remove_partial(tmp);
     throw IoError("cannot write the frame " + path + ": " + reason);
   }
-  std::error_code error;
-  std::filesystem::rename(tmp, path, error);
-  if (error) {
-    remove_partial(tmp);
-    throw IoError("cannot rename " + tmp + " to " + path + ": " + error.message());
-  }
+  rename_into_place(tmp, path);
 }
 
 // VTK's parallel XML writer (vtkXMLPUnstructuredGridWriter, vtkXMLPPolyDataWriter) adapted to
@@ -378,7 +396,10 @@ bool single_rank(int rank, int ranks) {
 
 void write_tet_frame(const std::string& path, const Model& model,
                      const std::vector<std::string>& fields, const std::vector<FrameField>& extra) {
-  write_serial<vtkXMLUnstructuredGridWriter>(path, owned_tet_grid(model, fields, extra));
+  const OwnedTetGrid owned(model, fields, extra);
+  const std::string tmp = path + ".tmp";
+  write_vtu(tmp, owned.grid(), frame_compression_level, "cannot write the frame " + path);
+  rename_into_place(tmp, path);
 }
 
 void write_parallel_tet_frame(const std::string& stem, const Model& model,
@@ -386,8 +407,16 @@ void write_parallel_tet_frame(const std::string& stem, const Model& model,
                               const std::vector<FrameField>& extra, int rank, int ranks) {
   if (single_rank(rank, ranks))
     return write_tet_frame(frame_file_name(stem, "vtu", 1), model, fields, extra);
-  write_piece<vtkXMLPUnstructuredGridWriter>(stem, "vtu", owned_tet_grid(model, fields, extra),
-                                             rank, ranks);
+  const OwnedTetGrid owned(model, fields, extra);
+  const std::string piece = frame_piece_name(stem, "vtu", rank);
+  write_vtu(piece + ".tmp", owned.grid(), frame_compression_level,
+            "cannot write the frame piece " + piece);
+  rename_into_place(piece + ".tmp", piece);
+  if (rank != 0) return;
+  std::vector<std::string> pieces;
+  for (int r = 0; r < ranks; ++r)
+    pieces.push_back(std::filesystem::path(frame_piece_name(stem, "vtu", r)).filename().string());
+  write_file_atomically(frame_file_name(stem, "vtu", ranks), pvtu_summary(owned.grid(), pieces));
 }
 
 void write_point_frame(const std::string& path, const std::vector<double>& points,

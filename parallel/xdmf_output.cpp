@@ -28,9 +28,9 @@ std::string trimmed(const std::string& text) {
 }
 
 // Names, types and shapes of the arrays: every rank must write the same datasets.
-std::string signature(const std::vector<FrameArray>& arrays) {
+std::string signature(const std::vector<FrameColumn>& arrays) {
   std::ostringstream out;
-  for (const FrameArray& a : arrays)
+  for (const FrameColumn& a : arrays)
     out << a.name << '/' << a.per_cell << '/' << a.components << '/' << static_cast<int>(a.type)
         << ';';
   return out.str();
@@ -49,12 +49,11 @@ void check_rows(const XdmfFrameRows& rows) {
         "frame: a ghost node without its owner");
   }
   const std::size_t cells = rows.tet_nodes.size() / 4;
-  for (const FrameArray& a : rows.arrays) {
+  for (const FrameColumn& a : rows.arrays) {
     FDEM_VERIFY(!a.name.empty() && a.name.find('/') == std::string::npos && a.name != "." &&
                     a.name != (a.per_cell ? "connectivity" : "xyz"),
                 "frame array name '" + a.name + "' is empty, has a '/' or is reserved");
-    FDEM_VERIFY(a.components >= 1 && a.values() == (a.per_cell ? cells : owned) *
-                                                       static_cast<std::size_t>(a.components),
+    FDEM_VERIFY(a.components >= 1 && a.rows == (a.per_cell ? cells : owned),
                 "frame array '" + a.name + "' does not have its values for every row");
   }
 }
@@ -175,16 +174,16 @@ void write_file(const Context& ctx, const std::string& tmp_path, double time,
     const auto n = static_cast<hsize_t>(layout.n_nodes);
     Handle nodes = write.group("nodes");
     write.rows(nodes.get(), "xyz", n, 3, rows.node_x, node_runs);
-    for (const FrameArray& a : rows.arrays)
-      if (!a.per_cell) write_array(write, nodes.get(), a, n, node_runs);
+    for (const FrameColumn& a : rows.arrays)  // one array in memory at a time
+      if (!a.per_cell) write_array(write, nodes.get(), a.materialize(), n, node_runs);
   });
   comm.run_collectively([&] {
     const Writer write(ctx, file.get());
     const auto n = static_cast<hsize_t>(layout.n_tets);
     Handle tets = write.group("tets");
     write.rows(tets.get(), "connectivity", n, 4, connectivity, tet_runs);
-    for (const FrameArray& a : rows.arrays)
-      if (a.per_cell) write_array(write, tets.get(), a, n, tet_runs);
+    for (const FrameColumn& a : rows.arrays)
+      if (a.per_cell) write_array(write, tets.get(), a.materialize(), n, tet_runs);
   });
   comm.run_collectively([&] {
     ctx.check_collective_write(H5Fflush(file.get(), H5F_SCOPE_GLOBAL),
@@ -194,16 +193,16 @@ void write_file(const Context& ctx, const std::string& tmp_path, double time,
 }
 
 // The file's size, about: its datasets (bytes per row) and 1 MiB for metadata.
-double estimated_file_bytes(const Layout& layout, const std::vector<FrameArray>& arrays) {
+double estimated_file_bytes(const Layout& layout, const std::vector<FrameColumn>& arrays) {
   double node_row = 3 * 8, tet_row = 4 * 8;  // xyz, connectivity
-  for (const FrameArray& a : arrays)
+  for (const FrameColumn& a : arrays)
     (a.per_cell ? tet_row : node_row) +=
         a.components * (a.type == FrameValue::f64 || a.type == FrameValue::i64 ? 8.0 : 4.0);
   return double(layout.n_nodes) * node_row + double(layout.n_tets) * tet_row + 1048576.0;
 }
 
 FrameFileInfo frame_info(const std::string& file, double time, const Layout& layout,
-                         const std::vector<FrameArray>& arrays) {
+                         const std::vector<FrameColumn>& arrays) {
   using Role = FrameDataset::Role;
   FrameFileInfo info;
   info.file = file;
@@ -213,7 +212,7 @@ FrameFileInfo frame_info(const std::string& file, double time, const Layout& lay
   info.datasets.push_back({Role::geometry, "", "/nodes/xyz", layout.n_nodes, 3, FrameValue::f64});
   info.datasets.push_back(
       {Role::topology, "", "/tets/connectivity", layout.n_tets, 4, FrameValue::i64});
-  for (const FrameArray& a : arrays)
+  for (const FrameColumn& a : arrays)
     info.datasets.push_back({a.per_cell ? Role::cell : Role::point, a.name,
                              (a.per_cell ? "/tets/" : "/nodes/") + a.name,
                              a.per_cell ? layout.n_tets : layout.n_nodes, a.components, a.type});

@@ -49,7 +49,7 @@ struct XdmfFrameRows {
   std::vector<std::int32_t> node_owner;  // per local node: its owner's rank (read for ghosts)
   std::vector<double> node_x;            // 3 per owned node (m)
   std::vector<LocalIndex> tet_nodes;     // 4 per written (owned) tet: local node indices
-  std::vector<FrameArray> arrays;        // per_cell: per written tet; else per owned node
+  std::vector<FrameColumn> arrays;       // per_cell: per written tet; else per owned node
 };
 
 // Collective.  Writes `directory/file` (file relative to the series directory, e.g.

@@ -3,7 +3,7 @@
 # python3-matplotlib: scripts/plot.py (and its test).
 set -euo pipefail
 packages=(g++ make cmake libeigen3-dev libopenmpi-dev openmpi-bin libmetis-dev libhdf5-openmpi-dev
-          libvtk9-dev catch2 libyaml-cpp-dev libtrilinos-zoltan-dev python3-matplotlib)
+          libvtk9-dev zlib1g-dev catch2 libyaml-cpp-dev libtrilinos-zoltan-dev python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

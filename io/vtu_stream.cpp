@@ -1,0 +1,204 @@
+#include "io/vtu_stream.hpp"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace fdem {
+
+namespace {
+
+// Uncompressed bytes per zlib block, as VTK's writer (a block is a whole number of tuples here,
+// which the format allows: the block size is in each array's header).
+constexpr std::size_t block_target_bytes = 32768;
+constexpr int offset_width = 20;  // digits reserved for an offset (VTK pads the same way)
+constexpr unsigned char vtk_tetra = 10;
+
+class VtuFile {
+ public:
+  VtuFile(const std::string& path, std::string what) : path_(path), what_(std::move(what)) {
+    errno = 0;
+    file_ = std::fopen(path.c_str(), "wb");
+    if (!file_) fail();
+  }
+  ~VtuFile() {
+    if (file_) std::fclose(file_);
+  }
+  VtuFile(const VtuFile&) = delete;
+  VtuFile& operator=(const VtuFile&) = delete;
+
+  [[noreturn]] void fail() {
+    const std::string reason = errno != 0 ? std::strerror(errno) : "disk full or no permission?";
+    if (file_) std::fclose(file_);
+    file_ = nullptr;
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+    throw IoError(what_ + ": " + reason);
+  }
+  void write(const void* data, std::size_t bytes) {
+    if (bytes != 0 && std::fwrite(data, 1, bytes, file_) != bytes) fail();
+  }
+  void write(const std::string& text) { write(text.data(), text.size()); }
+  std::int64_t tell() {
+    const auto at = ftello(file_);
+    if (at < 0) fail();
+    return static_cast<std::int64_t>(at);
+  }
+  void seek(std::int64_t at) {
+    if (fseeko(file_, static_cast<off_t>(at), SEEK_SET) != 0) fail();
+  }
+  void close() {
+    const bool failed = std::fflush(file_) != 0 || std::ferror(file_) != 0;
+    const bool closed = std::fclose(file_) == 0;
+    file_ = nullptr;
+    if (failed || !closed) fail();
+  }
+
+ private:
+  std::string path_, what_;
+  std::FILE* file_ = nullptr;
+};
+
+// The XML of one DataArray with a padded offset placeholder; `at` receives the placeholder's
+// position in the file.
+void data_array_xml(VtuFile& file, const VtuArray& a, bool show_components, std::int64_t& at,
+                    const char* indent) {
+  std::ostringstream xml;
+  xml << indent << "<DataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
+  if (show_components && a.components != 1) xml << " NumberOfComponents=\"" << a.components << "\"";
+  xml << " format=\"appended\" offset=\"";
+  file.write(xml.str());
+  at = file.tell();
+  file.write(std::string(offset_width, ' ') + "\"/>\n");
+}
+
+// The array's tuples as zlib blocks after a UInt64 header [blocks, block bytes, bytes of a partial
+// last block (0: the last is whole), compressed size of each block], as VTK's zlib compressor.
+void write_compressed(VtuFile& file, const VtuArray& a, int level) {
+  const std::size_t tuple_bytes = vtu_value_bytes(a.type) * static_cast<std::size_t>(a.components);
+  const std::size_t tuples_per_block = std::max<std::size_t>(1, block_target_bytes / tuple_bytes);
+  const std::size_t block_bytes = tuples_per_block * tuple_bytes;
+  const std::size_t blocks = (a.tuples + tuples_per_block - 1) / tuples_per_block;
+  std::vector<std::uint64_t> header(3 + blocks, 0);
+  header[0] = blocks;
+  header[1] = block_bytes;
+  header[2] = (a.tuples % tuples_per_block) * tuple_bytes;
+  const std::int64_t header_at = file.tell();
+  file.write(header.data(), header.size() * sizeof(std::uint64_t));
+
+  std::vector<unsigned char> raw(block_bytes), packed(compressBound(block_bytes));
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t first = b * tuples_per_block;
+    const std::size_t count = std::min(tuples_per_block, a.tuples - first);
+    a.fill(first, count, raw.data());
+    uLongf packed_bytes = static_cast<uLongf>(packed.size());
+    const int status = compress2(packed.data(), &packed_bytes, raw.data(),
+                                 static_cast<uLong>(count * tuple_bytes), level);
+    FDEM_VERIFY(status == Z_OK, "zlib compress2 of a frame block");
+    file.write(packed.data(), packed_bytes);
+    header[3 + b] = packed_bytes;
+  }
+  const std::int64_t end = file.tell();
+  file.seek(header_at);
+  file.write(header.data(), header.size() * sizeof(std::uint64_t));
+  file.seek(end);
+}
+
+}  // namespace
+
+std::size_t vtu_value_bytes(const char* type) {
+  const std::string t = type;
+  if (t == "Float64" || t == "Int64") return 8;
+  if (t == "Int32") return 4;
+  FDEM_VERIFY(t == "UInt8", "vtu value type");
+  return 1;
+}
+
+void write_vtu(const std::string& path, const VtuGrid& grid, int level, const std::string& what) {
+  FDEM_VERIFY(grid.positions.tuples == grid.points && grid.tet_corners.tuples == grid.cells,
+              "vtu grid sizes");
+  const VtuArray offsets{"offsets", "Int64", 1, grid.cells,
+                         [](std::size_t first, std::size_t count, unsigned char* out) {
+                           for (std::size_t c = 0; c < count; ++c) {
+                             const std::int64_t end = 4 * static_cast<std::int64_t>(first + c + 1);
+                             std::memcpy(out + 8 * c, &end, 8);
+                           }
+                         }};
+  const VtuArray types{"types", "UInt8", 1, grid.cells,
+                       [](std::size_t, std::size_t count, unsigned char* out) {
+                         std::fill_n(out, count, vtk_tetra);
+                       }};
+  VtuArray connectivity = grid.tet_corners;
+  connectivity.name = "connectivity";
+
+  VtuFile file(path, what);
+  std::ostringstream head;
+  head << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+          "byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+          "compressor=\"vtkZLibDataCompressor\">\n  <UnstructuredGrid>\n"
+       << "    <Piece NumberOfPoints=\"" << grid.points << "\" NumberOfCells=\"" << grid.cells
+       << "\">\n      <PointData>\n";
+  file.write(head.str());
+  // Arrays in the order of the XML, each with the position of its offset placeholder.
+  std::vector<std::pair<const VtuArray*, std::int64_t>> order;
+  const auto declare = [&](const VtuArray& a, bool show_components, const char* indent) {
+    order.emplace_back(&a, 0);
+    data_array_xml(file, a, show_components, order.back().second, indent);
+  };
+  for (const VtuArray& a : grid.point_data) declare(a, true, "        ");
+  file.write("      </PointData>\n      <CellData>\n");
+  for (const VtuArray& a : grid.cell_data) declare(a, true, "        ");
+  file.write("      </CellData>\n      <Points>\n");
+  declare(grid.positions, true, "        ");
+  file.write("      </Points>\n      <Cells>\n");
+  declare(connectivity, false, "        ");
+  declare(offsets, false, "        ");
+  declare(types, false, "        ");
+  file.write(
+      "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n"
+      "   _");
+  const std::int64_t data_start = file.tell();
+  std::vector<std::int64_t> offsets_in_data;
+  for (const auto& [array, placeholder] : order) {
+    offsets_in_data.push_back(file.tell() - data_start);
+    write_compressed(file, *array, level);
+  }
+  file.write("\n  </AppendedData>\n</VTKFile>\n");
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    file.seek(order[i].second);
+    file.write(std::to_string(offsets_in_data[i]));
+  }
+  file.close();
+}
+
+std::string pvtu_summary(const VtuGrid& grid, const std::vector<std::string>& pieces) {
+  std::ostringstream xml;
+  xml << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\" "
+         "byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+         "compressor=\"vtkZLibDataCompressor\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n";
+  const auto declare = [&](const VtuArray& a) {
+    xml << "      <PDataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
+    if (a.components != 1) xml << " NumberOfComponents=\"" << a.components << "\"";
+    xml << "/>\n";
+  };
+  xml << "    <PPointData>\n";
+  for (const VtuArray& a : grid.point_data) declare(a);
+  xml << "    </PPointData>\n    <PCellData>\n";
+  for (const VtuArray& a : grid.cell_data) declare(a);
+  xml << "    </PCellData>\n    <PPoints>\n";
+  declare(grid.positions);
+  xml << "    </PPoints>\n";
+  for (const std::string& piece : pieces) xml << "    <Piece Source=\"" << piece << "\"/>\n";
+  xml << "  </PUnstructuredGrid>\n</VTKFile>\n";
+  return xml.str();
+}
+
+}  // namespace fdem
