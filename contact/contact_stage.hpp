@@ -161,6 +161,7 @@ class ContactStage {
  private:
   static bool piece_fixed(const Model& model, std::int32_t piece);
   void compute_boxes(const Model& model, const double* x);
+  void release_boxes();  // the boxes of a detection, freed once it is done
   ContactWork work_against(const Model& model, double dt) const;
   void run_detection(const Model& model, const double* x);
   bool keeps(const Model& model, const double* x, LocalIndex a, LocalIndex b) const;

@@ -158,6 +158,13 @@ void ContactStage::run_detection(const Model& model, const double* x) {
   const auto keep = [&](LocalIndex a, LocalIndex b) { return keeps(model, x, a, b); };
   detector_.detect(lo_.data(), hi_.data(), model.tets.size(), buffer_, pairs_, keep);
   may_hold_friction_.assign(pairs_.size(), 1);
+  release_boxes();
+}
+
+void ContactStage::release_boxes() {
+  lo_ = {};
+  hi_ = {};
+  detector_.release_boxes();
 }
 
 // The pairs a detection at the positions of the last one would add after the eligibility of the
@@ -199,6 +206,7 @@ void ContactStage::add_pairs_of(const Model& model, const std::vector<LocalIndex
   std::inplace_merge(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(old_size),
                      pairs_.end());
   may_hold_friction_.assign(pairs_.size(), 1);
+  release_boxes();
 }
 
 void ContactStage::set_bonds(LocalIndex n_tets,

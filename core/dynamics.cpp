@@ -165,6 +165,12 @@ inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, std::uint
     const bool prescribed = constrained && (mask & (1u << k));
     const double v_old = nodes.v[i];
     double v_new = v_old + dt * nodes.f[i] / m;
+    if (damped) {  // quasi-static runs: the forces of the unbalanced-force ratio
+      if (prescribed)
+        out.support_force += std::abs(nodes.f[i]);
+      else
+        out.unbalanced_force += std::abs(nodes.f[i]);
+    }
     if (damped && !prescribed && v_old != 0.0) {
       // The damping force opposes v⁻; v⁻ = 0 (a node at rest) gets none.
       const double f_damping = -local_damping * std::abs(nodes.f[i]) * (v_old > 0 ? 1.0 : -1.0);
@@ -173,7 +179,7 @@ inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, std::uint
       sum.damping_power_new += f_damping * v_new;
     }
     if (prescribed) {
-      v_new = nodes.prescribed_velocity[i];
+      v_new = nodes.prescribed_velocity_at(i);
       const double reaction = m * (v_new - v_old) / dt - nodes.f[i];
       out.constraint_work_before += 0.5 * reaction * dt * v_old;
       out.constraint_work_after += 0.5 * reaction * dt * v_new;
@@ -188,6 +194,7 @@ inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, std::uint
     dx2 += dx * dx;
   }
   sum.max_dx2 = std::max(sum.max_dx2, dx2);
+  if (damped) out.mass += m;
 }
 
 template <bool damped>

@@ -52,6 +52,10 @@ struct IntegrationSummary {
   Vec3 momentum_after = Vec3::Zero();      // Σ m·v_n+½
   double local_damping_work_before = 0.0;  // J, local damping forces · (x_n − x_n−1)/2 (≤ 0)
   double local_damping_work_after = 0.0;   // J, local damping forces · (x_n+1 − x_n)/2
+  // With local damping only (the quasi-static mode's equilibrium test), over the owned nodes: the
+  // unbalanced force Σ|f_k| over free components, the supports' Σ|f_k| over prescribed ones (N),
+  // and the mass (kg).
+  double unbalanced_force = 0.0, support_force = 0.0, mass = 0.0;
   double max_displacement_increment = 0.0;  // m, largest |Δx| of a node this step
   bool finite = true;                       // false if any velocity became NaN or infinite
 };

@@ -130,7 +130,7 @@ inline const std::array<Field<NodeArrays>, 8> node_fields = {{
     {"piece", &NodeArrays::piece, 1, FieldUse::migrates},
     {"constrained", &NodeArrays::constrained, 1, FieldUse::migrates},
     {"prescribed_velocity", &NodeArrays::prescribed_velocity, 3,
-     FieldUse::migrates | FieldUse::checkpoint},
+     FieldUse::migrates | FieldUse::checkpoint, 0.0, true},  // absent: NodeArrays says when
 }};
 
 // Tets (besides gid, nodes, n_owned and the roles owned / active, which the distribution sets,

@@ -37,7 +37,7 @@ void add_load_sums(const LoadSpec& load, const Model& model, double dt, GroupSum
       const std::size_t i = 3 * static_cast<std::size_t>(n) + k;
       // As integrate_central_difference books it: the impulse that sets the prescribed
       // velocity, less the forces the model puts on the node.
-      sums.force[k].add(nodes.mass[n] * (nodes.prescribed_velocity[i] - nodes.v[i]) / dt -
+      sums.force[k].add(nodes.mass[n] * (nodes.prescribed_velocity_at(i) - nodes.v[i]) / dt -
                         nodes.f[i]);
     }
   }

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <set>
 #include <numeric>
 #include <sstream>
 
@@ -223,6 +224,10 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
         throw InputError(no_touching_pieces_message(scene, b, meshes[b].source));
     }
     if (!jointed) continue;
+    std::size_t interior = 0;  // faces shared by two tets: one joint each (reserved: no slack)
+    for (std::size_t i = 0; i + 1 < f.size(); ++i)
+      if (f[i].key == f[i + 1].key) ++interior, ++i;
+    drafts.reserve(drafts.size() + interior);
     std::vector<std::uint8_t> on_boundary(meshes[b].coords.size() / 3, 0);  // per mesh node
     for (std::size_t i = 0; i < f.size(); ++i)
       if (i + 1 < f.size() && f[i].key == f[i + 1].key) {
@@ -304,6 +309,8 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     if (drafts.size() == before) throw InputError(no_interface_match_message(scene, k, tol));
   }
 
+  faces = {};  // the joints are drafted: the face lists go before the joint arrays come
+
   // Canonical order: ascending (gid A, gid B); a joint's gid is its rank in it.
   std::vector<std::size_t> order(drafts.size());
   std::iota(order.begin(), order.end(), 0);
@@ -314,7 +321,15 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
   // Laws: one per (group, element-size bin, strength bin) in use, numbered in ascending key.
   JointArrays& joints = model.joints;
   joints.resize(local_count(drafts.size(), "joints"));
-  std::vector<JointLawKey> law_key(drafts.size());
+  // A joint's law key, from its tets and area (computed twice rather than stored per joint).
+  const auto law_key = [&](std::size_t j) {
+    return JointLawKey{drafts[order[j]].group,
+                       joint_size_bin(tets.volume0[joints.tets[2 * j]],
+                                      tets.volume0[joints.tets[2 * j + 1]], joints.area0[j]),
+                       joint_strength_bin(scene, drafts[order[j]].group, joints.gid[j],
+                                          model.gid_offset)};
+  };
+  std::set<JointLawKey> used;
   const double* x0 = nodes.x0.data();
   for (std::size_t j = 0; j < order.size(); ++j) {
     const JointDraft& d = drafts[order[j]];
@@ -327,17 +342,13 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     joints.tets[2 * j + 1] = d.tet_b;
     joints.area0[j] =
         joint_face_area(vec3_at(x0, d.a[0]), vec3_at(x0, d.a[1]), vec3_at(x0, d.a[2]));
-    law_key[j] = {d.group,
-                  joint_size_bin(tets.volume0[d.tet_a], tets.volume0[d.tet_b], joints.area0[j]),
-                  joint_strength_bin(scene, d.group, joints.gid[j], model.gid_offset)};
+    used.insert(law_key(j));
   }
-  std::vector<JointLawKey> keys = law_key;
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  const std::vector<JointLawKey> keys(used.begin(), used.end());  // ascending
   for (const JointLawKey& key : keys) model.joint_laws.push_back(joint_law(scene, key));
   for (std::size_t j = 0; j < order.size(); ++j)
     joints.law[j] = static_cast<std::int32_t>(
-        std::lower_bound(keys.begin(), keys.end(), law_key[j]) - keys.begin());
+        std::lower_bound(keys.begin(), keys.end(), law_key(j)) - keys.begin());
 }
 
 double matching_tolerance(const Vec3& extent) {

@@ -24,6 +24,7 @@ namespace {
 using AnyArray = std::vector<double>;
 struct NodeArraysShape {
   LocalIndex n_owned;
+  bool has_prescribed_velocity;
   std::vector<GlobalId> gid;
   AnyArray fields[std::tuple_size_v<decltype(node_fields)>];
 };
@@ -46,6 +47,10 @@ static_assert(sizeof(JointArrays) == sizeof(JointArraysShape), "joint field with
 
 void NodeArrays::resize(LocalIndex n) {
   resize_exact(gid, static_cast<std::size_t>(n));
+  if (has_prescribed_velocity)
+    resize_exact(prescribed_velocity, 3 * static_cast<std::size_t>(n), 0.0);
+  else
+    prescribed_velocity = {};
   for (const auto& field : node_fields) field.resize(*this, static_cast<std::size_t>(n));
 }
 

@@ -24,6 +24,11 @@ void resize_exact(std::vector<T>& values, std::size_t n, const Fill&... fill) {
 // Nodes.  Vector quantities are stored xyz-interleaved (3 doubles per node) in separate arrays.
 struct NodeArrays {
   LocalIndex n_owned = 0;  // entries [0, n_owned) are integrated here; the rest are halo copies
+  // False when no node moves at a prescribed nonzero velocity (the scene has no velocity or
+  // base-motion load): `prescribed_velocity` then stays empty and constrained components are held
+  // at rest, 24 bytes per node saved.  Set by the builders from the scene, the same on every
+  // rank; resize() allocates the array only when true.
+  bool has_prescribed_velocity = true;
   std::vector<GlobalId> gid;
   std::vector<double> x;                    // current position (m)
   std::vector<double> x0;                   // reference position (m)
@@ -32,10 +37,20 @@ struct NodeArrays {
   std::vector<double> mass;                 // lumped mass (kg)
   std::vector<std::int32_t> piece;          // discrete element (connected piece at t = 0) index
   std::vector<std::uint8_t> constrained;    // bit k: velocity component k is prescribed
-  std::vector<double> prescribed_velocity;  // 3 per node (m/s), used where constrained
+  std::vector<double> prescribed_velocity;  // 3 per node (m/s), used where constrained; see above
 
   LocalIndex size() const { return static_cast<LocalIndex>(gid.size()); }
   void resize(LocalIndex n);
+  // Component i (3 per node) of the prescribed velocity: 0 without the array.
+  double prescribed_velocity_at(std::size_t i) const {
+    return prescribed_velocity.empty() ? 0.0 : prescribed_velocity[i];
+  }
+  // The array allocated (zeros) if absent: for drivers that set velocities themselves on one rank
+  // (tests driving a body).
+  void keep_prescribed_velocities() {
+    has_prescribed_velocity = true;
+    if (prescribed_velocity.empty()) prescribed_velocity.assign(3 * gid.size(), 0.0);
+  }
   // Local index of the node with global id `gid` (the owned and the ghost range are each in
   // ascending gid), or −1 when it is not held here.
   LocalIndex find(GlobalId gid) const;

@@ -218,6 +218,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
   const LocalIndex n_all_nodes = node_offset.back();
   std::vector<LocalIndex> new_node(n_all_nodes, -1);
   std::vector<LocalIndex> node_source;  // old (body-offset) node of each model node
+  node_source.reserve(all_nodes);
   std::vector<LocalIndex> tet_node(4 * records.size());
   LocalIndex n_nodes = 0;
   for (std::size_t t = 0; t < records.size(); ++t) {
@@ -243,6 +244,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
       node_body[i] = static_cast<std::int32_t>(b);
 
   NodeArrays& nodes = model.nodes;
+  nodes.has_prescribed_velocity = scene.prescribes_velocities();
   nodes.resize(n_nodes);
   nodes.n_owned = n_nodes;
   std::fill(nodes.v.begin(), nodes.v.end(), 0.0);
@@ -308,11 +310,13 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
 
 void apply_constraints(const Scene& scene, Model& model) {
   NodeArrays& nodes = model.nodes;
+  FDEM_VERIFY(nodes.has_prescribed_velocity || !scene.prescribes_velocities(),
+              "a scene with velocity loads keeps the prescribed velocities");
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
     const std::int32_t body = model.pieces.body_of(nodes.piece[n]);
     if (scene.bodies[body].fixed) {
       nodes.constrained[n] = 7;
-      vec3_at(nodes.prescribed_velocity.data(), n).setZero();
+      if (nodes.has_prescribed_velocity) vec3_at(nodes.prescribed_velocity.data(), n).setZero();
       vec3_at(nodes.v.data(), n).setZero();
     }
   }

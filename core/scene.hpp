@@ -287,6 +287,10 @@ struct ParallelSpec {
 struct QuasiStaticSpec {
   double local_damping = 0.0;  // α in [0, 1): the unbalanced force is damped by α·|f|; 0: off
   double until = HUGE_VAL;     // s: dynamic (undamped) from this time on, e.g. after settling
+  // > 0: the run ends at the first step (while damped) whose mean unbalanced force is below this
+  // fraction of the weight and support forces: Σ|f| over free components / (Σm·|g| + Σ|f| over
+  // prescribed ones).  0: runs to time.end.
+  double equilibrium_ratio = 0.0;
   bool active_at(double t) const { return local_damping > 0.0 && t < until; }
   bool active_until(double end) const { return local_damping > 0.0 && until >= end; }  // whole run
 };
@@ -317,6 +321,15 @@ struct Scene {
   double contact_friction_anchor_lag = 0.05;  // s, contact.friction_anchor_lag
   ParallelSpec parallel;
   LimitsSpec limits;
+
+  // True when a load moves nodes at a prescribed velocity (velocity or base-motion loads); fixed
+  // bodies alone hold their nodes at rest and need no stored velocities.
+  bool prescribes_velocities() const {
+    for (const LoadSpec& load : loads)
+      if (load.kind == LoadSpec::Kind::velocity || load.kind == LoadSpec::Kind::base_motion)
+        return true;
+    return false;
+  }
 };
 
 }  // namespace fdem

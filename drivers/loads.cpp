@@ -80,6 +80,8 @@ LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
 }
 
 void LoadSchedule::rebind(const Model& model) {
+  FDEM_VERIFY((bases_.empty() && varying_.empty()) || model.nodes.has_prescribed_velocity,
+              "velocity loads need the nodes' prescribed velocities");
   for (Surface& surface : surfaces_) surface.faces = select_surface_faces(model, surface.load);
   if (!varying_.empty()) {
     // Which load sets each prescribed component: the last in scene order that holds the node, as

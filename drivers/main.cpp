@@ -218,6 +218,8 @@ int run_command(int argc, char** argv, const fdem::Communicator& world) {
                      options.output_dir.c_str());
       return report.io_failure ? exit_io_failure : exit_numerical_failure;
     }
+    if (!options.quiet && world.rank() == 0 && !report.reason.empty())
+      std::fprintf(stderr, "fdem: %s\n", report.reason.c_str());  // e.g. ended at equilibrium
     if (!options.quiet)
       std::fprintf(stderr, "results in %s (open frames.pvd in ParaView)\n",
                    options.output_dir.c_str());

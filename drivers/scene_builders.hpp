@@ -114,6 +114,7 @@ inline Vec3 reaction_on_body(const Model& model, int body) {
 // New prescribed velocity of a body's nodes.  The integrator applies it in the next step and books
 // the kinetic energy change as the reactions' work (that step's reaction holds the impulse).
 inline void set_body_velocity(Model& model, int body, const Vec3& v) {
+  model.nodes.keep_prescribed_velocities();
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
     if (model.pieces.body_of(model.nodes.piece[n]) == body)
       vec3_at(model.nodes.prescribed_velocity.data(), n) = v;

@@ -434,16 +434,28 @@ RunReport Simulation::run() {
   ProgressReport progress(options_.quiet || !is_root(), ProgressReport::stderr_is_terminal());
   try {
     write_outputs(true);
-    while (steps_ < total_steps && interrupt_ == 0) {
+    const double ratio = scene_.quasi_static.equilibrium_ratio;
+    bool equilibrium = false;
+    while (steps_ < total_steps && interrupt_ == 0 && !equilibrium) {
       step();
-      write_outputs(steps_ == total_steps);
+      equilibrium = ratio > 0.0 && force_ratio_ < ratio;  // NaN (undamped): no
+      write_outputs(steps_ == total_steps || equilibrium);
       const double wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
       progress.after_step({steps_, total_steps, time_, dt_, ledger_.balance_error(), wall},
-                          steps_ == total_steps);
+                          steps_ == total_steps || equilibrium);
     }
     mark_phase(CommPhase::finish);
-    if (steps_ < total_steps) {
+    if (equilibrium) {
+      progress.end_line();
+      result = report();
+      result.status = "completed";
+      std::ostringstream reason;
+      reason << "equilibrium at step " << steps_ << " (t = " << time_
+             << " s): unbalanced force ratio " << force_ratio_
+             << " < quasi_static.equilibrium_ratio " << ratio;
+      result.reason = reason.str();
+    } else if (steps_ < total_steps) {
       progress.end_line();
       finish_interrupted(result);
     } else {

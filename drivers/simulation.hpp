@@ -75,6 +75,9 @@ class Simulation {
 
   const Model& model() const { return model_; }
   double initial_equilibrium_residual() const { return initial_residual_; }
+  // The last step's mean unbalanced-force ratio (quasi_static.equilibrium_ratio); NaN when the
+  // step was not damped.
+  double unbalanced_force_ratio() const { return force_ratio_; }
   Model& model() { return model_; }
   const Scene& scene() const { return scene_; }
   const StagePlan& plan() const { return plan_; }
@@ -159,6 +162,7 @@ class Simulation {
   double energy_floor_ = 0.0;       // J, see the constructor
   double energy_input_ = 0.0;       // J, largest energy put in so far (see check_state)
   double kinetic_half_step_ = 0.0;  // J, ½m|v_n+½|² of the last step
+  double force_ratio_ = 0.0;        // unbalanced-force ratio of the last step (NaN: undamped)
   StageClock clocks_[n_stages];
   std::chrono::steady_clock::time_point wall_start_;
   double next_frame_time_ = 0.0, next_energy_time_ = 0.0;

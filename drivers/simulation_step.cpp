@@ -260,7 +260,7 @@ void Simulation::sum_over_ranks(StepRecord& r) {
   r.flags.inverted_tet = r.forces.min_jacobian > 0.0 ? 0.0 : 1.0;
   r.flags.interrupted = interrupt_signal() != 0 ? 1.0 : 0.0;
   const auto start = std::chrono::steady_clock::now();
-  const std::array<double*, 33> values = summed_values(r);
+  const auto values = summed_values(r);
   reduced_.resize(values.size());  // kept: no allocation per step
   for (std::size_t i = 0; i < values.size(); ++i) reduced_[i] = *values[i];
   domain_->sum(reduced_);
@@ -273,6 +273,11 @@ void Simulation::sum_over_ranks(StepRecord& r) {
   bodies_cracking_ = r.flags.bodies_cracked > 0.0;
   // A signal on any rank ends the run after this step on every rank.
   if (r.flags.interrupted > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
+  // Quasi-static runs: the mean unbalanced force over the applied ones (weight and supports), the
+  // equilibrium test of quasi_static.equilibrium_ratio (FLAC's and 3DEC's "ratio", averaged).
+  const double applied = r.motion.mass * model_.gravity.norm() + r.motion.support_force;
+  force_ratio_ = r.motion.mass > 0.0 && applied > 0.0 ? r.motion.unbalanced_force / applied
+                                                      : std::numeric_limits<double>::quiet_NaN();
 }
 
 // The energy balance at t_n from the reduced terms.

@@ -39,7 +39,7 @@ struct StepRecord {
 };
 
 // Every value of a StepRecord that the step sums over the ranks, each listed once.
-inline std::array<double*, 33> summed_values(StepRecord& r) {
+inline std::array<double*, 36> summed_values(StepRecord& r) {
   double* p_before = r.motion.momentum_before.data();
   double* p_after = r.motion.momentum_after.data();
   StepFlags& f = r.flags;
@@ -60,6 +60,9 @@ inline std::array<double*, 33> summed_values(StepRecord& r) {
           &r.motion.constraint_work_after,
           &r.motion.local_damping_work_before,
           &r.motion.local_damping_work_after,
+          &r.motion.unbalanced_force,
+          &r.motion.support_force,
+          &r.motion.mass,
           p_before,
           p_before + 1,
           p_before + 2,

@@ -81,7 +81,8 @@ std::vector<InitialStressSpec> read_initial_stress(const Reader& r, const YAML::
 }
 
 QuasiStaticSpec read_quasi_static(const Reader& r, const YAML::Node& node) {
-  r.check_keys(node, "quasi_static", {"local_damping", "until"}, {"local_damping"});
+  r.check_keys(node, "quasi_static", {"local_damping", "until", "equilibrium_ratio"},
+               {"local_damping"});
   QuasiStaticSpec spec;
   spec.local_damping = r.number(node["local_damping"], "quasi_static.local_damping");
   if (!(spec.local_damping > 0.0 && spec.local_damping < 1.0))
@@ -91,6 +92,13 @@ QuasiStaticSpec read_quasi_static(const Reader& r, const YAML::Node& node) {
   if (node["until"])
     spec.until = r.positive(node["until"], "quasi_static.until",
                             "time (s) after which the run is dynamic again");
+  if (node["equilibrium_ratio"]) {
+    spec.equilibrium_ratio = r.number(node["equilibrium_ratio"], "quasi_static.equilibrium_ratio");
+    if (!(spec.equilibrium_ratio > 0.0 && spec.equilibrium_ratio < 1.0))
+      r.fail(node["equilibrium_ratio"], "quasi_static.equilibrium_ratio",
+             "must be in (0, 1): the run ends at equilibrium, when the mean unbalanced force "
+             "falls below this fraction of the weight and support forces (1e-4 to 1e-6 are usual)");
+  }
   return spec;
 }
 

@@ -37,6 +37,12 @@ void append_entry(const std::array<Field<Arrays>, N>& table, const Arrays& array
     field.apply(arrays, [&](const auto& values) {
       auto& out = std::get<std::decay_t<decltype(values)>>(column->values);
       const std::size_t width = column->components;
+      if (values.empty() && field.optional) {  // absent: its fill (or fallback) values
+        out.resize(out.size() + width);
+        field.copy_out(arrays, entry,
+                       reinterpret_cast<unsigned char*>(out.data() + out.size() - width));
+        return;
+      }
       out.insert(out.end(), values.begin() + static_cast<std::ptrdiff_t>(entry * width),
                  values.begin() + static_cast<std::ptrdiff_t>((entry + 1) * width));
     });

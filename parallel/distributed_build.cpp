@@ -433,6 +433,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   });
   NodeArrays& nodes = model.nodes;
   const LocalIndex n_local = local_count(local_nodes.size(), "nodes");
+  nodes.has_prescribed_velocity = scene.prescribes_velocities();
   nodes.resize(n_local);
   nodes.n_owned = 0;
   out.node_first_tet.resize(static_cast<std::size_t>(n_local));

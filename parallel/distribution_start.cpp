@@ -66,6 +66,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
     local.gravity = start.model.gravity;
     local.joint_laws = start.model.joint_laws;
     local.gid_offset = start.model.gid_offset;
+    local.nodes.has_prescribed_velocity = start.model.nodes.has_prescribed_velocity;
     migrate(start.model, state, local, local_state, &start.joints, &start.tet_reach);
   }
   record_holders(local);

@@ -52,6 +52,7 @@ inline void check_block_is_serial_model(const DistributedModel& block, const Mod
                          serial.nodes.gid[serial.tets.nodes[4 * g + c]];
     tet_mismatches += !same;
   }
+  CHECK(local.nodes.has_prescribed_velocity == serial.nodes.has_prescribed_velocity);
   for (LocalIndex n = 0; n < local.nodes.size(); ++n) {
     const auto g = static_cast<std::size_t>(local.nodes.gid[n] - offset);
     if (local.nodes.gid[n] < offset || g >= static_cast<std::size_t>(serial.nodes.size())) {
@@ -66,8 +67,8 @@ inline void check_block_is_serial_model(const DistributedModel& block, const Mod
       same = same && same_bits(local.nodes.x0[3 * n + k], serial.nodes.x0[3 * g + k]) &&
              same_bits(local.nodes.x[3 * n + k], serial.nodes.x[3 * g + k]) &&
              same_bits(local.nodes.v[3 * n + k], serial.nodes.v[3 * g + k]) &&
-             same_bits(local.nodes.prescribed_velocity[3 * n + k],
-                       serial.nodes.prescribed_velocity[3 * g + k]);
+             same_bits(local.nodes.prescribed_velocity_at(3 * n + k),
+                       serial.nodes.prescribed_velocity_at(3 * g + k));
     // Owned nodes: their first tet is in this block; the owner table says so.
     same = same && (n < local.nodes.n_owned) == (block.node_owner[n] == comm.rank()) &&
            block.node_first_tet[n] >= offset;

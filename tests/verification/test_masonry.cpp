@@ -209,6 +209,7 @@ namespace {
 
 // Nodes of one piece: prescribed velocity v (all components).
 void drive_piece(Model& model, std::int32_t piece, const Vec3& v) {
+  model.nodes.keep_prescribed_velocities();
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
     if (model.nodes.piece[n] == piece) {
       model.nodes.constrained[n] = 7;

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include "scene_helpers.hpp"
 
@@ -143,6 +144,42 @@ Scene settled(Scene scene, double settle) {
 }
 
 }  // namespace
+
+TEST_CASE(
+    "quasi_static.equilibrium_ratio: a settling block ends the run at equilibrium, at rest "
+    "under its weight, and a block on a slope steeper than its friction runs to the end",
+    "[verification][quasi_static]") {
+  // incline()'s 0.4 m block (E = 0.1 GPa, μ = 0.5) under local damping 0.8 from the start, on a
+  // level base, then on a 30° slope (tan 30° = 0.577 > μ: it slides).
+  const auto run = [](double angle, double ratio) {
+    Scene scene = incline(angle, 0.5, 0.5);
+    scene.quasi_static.local_damping = 0.8;
+    scene.quasi_static.equilibrium_ratio = ratio;
+    auto sim = quiet_simulation(scene);
+    const RunReport report = sim->run();
+    const double mass = 2400 * 0.4 * 0.4 * 0.3;
+    return std::make_tuple(report, sim->time(), sim->unbalanced_force_ratio(),
+                           sim->energy().current().kinetic / (mass * g * 0.3));
+  };
+  const auto [level, level_time, level_ratio, level_kinetic] = run(0.0, 1e-5);
+  INFO("level: " << level.reason << "; kinetic energy " << level_kinetic << " m g h");
+  CHECK(level.status == "completed");
+  CHECK_THAT(level.reason, Catch::Matchers::Contains("equilibrium at step"));
+  CHECK(level_time < 0.25);  // it settles in a fraction of the 0.5 s allowed
+  CHECK(level_ratio < 1e-5);
+  CHECK(level_kinetic < 1e-9);
+  // A tighter ratio costs more steps, a looser one fewer.
+  const auto [loose, loose_time, loose_ratio, loose_kinetic] = run(0.0, 1e-3);
+  CHECK(loose_time < level_time);
+  CHECK(loose_ratio < 1e-3);
+
+  const auto [slope, slope_time, slope_ratio, slope_kinetic] = run(30 * deg, 1e-5);
+  INFO("slope: " << slope.reason << "; unbalanced force ratio at the end " << slope_ratio);
+  CHECK(slope.status == "completed");
+  CHECK(slope.reason.empty());
+  CHECK(slope_time == Approx(0.5).margin(1e-9));
+  CHECK(slope_ratio > 1e-2);  // the sliding block's driving force, damped to (1 − α)
+}
 
 TEST_CASE("static friction holds at τ/μσ = 0.95 for 2 s after settling, a sudden load slides",
           "[verification][quasi_static][long]") {

@@ -13,6 +13,7 @@ using namespace fdem::testing;
 namespace {
 
 void set_body_velocity(Model& model, int body, const Vec3& v) {
+  model.nodes.keep_prescribed_velocities();
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
     if (model.pieces[model.nodes.piece[n]].body == body)
       vec3_at(model.nodes.prescribed_velocity.data(), n) = v;

@@ -221,3 +221,31 @@ TEST_CASE("local_count refuses more entries than one rank can index", "[model]")
                     Catch::Contains("238609295 tetrahedra") && Catch::Contains("more ranks"));
   CHECK_THROWS_AS(local_count(std::size_t{1} << 33, "nodes"), InputError);
 }
+
+TEST_CASE("prescribed velocities are stored only when a load moves nodes", "[model]") {
+  // Fixed bodies alone: held at rest without the array (24 bytes per node saved).
+  Scene scene = scene_for(2);
+  scene.bodies[0].fixed = true;
+  const Model held = build_model(scene, {two_pieces(), two_pieces()});
+  CHECK_FALSE(held.nodes.has_prescribed_velocity);
+  CHECK(held.nodes.prescribed_velocity.empty());
+  CHECK(held.nodes.constrained[0] == 7);
+  CHECK(held.nodes.prescribed_velocity_at(0) == 0.0);
+
+  // A velocity load on body 1: the array is there and holds the load's velocity.
+  LoadSpec load;
+  load.kind = LoadSpec::Kind::velocity;
+  load.bodies = {1};
+  load.velocity = Vec3(0, 0, -0.5);
+  scene.loads.push_back(load);
+  const Model moved = build_model(scene, {two_pieces(), two_pieces()});
+  CHECK(moved.nodes.has_prescribed_velocity);
+  REQUIRE(moved.nodes.prescribed_velocity.size() == 3 * moved.nodes.size());
+  int driven = 0;
+  for (LocalIndex n = 0; n < moved.nodes.size(); ++n)
+    if (moved.pieces.body_of(moved.nodes.piece[n]) == 1) {
+      ++driven;
+      CHECK(moved.nodes.prescribed_velocity_at(3 * n + 2) == -0.5);
+    }
+  CHECK(driven == 9);
+}

@@ -92,4 +92,15 @@ TEST_CASE("quasi_static: local damping and the time it ends, errors name the key
              Contains("quasi_static.until"));
   CHECK_THAT(error(scene_with("quasi_static: {local_damping: 0.8, ratio: 1}\n")),
              Contains("quasi_static") && Contains("ratio"));
+  // The equilibrium test: off by default, a fraction in (0, 1).
+  CHECK(whole.quasi_static.equilibrium_ratio == 0.0);
+  const fdem::Scene stop = fdem::parse_scene(
+      scene_with("quasi_static: {local_damping: 0.8, equilibrium_ratio: 1e-5}\n"), "scene.yaml");
+  CHECK(stop.quasi_static.equilibrium_ratio == 1e-5);
+  for (const char* bad : {"0", "1", "-1e-5", "2"})
+    CHECK_THAT(error(scene_with(std::string("quasi_static: {local_damping: 0.8, "
+                                            "equilibrium_ratio: ") +
+                                bad + "}\n")),
+               Contains("scene.yaml:8:") &&
+                   Contains("quasi_static.equilibrium_ratio: must be in (0, 1)"));
 }

@@ -115,3 +115,29 @@ TEST_CASE(
     CHECK(restored.state.pairs[i].value[0] == 1.0);
   }
 }
+
+TEST_CASE(
+    "checkpoint fields: without prescribed velocities (no velocity load) the column holds zeros "
+    "and restores into a model without them",
+    "[parallel][checkpoint]") {
+  Held written = make_held(1.0);
+  written.model.nodes.has_prescribed_velocity = false;
+  written.model.nodes.resize(4);  // drops the array
+  REQUIRE(written.model.nodes.prescribed_velocity.empty());
+  const CheckpointRows rows = owned_checkpoint_rows(written.model, written.state);
+  CHECK(rows.field_list() == checkpoint_layout(5).field_list());
+  CHECK(std::get<std::vector<double>>(rows.nodes.column("prescribed_velocity").values) ==
+        std::vector<double>(9, 0.0));
+  CHECK(std::get<std::vector<double>>(rows.nodes.column("x").values).size() == 9);
+
+  Held restored = make_held(5.0);
+  restored.model.nodes.has_prescribed_velocity = false;
+  restored.model.nodes.resize(4);
+  store_checkpoint_rows(rows, restored.model, restored.state);
+  CHECK(restored.model.nodes.prescribed_velocity.empty());
+  for (LocalIndex n = 0; n < 3; ++n)
+    for (int k = 0; k < 3; ++k) {
+      CHECK(restored.model.nodes.x[3 * n + k] == written.model.nodes.x[3 * n + k]);
+      CHECK(restored.model.nodes.prescribed_velocity_at(3 * n + k) == 0.0);
+    }
+}
