@@ -256,6 +256,32 @@ TEST_CASE(
 }
 
 TEST_CASE(
+    "quasi-static tilting table ended at equilibrium (ratio 1e-4): at 0.98 θc the run stops "
+    "settled, at 1.02 θc it runs its hold and the end wedge turns (docs/references.md 17)",
+    "[verification][quasi_static][long]") {
+  // The holds of the test above, each ended by quasi_static.equilibrium_ratio = 1e-4 instead of
+  // running its fixed time.  Measured (docs/verification.md): 0.98 θc stops at step 26,056
+  // (0.117 s, the corner settled at 45 µm of the 48 µm a 0.2 s hold reaches); 1.02 θc never comes
+  // below 1e-3 and turns.
+  const double critical = std::atan(0.2 / (4 * 0.1) * (4 * 4 + 2) / (4 * 4 - 1));  // 30.96°
+  const auto run = [](double angle, double end) {
+    Scene scene = tilting_table_wall(angle, end);
+    scene.quasi_static.equilibrium_ratio = 1e-4;
+    auto sim = quiet_simulation(scene);
+    const RunReport report = sim->run();
+    return std::make_tuple(report, sim->steps_done(), sim->time());
+  };
+  const auto [stands, stand_steps, stand_time] = run(0.98 * critical, 0.2);
+  const auto [turns, turn_steps, turn_time] = run(1.02 * critical, 0.12);
+  INFO("0.98 θc: " << stands.reason << "; 1.02 θc: " << turn_steps << " steps to t = "
+                   << turn_time << " s, " << turns.reason);
+  CHECK_THAT(stands.reason, Catch::Matchers::Contains("equilibrium at step"));
+  CHECK(stand_steps < 30000);  // of the 44,444 of the fixed 0.2 s hold
+  CHECK(turns.reason.empty());
+  CHECK(turn_time == Approx(0.12).margin(1e-9));
+}
+
+TEST_CASE(
     "a dry running-bond wall at τ/μσ = 0.95 holds for 2 s after settling and slides at 1.01 μ",
     "[verification][quasi_static][long]") {
   // 3 courses of 3 units (108 tets) on the held lowest course, E = 0.1 GPa, μ = 0.5, contact
