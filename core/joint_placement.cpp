@@ -4,8 +4,8 @@
 #include <array>
 #include <cmath>
 #include <map>
-#include <set>
 #include <numeric>
+#include <set>
 #include <sstream>
 
 #include "core/checked_cast.hpp"
@@ -323,11 +323,11 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
   joints.resize(local_count(drafts.size(), "joints"));
   // A joint's law key, from its tets and area (computed twice rather than stored per joint).
   const auto law_key = [&](std::size_t j) {
-    return JointLawKey{drafts[order[j]].group,
-                       joint_size_bin(tets.volume0[joints.tets[2 * j]],
-                                      tets.volume0[joints.tets[2 * j + 1]], joints.area0[j]),
-                       joint_strength_bin(scene, drafts[order[j]].group, joints.gid[j],
-                                          model.gid_offset)};
+    return JointLawKey{
+        drafts[order[j]].group,
+        joint_size_bin(tets.volume0[joints.tets[2 * j]], tets.volume0[joints.tets[2 * j + 1]],
+                       joints.area0[j]),
+        joint_strength_bin(scene, drafts[order[j]].group, joints.gid[j], model.gid_offset)};
   };
   std::set<JointLawKey> used;
   const double* x0 = nodes.x0.data();

@@ -273,8 +273,8 @@ TEST_CASE(
   };
   const auto [stands, stand_steps, stand_time] = run(0.98 * critical, 0.2);
   const auto [turns, turn_steps, turn_time] = run(1.02 * critical, 0.12);
-  INFO("0.98 θc: " << stands.reason << "; 1.02 θc: " << turn_steps << " steps to t = "
-                   << turn_time << " s, " << turns.reason);
+  INFO("0.98 θc: " << stands.reason << "; 1.02 θc: " << turn_steps << " steps to t = " << turn_time
+                   << " s, " << turns.reason);
   CHECK_THAT(stands.reason, Catch::Matchers::Contains("equilibrium at step"));
   CHECK(stand_steps < 30000);  // of the 44,444 of the fixed 0.2 s hold
   CHECK(turns.reason.empty());

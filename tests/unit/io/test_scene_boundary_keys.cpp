@@ -98,9 +98,9 @@ TEST_CASE("quasi_static: local damping and the time it ends, errors name the key
       scene_with("quasi_static: {local_damping: 0.8, equilibrium_ratio: 1e-5}\n"), "scene.yaml");
   CHECK(stop.quasi_static.equilibrium_ratio == 1e-5);
   for (const char* bad : {"0", "1", "-1e-5", "2"})
-    CHECK_THAT(error(scene_with(std::string("quasi_static: {local_damping: 0.8, "
-                                            "equilibrium_ratio: ") +
-                                bad + "}\n")),
-               Contains("scene.yaml:8:") &&
-                   Contains("quasi_static.equilibrium_ratio: must be in (0, 1)"));
+    CHECK_THAT(
+        error(scene_with(std::string("quasi_static: {local_damping: 0.8, "
+                                     "equilibrium_ratio: ") +
+                         bad + "}\n")),
+        Contains("scene.yaml:8:") && Contains("quasi_static.equilibrium_ratio: must be in (0, 1)"));
 }
