@@ -160,7 +160,9 @@ class ContactStage {
 
  private:
   static bool piece_fixed(const Model& model, std::int32_t piece);
-  void compute_boxes(const Model& model, const double* x);
+  // Boxes (lo_, hi_) of every tet, or of `members` only (in their order).
+  void compute_boxes(const Model& model, const double* x,
+                     const std::vector<LocalIndex>* members = nullptr);
   void release_boxes();  // the boxes of a detection, freed once it is done
   ContactWork work_against(const Model& model, double dt) const;
   void run_detection(const Model& model, const double* x);

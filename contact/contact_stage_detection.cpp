@@ -1,6 +1,8 @@
 // The contact stage's detection (contact_stage.hpp): boxes, the rule that keeps a detected pair,
 // and the bonds and joint states that decide which tets may pair.
 #include <algorithm>
+#include <cmath>
+#include <string>
 #include <unordered_set>
 
 #include "contact/contact_stage.hpp"
@@ -10,11 +12,14 @@
 
 namespace fdem {
 
-void ContactStage::compute_boxes(const Model& model, const double* x) {
+void ContactStage::compute_boxes(const Model& model, const double* x,
+                                 const std::vector<LocalIndex>* members) {
   const TetArrays& tets = model.tets;
-  lo_.resize(3 * tets.size());
-  hi_.resize(3 * tets.size());
-  for (LocalIndex t = 0; t < tets.size(); ++t)
+  const std::size_t n = members ? members->size() : static_cast<std::size_t>(tets.size());
+  lo_.resize(3 * n);
+  hi_.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const LocalIndex t = members ? (*members)[i] : static_cast<LocalIndex>(i);
     for (int k = 0; k < 3; ++k) {
       double lo = x[3 * tets.nodes[4 * t] + k], hi = lo;
       for (int c = 1; c < 4; ++c) {
@@ -22,9 +27,14 @@ void ContactStage::compute_boxes(const Model& model, const double* x) {
         lo = std::min(lo, v);
         hi = std::max(hi, v);
       }
-      lo_[3 * t + k] = lo;
-      hi_[3 * t + k] = hi;
+      if (!std::isfinite(lo) || !std::isfinite(hi))
+        throw NumericalFailure("contact detection: tet " + std::to_string(tets.gid[t]) +
+                               " has a non-finite bounding box (its nodes left the finite "
+                               "range); reduce the time step or check the loads.");
+      lo_[3 * i + k] = lo;
+      hi_[3 * i + k] = hi;
     }
+  }
 }
 
 namespace {
@@ -153,10 +163,31 @@ bool ContactStage::keeps(const Model& model, const double* x, LocalIndex a, Loca
 
 void ContactStage::run_detection(const Model& model, const double* x) {
   ++broad_phase_passes_;
-  compute_boxes(model, x);
   mark_left_out(model);
-  const auto keep = [&](LocalIndex a, LocalIndex b) { return keeps(model, x, a, b); };
-  detector_.detect(lo_.data(), hi_.data(), model.tets.size(), buffer_, pairs_, keep);
+  if (left_out_count_ == 0) {
+    compute_boxes(model, x);
+    const auto keep = [&](LocalIndex a, LocalIndex b) { return keeps(model, x, a, b); };
+    detector_.detect(lo_.data(), hi_.data(), model.tets.size(), buffer_, pairs_, keep);
+  } else {
+    // Left-out tets (keeps() rejects every pair of theirs) do not enter the broad phase: boxes
+    // and grids for the others only.  Their indices in `members` ascend with the tets', so the
+    // detector's sorted pairs map to the same sorted pairs of tets.
+    std::vector<LocalIndex> members;
+    members.reserve(static_cast<std::size_t>(model.tets.size() - left_out_count_));
+    for (LocalIndex t = 0; t < model.tets.size(); ++t)
+      if (!left_out_[static_cast<std::size_t>(t)]) members.push_back(t);
+    compute_boxes(model, x, &members);
+    const auto keep = [&](LocalIndex a, LocalIndex b) {
+      return keeps(model, x, members[static_cast<std::size_t>(a)],
+                   members[static_cast<std::size_t>(b)]);
+    };
+    detector_.detect(lo_.data(), hi_.data(), static_cast<LocalIndex>(members.size()), buffer_,
+                     pairs_, keep);
+    for (CandidatePair& p : pairs_) {
+      p.a = members[static_cast<std::size_t>(p.a)];
+      p.b = members[static_cast<std::size_t>(p.b)];
+    }
+  }
   may_hold_friction_.assign(pairs_.size(), 1);
   release_boxes();
 }
