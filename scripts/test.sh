@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # README command 2: install, build, and run the test suite with CTest.  Without arguments the
-# tests whose labels match `long` (each over ~30 s: the long verification runs and the 3–4 rank runs of the
-# fracture and bonded scenes; ~13 CPU-min together) are left out; `scripts/test.sh -L long` runs
-# only them, `scripts/test.sh -LE none` everything.  Other arguments go to ctest.
+# tests whose labels match `long` (each over ~20 s: the long verification runs and the 3–4 rank
+# runs of the fracture and bonded scenes; ~18 min of test time together) are left out;
+# `scripts/test.sh -L long` runs only them, `scripts/test.sh -LE none` everything.  Other
+# arguments go to ctest.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/build.sh"
