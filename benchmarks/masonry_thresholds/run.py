@@ -6,6 +6,7 @@ from the start at `ratio` × the rigid-block threshold and held under local damp
 
   benchmarks/masonry_thresholds/run.py [--fdem build/drivers/fdem] [--cases all|NAME,...]
                                        [--ratios all|R,...] [--hold-scale 1]
+                                       [--equilibrium-ratio R]
                                        [--csv docs/data/masonry_thresholds.csv]
   benchmarks/masonry_thresholds/run.py --references   # the rigid-block values only
 
@@ -24,6 +25,9 @@ d1 = |u(T)| − |u(T − w)|, d0 = |u(T − w)| − |u(T − 2w)|:
   stands     d1 < `still` (the problem's tolerance: the structure has stopped or turns back)
   turns      d1 > `moving` and d1 ≥ d0 (a mechanism accelerating)
   undecided  otherwise (still creeping: a longer hold would decide)
+With --equilibrium-ratio R every hold also ends at equilibrium (quasi_static.equilibrium_ratio:
+the mean unbalanced-force ratio below R); a hold that ends so `stands (equilibrium)`, before its
+full time.
 Time is the user CPU time of the fdem process (/usr/bin/time), one core.
 """
 import argparse, csv, itertools, json, math, os, subprocess, sys, tempfile
@@ -230,8 +234,8 @@ def run(fdem, text, workdir):
     with open(os.path.join(out, "histories.csv")) as f:
         rows = list(csv.DictReader(f))
     with open(os.path.join(out, "summary.json")) as f:
-        steps = json.load(f)["steps"]
-    return rows, cpu, steps
+        summary = json.load(f)
+    return rows, cpu, summary["steps"], "equilibrium" in summary.get("reason", "")
 
 
 def main():
@@ -243,6 +247,8 @@ def main():
     p.add_argument("--references", action="store_true")
     p.add_argument("--hold-scale", type=float, default=1.0,
                    help="multiplies every hold (a quick check of the script: 0.1)")
+    p.add_argument("--equilibrium-ratio", type=float, default=0.0,
+                   help="end holds at equilibrium (quasi_static.equilibrium_ratio), e.g. 1e-4")
     a = p.parse_args()
     refs = {"wall_tilt": math.degrees(math.atan(0.6)),
             "arch_min_thickness": minimum_thickness(),
@@ -262,12 +268,20 @@ def main():
         if ratios and not any(abs(ratio - r) < 1e-9 for r in ratios):
             continue
         hold *= a.hold_scale
+        text = scene(hold)
+        if a.equilibrium_ratio > 0:
+            text = text.replace("quasi_static: {local_damping: 0.8}",
+                                "quasi_static: {local_damping: 0.8, equilibrium_ratio: %g}" %
+                                a.equilibrium_ratio)
         with tempfile.TemporaryDirectory() as workdir:
-            rows, cpu, steps = run(a.fdem, scene(hold), workdir)
+            rows, cpu, steps, at_equilibrium = run(a.fdem, text, workdir)
         verdict, end, d1 = outcome(rows, still, moving)
+        if at_equilibrium:
+            verdict = "stands (equilibrium)"
         print("%-20s %6.3f %6.2f %9d %8.1f %11.3e %11.3e  %s" % (name, ratio, hold, steps, cpu, end,
                                                                   d1, verdict), flush=True)
         results.append({"problem": name, "ratio": ratio, "reference": refs[name], "hold_s": hold,
+                        "equilibrium_ratio": a.equilibrium_ratio,
                         "steps": steps, "cpu_s": cpu, "displacement_m": end,
                         "last_window_m": d1, "outcome": verdict})
     os.makedirs(os.path.dirname(a.csv), exist_ok=True)
