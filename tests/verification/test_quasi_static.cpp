@@ -276,7 +276,7 @@ TEST_CASE(
   INFO("0.98 θc: " << stands.reason << "; 1.02 θc: " << turn_steps << " steps to t = " << turn_time
                    << " s, " << turns.reason);
   CHECK_THAT(stands.reason, Catch::Matchers::Contains("equilibrium at step"));
-  CHECK(stand_steps < 30000);  // of the 44,444 of the fixed 0.2 s hold
+  CHECK(stand_steps < 30000);  // of the 44,454 of the fixed 0.2 s hold
   CHECK(turns.reason.empty());
   CHECK(turn_time == Approx(0.12).margin(1e-9));
 }
