@@ -163,7 +163,6 @@ class ContactStage {
   // Boxes (lo_, hi_) of every tet, or of `members` only (in their order).
   void compute_boxes(const Model& model, const double* x,
                      const std::vector<LocalIndex>* members = nullptr);
-  void release_boxes();  // the boxes of a detection, freed once it is done
   ContactWork work_against(const Model& model, double dt) const;
   void run_detection(const Model& model, const double* x);
   bool keeps(const Model& model, const double* x, LocalIndex a, LocalIndex b) const;

@@ -164,38 +164,24 @@ bool ContactStage::keeps(const Model& model, const double* x, LocalIndex a, Loca
 void ContactStage::run_detection(const Model& model, const double* x) {
   ++broad_phase_passes_;
   mark_left_out(model);
-  if (left_out_count_ == 0) {
-    compute_boxes(model, x);
-    const auto keep = [&](LocalIndex a, LocalIndex b) { return keeps(model, x, a, b); };
-    detector_.detect(lo_.data(), hi_.data(), model.tets.size(), buffer_, pairs_, keep);
-  } else {
-    // Left-out tets (keeps() rejects every pair of theirs) do not enter the broad phase: boxes
-    // and grids for the others only.  Their indices in `members` ascend with the tets', so the
-    // detector's sorted pairs map to the same sorted pairs of tets.
-    std::vector<LocalIndex> members;
+  // Left-out tets (keeps() rejects every pair of theirs) do not enter the broad phase: boxes and
+  // grids for the others only.  Their indices in `members` ascend with the tets', so the
+  // detector's sorted pairs map to the same sorted pairs of tets.  None left out: every tet.
+  std::vector<LocalIndex> members;
+  if (left_out_count_ > 0) {
     members.reserve(static_cast<std::size_t>(model.tets.size() - left_out_count_));
     for (LocalIndex t = 0; t < model.tets.size(); ++t)
       if (!left_out_[static_cast<std::size_t>(t)]) members.push_back(t);
-    compute_boxes(model, x, &members);
-    const auto keep = [&](LocalIndex a, LocalIndex b) {
-      return keeps(model, x, members[static_cast<std::size_t>(a)],
-                   members[static_cast<std::size_t>(b)]);
-    };
-    detector_.detect(lo_.data(), hi_.data(), static_cast<LocalIndex>(members.size()), buffer_,
-                     pairs_, keep);
-    for (CandidatePair& p : pairs_) {
-      p.a = members[static_cast<std::size_t>(p.a)];
-      p.b = members[static_cast<std::size_t>(p.b)];
-    }
   }
+  const bool all = left_out_count_ == 0;
+  const auto tet = [&](LocalIndex i) { return all ? i : members[static_cast<std::size_t>(i)]; };
+  compute_boxes(model, x, all ? nullptr : &members);
+  const auto keep = [&](LocalIndex a, LocalIndex b) { return keeps(model, x, tet(a), tet(b)); };
+  const auto n = all ? model.tets.size() : static_cast<LocalIndex>(members.size());
+  detector_.detect(lo_.data(), hi_.data(), n, buffer_, pairs_, keep);
+  if (!all)
+    for (CandidatePair& p : pairs_) p = {tet(p.a), tet(p.b)};
   may_hold_friction_.assign(pairs_.size(), 1);
-  release_boxes();
-}
-
-void ContactStage::release_boxes() {
-  lo_ = {};
-  hi_ = {};
-  detector_.release_boxes();
 }
 
 // The pairs a detection at the positions of the last one would add after the eligibility of the
@@ -237,7 +223,6 @@ void ContactStage::add_pairs_of(const Model& model, const std::vector<LocalIndex
   std::inplace_merge(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(old_size),
                      pairs_.end());
   may_hold_friction_.assign(pairs_.size(), 1);
-  release_boxes();
 }
 
 void ContactStage::set_bonds(LocalIndex n_tets,

@@ -60,12 +60,6 @@ std::size_t NbsDetector::workspace_bytes() const {
   return total;
 }
 
-void NbsDetector::release_boxes() {
-  boxes_ = {};
-  extent_ = {};
-  extent_scratch_ = {};
-}
-
 void NbsDetector::release_workspace() {
   levels_ = {};  // head arrays are built afresh (all −1) for new levels
   boxes_ = {};

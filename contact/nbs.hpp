@@ -74,9 +74,6 @@ class NbsDetector {
   std::size_t workspace_bytes() const;
   // Gives the grids and scratch arrays back (the next detect() rebuilds them).
   void release_workspace();
-  // Gives back only the per-element arrays (inflated boxes, extents; 56 bytes per element), which
-  // detect() fills anew: between detections they would sit under the step's and the frames' peak.
-  void release_boxes();
 
  private:
   struct Level {

@@ -134,24 +134,13 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, const std::vector
   return columns;
 }
 
-void for_each_tet_frame_array(const Model& model, const std::vector<LocalIndex>& cells,
-                              const std::vector<LocalIndex>& points,
-                              const std::vector<std::string>& fields,
-                              const std::vector<FrameField>& extra,
-                              const std::function<void(FrameArray&)>& take) {
-  for (const FrameColumn& column : tet_frame_columns(model, cells, points, fields, extra)) {
-    FrameArray a = column.materialize();
-    take(a);
-  }
-}
-
 std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<LocalIndex>& cells,
                                          const std::vector<LocalIndex>& points,
                                          const std::vector<std::string>& fields,
                                          const std::vector<FrameField>& extra) {
   std::vector<FrameArray> arrays;
-  for_each_tet_frame_array(model, cells, points, fields, extra,
-                           [&](FrameArray& a) { arrays.push_back(std::move(a)); });
+  for (const FrameColumn& column : tet_frame_columns(model, cells, points, fields, extra))
+    arrays.push_back(column.materialize());
   return arrays;
 }
 

@@ -75,13 +75,6 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, const std::vector
                                            const std::vector<LocalIndex>& points,
                                            const std::vector<std::string>& fields,
                                            const std::vector<FrameField>& extra);
-// The same arrays handed to `take` one at a time, each built just before and freed just after
-// (a writer that copies them keeps one at a time, not the whole frame twice).
-void for_each_tet_frame_array(const Model& model, const std::vector<LocalIndex>& cells,
-                              const std::vector<LocalIndex>& points,
-                              const std::vector<std::string>& fields,
-                              const std::vector<FrameField>& extra,
-                              const std::function<void(FrameArray&)>& take);
 
 // A dataset of a written frame file: what the series file (.xdmf) needs to reference it.
 struct FrameDataset {

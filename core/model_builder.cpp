@@ -322,7 +322,7 @@ void apply_constraints(const Scene& scene, Model& model) {
   }
   for (const LoadSpec& load : scene.loads) {
     // Tilts, ramps and surface loads hold no node.
-    if (load.kind != LoadSpec::Kind::velocity && load.kind != LoadSpec::Kind::base_motion) continue;
+    if (!load.prescribes_velocity()) continue;
     // The velocity at t = 0 (drivers/loads sets it each step when it varies).
     const Vec3 velocity = load.kind == LoadSpec::Kind::velocity
                               ? Vec3(load.history(0.0) * load.velocity)

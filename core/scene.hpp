@@ -2,6 +2,7 @@
 // io/scene_reader fills it from YAML; drivers/ turn it into a Model.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -220,6 +221,9 @@ struct LoadSpec {
   RampSpec ramp;                 // kind == ramp
   SurfaceLoadSpec surface;       // kind == surface (bodies or region select the faces)
   std::string where;             // "FILE:LINE:COLUMN: loads[i].region" (or .bodies), for messages
+
+  // A velocity or base-motion load: it prescribes its nodes' velocities (the others hold none).
+  bool prescribes_velocity() const { return kind == Kind::velocity || kind == Kind::base_motion; }
 };
 
 // A point whose displacement, velocity and stress histories.csv records, interpolated in the tet
@@ -325,10 +329,8 @@ struct Scene {
   // True when a load moves nodes at a prescribed velocity (velocity or base-motion loads); fixed
   // bodies alone hold their nodes at rest and need no stored velocities.
   bool prescribes_velocities() const {
-    for (const LoadSpec& load : loads)
-      if (load.kind == LoadSpec::Kind::velocity || load.kind == LoadSpec::Kind::base_motion)
-        return true;
-    return false;
+    return std::any_of(loads.begin(), loads.end(),
+                       [](const LoadSpec& load) { return load.prescribes_velocity(); });
   }
 };
 

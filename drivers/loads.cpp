@@ -89,8 +89,7 @@ void LoadSchedule::rebind(const Model& model) {
     std::vector<int> setter(3 * static_cast<std::size_t>(model.nodes.size()), -1);
     for (int l = 0; l < static_cast<int>(all_loads_.size()); ++l) {
       const LoadSpec& load = all_loads_[static_cast<std::size_t>(l)];
-      if (load.kind != LoadSpec::Kind::velocity && load.kind != LoadSpec::Kind::base_motion)
-        continue;
+      if (!load.prescribes_velocity()) continue;
       for (LocalIndex n = 0; n < model.nodes.size(); ++n)
         if (load_holds_node(load, model, n))
           for (int k = 0; k < 3; ++k)

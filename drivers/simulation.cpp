@@ -97,10 +97,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   const auto global_sum = [&](auto v) { return distributed ? comm_->sum(v) : v; };
   loads_ = std::make_unique<LoadSchedule>(scene_, model_);
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
-  plan_.kinematic_loads =
-      std::any_of(scene_.loads.begin(), scene_.loads.end(), [](const LoadSpec& l) {
-        return l.kind == LoadSpec::Kind::velocity || l.kind == LoadSpec::Kind::base_motion;
-      });
+  plan_.kinematic_loads = scene_.prescribes_velocities();
   plan_.surface_loads = loads_->has_surface_loads();
   // A surface load that acts on no face is a mistake in the scene (a region beside the model).
   for (const auto& [index, owned] : loads_->surface_face_counts())
