@@ -11,7 +11,9 @@ if(FDEM_SANITIZE)
   add_link_options(${FDEM_SANITIZER_FLAGS})
 endif()
 set(CMAKE_CXX_FLAGS_RELEASE "-O3 -DNDEBUG")
-set(CMAKE_CXX_FLAGS_RELWITHDEBINFO "-O2 -g -DNDEBUG")
+# -g1 (line tables): what the sanitizers' and the fuzzer's stack traces print; full -g doubled the
+# sanitizer build's compile time (20.7 → ~10 min on 2 cores).
+set(CMAKE_CXX_FLAGS_RELWITHDEBINFO "-O2 -g1 -DNDEBUG")
 
 # -ffp-contract=off: no a·b + c fused into one rounding where the CPU has FMA (-march=native, the
 # AVX2 clones), so every build rounds as the x86-64 baseline does and the kernels written twice
