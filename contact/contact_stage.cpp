@@ -28,7 +28,6 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
     friction_coefficient_.push_back(m.contact.friction);
     damping_ratio_.push_back(m.contact.damping);
   }
-  x_at_detection_ = model.nodes.x;  // no detection yet: detected_ says one is due
   skip_enclosed_ = settings.skip_enclosed;
   exact_narrowing_ = settings.exact_narrowing;
   // The anchors' lag: long against the contact's vibrations (following the centroid at once, a
@@ -125,12 +124,22 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
     const auto it = local.find(e.a);
     pf.owned = it != local.end() && tets.is_owned(it->second);
   }
-  x_at_detection_ = std::move(x_at_detection);
   detected_ = detected;
   pairs_.clear();
-  if (!detected_) return;
+  x_at_detection_ = {};
+  kept_nodes_ = {};
+  every_node_kept_ = true;
+  if (!detected_) return;  // positions at detection are taken by the first detection
+  // The positions the last detection saw: of the nodes it looks at, once left_out_ is known.
+  const auto keep = [&] {
+    if (left_out_count_ == 0)
+      x_at_detection_ = std::move(x_at_detection);
+    else
+      keep_positions(model, x_at_detection.data());
+  };
   if (!candidates) {
-    run_detection(model, x_at_detection_.data());
+    run_detection(model, x_at_detection.data());
+    keep();
     return;
   }
   // The pairs this rank computes (run_detection's `eligible` keeps a pair with an active tet; the
@@ -146,6 +155,53 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
   }
   std::sort(pairs_.begin(), pairs_.end());
   may_hold_friction_.assign(pairs_.size(), 1);
+  keep();
+}
+
+void ContactStage::keep_positions(const Model& model, const double* x) {
+  const std::size_t n_nodes = static_cast<std::size_t>(model.nodes.size());
+  kept_owned_ = 0;
+  if (left_out_count_ == 0) {
+    every_node_kept_ = true;
+    kept_nodes_ = {};
+    x_at_detection_.assign(x, x + 3 * n_nodes);
+    return;
+  }
+  every_node_kept_ = false;
+  const TetArrays& tets = model.tets;
+  std::vector<std::uint8_t> kept(n_nodes, 0);
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    if (!left_out_[static_cast<std::size_t>(t)])
+      for (int c = 0; c < 4; ++c) kept[static_cast<std::size_t>(tets.nodes[4 * t + c])] = 1;
+  const std::size_t count = static_cast<std::size_t>(std::count(kept.begin(), kept.end(), 1));
+  std::vector<LocalIndex> nodes;  // sized exactly: no slack kept between detections
+  nodes.reserve(count);
+  std::vector<double> positions(3 * count);
+  for (std::size_t i = 0; i < n_nodes; ++i) {
+    if (!kept[i]) continue;
+    std::copy_n(x + 3 * i, 3, positions.data() + 3 * nodes.size());
+    nodes.push_back(static_cast<LocalIndex>(i));
+    if (static_cast<LocalIndex>(i) < model.nodes.n_owned) ++kept_owned_;
+  }
+  kept_nodes_ = std::move(nodes);
+  x_at_detection_ = std::move(positions);
+}
+
+std::vector<double> ContactStage::positions_at_detection(const Model& model) const {
+  if (every_node_kept_ && x_at_detection_.size() == model.nodes.x.size()) return x_at_detection_;
+  std::vector<double> out = model.nodes.x;
+  if (!every_node_kept_)
+    for (std::size_t k = 0; k < kept_nodes_.size(); ++k)
+      std::copy_n(x_at_detection_.data() + 3 * k, 3,
+                  out.data() + 3 * static_cast<std::size_t>(kept_nodes_[k]));
+  return out;
+}
+
+double ContactStage::travel_since_detection(const Model& model) const {
+  if (!detected_) return 0.0;
+  const double* x = model.nodes.x.data();
+  if (every_node_kept_) return max_node_displacement(x, x_at_detection_.data(), model.nodes.n_owned);
+  return max_node_displacement(x, x_at_detection_.data(), kept_nodes_.data(), kept_owned_);
 }
 
 std::vector<GidPair> ContactStage::candidate_gids(const Model& model) const {
@@ -163,6 +219,7 @@ void ContactStage::release_until_rebind() {
   lo_ = {};
   hi_ = {};
   x_at_detection_ = {};
+  kept_nodes_ = {};
   friction_ = {};
   detector_.release_workspace();
 }

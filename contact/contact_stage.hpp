@@ -112,7 +112,13 @@ class ContactStage {
   // pairs, their records and friction map, the detector's grids) so that it does not add to
   // the migration's buffers at the peak of the step loop.
   void release_until_rebind();
-  const std::vector<double>& x_at_detection() const { return x_at_detection_; }
+  // Positions (m, xyz) of every local node at the last detection, for checkpoints and
+  // migration: the nodes of the tets that may pair as the detection saw them, the others (nodes
+  // of enclosed tets only, which no detection looks at before their body cracks) where they are.
+  std::vector<double> positions_at_detection(const Model& model) const;
+  // Largest travel (m) since the last detection of an owned node of the tets that may pair
+  // (+infinity for NaN); 0 before the first detection.
+  double travel_since_detection(const Model& model) const;
   std::vector<std::uint8_t> tet_joint_states() const;
   bool detected() const { return detected_; }
   // Adds contact forces to model.nodes.f (pairs in ascending (gid, gid) order).
@@ -171,7 +177,16 @@ class ContactStage {
   double buffer_ = 0.0;
   std::vector<double> penalty_;
   NbsDetector detector_;
-  std::vector<double> lo_, hi_, x_at_detection_;
+  std::vector<double> lo_, hi_;
+  // Positions at the last detection (m, xyz): of every local node while every_node_kept_, else
+  // of kept_nodes_ (ascending), the nodes of the tets that may pair.  An intact jointed body's
+  // enclosed tets hold most of its nodes, whose positions no detection needs (24 B per node).
+  std::vector<double> x_at_detection_;
+  std::vector<LocalIndex> kept_nodes_;
+  std::size_t kept_owned_ = 0;  // kept_nodes_ below NodeArrays::n_owned (they come first)
+  bool every_node_kept_ = true;
+  // Keeps the positions x of the nodes the last mark_left_out() lets pair (or all of them).
+  void keep_positions(const Model& model, const double* x);
   std::vector<CandidatePair> pairs_;
   std::vector<std::uint8_t> overlapping_;
   // Per candidate pair: it may hold a friction history (it overlapped at the last add_forces, or

@@ -82,10 +82,7 @@ bool tets_farther_than(const Model& model, const double* positions, LocalIndex a
 }  // namespace
 
 bool ContactStage::detection_due(const Model& model) const {
-  const NodeArrays& nodes = model.nodes;
-  return !detected_ ||
-         detection_needed(
-             max_node_displacement(nodes.x.data(), x_at_detection_.data(), nodes.n_owned), buffer_);
+  return !detected_ || detection_needed(travel_since_detection(model), buffer_);
 }
 
 bool ContactStage::detect_if_needed(const Model& model) {
@@ -105,7 +102,7 @@ void ContactStage::detect(const Model& model) {
     for (auto it = friction_.begin(); it != friction_.end();)
       it = kept.count(it->first) ? std::next(it) : friction_.erase(it);
   }
-  x_at_detection_ = model.nodes.x;
+  keep_positions(model, model.nodes.x.data());
   detected_ = true;
   ++detections_;
 }
@@ -190,11 +187,15 @@ void ContactStage::run_detection(const Model& model, const double* x) {
 // pairs cost a pass over the boxes each; many, a detection.
 void ContactStage::add_pairs_of(const Model& model, const std::vector<LocalIndex>& changed) {
   const LocalIndex n = model.tets.size();
+  // Positions at the last detection of every node (those of left-out tets, whose pairs keeps()
+  // rejects, where they are now).
+  std::vector<double> all_positions;
+  if (!every_node_kept_) all_positions = positions_at_detection(model);
+  const double* x = every_node_kept_ ? x_at_detection_.data() : all_positions.data();
   if (changed.size() > 64) {
-    run_detection(model, x_at_detection_.data());
+    run_detection(model, x);
     return;
   }
-  const double* x = x_at_detection_.data();
   compute_boxes(model, x);
   const double half = 0.5 * buffer_;
   const auto box_of = [&](LocalIndex t, double(&box)[6]) {
@@ -271,6 +272,9 @@ void ContactStage::release_bonds(const Model& model,
         if (!left_out_.empty() && left_out_[t]) {  // enclosed, and its body had not cracked
           left_out_[t] = 0;
           --left_out_count_;
+          // Its nodes' positions at the last detection were not kept: detect anew (its body's
+          // crack, told first, has already asked for that).
+          detected_ = false;
         }
         joint_state_[t] = JointState::cracked;
         widened = true;

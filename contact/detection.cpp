@@ -20,10 +20,25 @@ double max_node_displacement(const double* x, const double* x_at_detection, Loca
   return std::sqrt(max_squared);
 }
 
-NodeTravel node_travel(const double* x, const double* x_at_detection, const double* v, double dt,
-                       LocalIndex n_nodes) {
+double max_node_displacement(const double* x, const double* x_at_detection,
+                             const LocalIndex* nodes, std::size_t count) {
+  double max_squared = 0.0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const double* p = x + 3 * static_cast<std::size_t>(nodes[k]);
+    const double dx = p[0] - x_at_detection[3 * k];
+    const double dy = p[1] - x_at_detection[3 * k + 1];
+    const double dz = p[2] - x_at_detection[3 * k + 2];
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (!(d2 <= max_squared)) {  // also true for NaN
+      if (std::isnan(d2)) return std::numeric_limits<double>::infinity();
+      max_squared = d2;
+    }
+  }
+  return std::sqrt(max_squared);
+}
+
+NodeTravel step_travel(const double* v, double dt, LocalIndex n_nodes) {
   NodeTravel out;
-  out.since_detection = max_node_displacement(x, x_at_detection, n_nodes);
   double max_speed2 = 0.0;
   for (LocalIndex i = 0; i < n_nodes; ++i) {
     const double s2 =

@@ -4,6 +4,8 @@
 // detection, each grown by the largest node travel, overlap.
 #pragma once
 
+#include <cstddef>
+
 #include "core/types.hpp"
 
 namespace fdem {
@@ -17,16 +19,20 @@ inline bool detection_needed(double max_travel, double buffer) {
 // each, xyz per node).  0 for n_nodes == 0.  A NaN displacement is returned as +infinity so
 // that the caller always re-detects (and the detector then reports the non-finite box).
 double max_node_displacement(const double* x, const double* x_at_detection, LocalIndex n_nodes);
+// The same over the listed nodes only: x_at_detection holds 3 values per listed node, in order.
+double max_node_displacement(const double* x, const double* x_at_detection,
+                             const LocalIndex* nodes, std::size_t count);
 
 // How far the nodes went, measured after a step: the largest travel since the last detection
-// (m, decides whether the next step detects) and the largest travel of the step itself, dt·|v|
-// (m, the tunnelling guard), with the node that made it.  NaN counts as +infinity.
+// (m, decides whether the next step detects; ContactStage::travel_since_detection) and the largest
+// travel of the step itself, dt·|v| (m, the tunnelling guard), with the node that made it.  NaN
+// counts as +infinity.
 struct NodeTravel {
   double since_detection = 0.0;
   double step = 0.0;
   LocalIndex fastest = -1;  // node of `step`; −1 when no node moved
 };
-NodeTravel node_travel(const double* x, const double* x_at_detection, const double* v, double dt,
-                       LocalIndex n_nodes);
+// The step's travel of the first n_nodes nodes (velocities v, 3 per node); since_detection 0.
+NodeTravel step_travel(const double* v, double dt, LocalIndex n_nodes);
 
 }  // namespace fdem

@@ -219,8 +219,8 @@ void Simulation::integrate(StepRecord& r) {
   r.contact_after = contact_->work_after(model_, dt_);  // friction and dashpots with v_n+½
   // How far the nodes went: whether the next step must detect, and whether a node crossed more
   // than the thinnest element in this step (tunnelling).
-  r.travel = node_travel(nodes.x.data(), contact_->x_at_detection().data(), nodes.v.data(), dt_,
-                         nodes.n_owned);
+  r.travel = step_travel(nodes.v.data(), dt_, nodes.n_owned);
+  r.travel.since_detection = contact_->travel_since_detection(model_);
   r.flags.detection_due = detection_needed(r.travel.since_detection, contact_->buffer());
   r.flags.tunnelling = r.travel.step > tunnel_size_ ? 1.0 : 0.0;
 }
@@ -342,7 +342,7 @@ void Simulation::check_step(const StepRecord& r) {
 TravellingState Simulation::travelling_state() const {
   TravellingState state;
   if (contact_) {
-    state.x_at_detection = contact_->x_at_detection();
+    state.x_at_detection = contact_->positions_at_detection(model_);
     state.tet_joint_state = contact_->tet_joint_states();
     state.pairs = friction_records(contact_->friction_entries());
   } else {

@@ -420,7 +420,7 @@ TEST_CASE(
       INFO("cycle " << cycle);
       move(local, 0.002);  // within buffer / 2 of the detection: no detection due
       state = TravellingState{};
-      state.x_at_detection = stage->x_at_detection();
+      state.x_at_detection = stage->positions_at_detection(local);
       state.candidates = stage->candidate_gids(local);
       d.redistribute(local, state, {}, 0.0);
       // What travelled, against the detection repeated at the positions it saw.

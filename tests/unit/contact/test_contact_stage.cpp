@@ -137,7 +137,7 @@ TEST_CASE("a bonded pair never pairs, and pairs again as soon as its bond is rel
   // detection, which stay, and no detection falls due.
   Model moved = model;
   for (double& x : moved.nodes.x) x += 1e-4;
-  const std::vector<double> at_detection = stage.x_at_detection();
+  const std::vector<double> at_detection = stage.positions_at_detection(model);
   const long detections = stage.detections();
   stage.release_bonds(moved, {{bonded.first, -1}});  // the other tet on another rank: cracked
   CHECK(stage.tet_joint_states()[bonded.first] ==
@@ -147,7 +147,7 @@ TEST_CASE("a bonded pair never pairs, and pairs again as soon as its bond is rel
   CHECK(pairs_of(stage) == all);
   CHECK(stage.tet_joint_states()[bonded.second] ==
         static_cast<std::uint8_t>(TetJointState::cracked));
-  CHECK(stage.x_at_detection() == at_detection);
+  CHECK(stage.positions_at_detection(model) == at_detection);
   CHECK(stage.detections() == detections);
   CHECK_FALSE(stage.detection_due(moved));  // 0.1 mm < buffer / 2
 

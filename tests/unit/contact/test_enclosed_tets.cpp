@@ -95,3 +95,64 @@ TEST_CASE("enclosed tets stay out of contact, change no force, and return when a
     CHECK(states[t] == static_cast<std::uint8_t>(want));
   }
 }
+
+TEST_CASE("positions at detection are kept for the nodes of tets that may pair only",
+          "[contact][enclosed]") {
+  Model model = testing::pressed_jointed_cube();
+  const double buffer = 0.025;
+  ContactStage skipping(model, ContactSettings{buffer, true, false});
+  ContactStage all(model, ContactSettings{buffer, false, false});
+  for (ContactStage* stage : {&skipping, &all}) {
+    stage->set_bonds(model.tets.size(), testing::joint_bonds(model));
+    stage->enclose(model.tets.enclosed);
+    stage->detect(model);
+  }
+  REQUIRE(skipping.left_out() > 0);
+  // A node of enclosed tets only (the jointed cube's tets have their own nodes) and a node of a
+  // tet that may pair.
+  std::vector<int> in_enclosed(static_cast<std::size_t>(model.nodes.size()), 0),
+      in_other(in_enclosed);
+  for (LocalIndex t = 0; t < model.tets.size(); ++t)
+    for (int c = 0; c < 4; ++c)
+      ++(model.tets.enclosed[t] ? in_enclosed : in_other)[model.tets.nodes[4 * t + c]];
+  LocalIndex inner = -1, outer = -1;
+  for (LocalIndex i = 0; i < model.nodes.n_owned; ++i) {
+    if (inner < 0 && in_enclosed[i] && !in_other[i]) inner = i;
+    if (outer < 0 && in_other[i] && !in_enclosed[i]) outer = i;
+  }
+  REQUIRE(inner >= 0);
+  REQUIRE(outer >= 0);
+  const std::vector<double> at_detection = model.nodes.x;
+  CHECK(skipping.positions_at_detection(model) == at_detection);
+  CHECK(skipping.travel_since_detection(model) == 0.0);
+
+  // The enclosed tets' node goes far: no detection is due where they are left out (their pairs
+  // are not looked at until their body cracks), one is where they are not.
+  Model moved = model;
+  moved.nodes.x[3 * inner] += 10.0 * buffer;
+  CHECK(skipping.travel_since_detection(moved) == 0.0);
+  CHECK_FALSE(skipping.detection_due(moved));
+  CHECK(all.travel_since_detection(moved) == Approx(10.0 * buffer).epsilon(1e-12));
+  CHECK(all.detection_due(moved));
+  // What checkpoints and migration carry: kept nodes as detected, the others where they are.
+  std::vector<double> expected = at_detection;
+  expected[3 * inner] = moved.nodes.x[3 * inner];
+  CHECK(skipping.positions_at_detection(moved) == expected);
+  CHECK(all.positions_at_detection(moved) == at_detection);
+
+  // A node of a tet that may pair goes 0.3 buffer: its travel counts on both stages.
+  moved.nodes.x[3 * outer + 1] -= 0.3 * buffer;
+  CHECK(skipping.travel_since_detection(moved) == Approx(0.3 * buffer).epsilon(1e-12));
+  CHECK_FALSE(skipping.detection_due(moved));
+  moved.nodes.x[3 * outer + 1] -= 0.3 * buffer;
+  CHECK(skipping.detection_due(moved));
+
+  // The body cracks: the detection that follows looks at every tet, and keeps every node.
+  skipping.crack_body(0);
+  skipping.detect(moved);
+  CHECK(skipping.left_out() == 0);
+  CHECK(skipping.positions_at_detection(moved) == moved.nodes.x);
+  Model further = moved;
+  further.nodes.x[3 * inner + 2] += 0.6 * buffer;
+  CHECK(skipping.detection_due(further));
+}
