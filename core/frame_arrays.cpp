@@ -32,13 +32,12 @@ FrameColumn integer_column(const std::string& name, bool per_cell, FrameValue ty
 }
 
 // The entries `kept` of a field given for all `all_entries` local tets or nodes.
-FrameColumn filtered(const FrameField& f, std::size_t all_entries,
-                     const std::vector<LocalIndex>& kept) {
+FrameColumn filtered(const FrameField& f, std::size_t all_entries, LocalSelection kept) {
   FDEM_VERIFY(f.values.size() == all_entries * static_cast<std::size_t>(f.components),
               "frame field size");
   const int n = f.components;
   return real_column(f.name, f.per_cell, n, kept.size(),
-                     [&f, &kept, n](std::size_t r, double* out) {
+                     [&f, kept, n](std::size_t r, double* out) {
                        for (int c = 0; c < n; ++c)
                          out[c] = f.values[static_cast<std::size_t>(kept[r]) * n + c];
                      });
@@ -80,8 +79,8 @@ FrameArray FrameColumn::materialize() const {
   return a;
 }
 
-std::vector<FrameColumn> tet_frame_columns(const Model& model, const std::vector<LocalIndex>& cells,
-                                           const std::vector<LocalIndex>& points,
+std::vector<FrameColumn> tet_frame_columns(const Model& model, LocalSelection cells,
+                                           LocalSelection points,
                                            const std::vector<std::string>& fields,
                                            const std::vector<FrameField>& extra) {
   const NodeArrays& nodes = model.nodes;
@@ -93,20 +92,21 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, const std::vector
   std::vector<FrameColumn> columns;
 
   columns.push_back(integer_column("gid", false, FrameValue::i64, n_points,
-                                   [&](std::size_t p) { return nodes.gid[points[p]]; }));
+                                   [&nodes, points](std::size_t p) { return nodes.gid[points[p]]; }));
   if (wants("displacement"))
     columns.push_back(
-        real_column("displacement", false, 3, n_points, [&](std::size_t p, double* u) {
+        real_column("displacement", false, 3, n_points, [&nodes, points](std::size_t p, double* u) {
           for (int k = 0; k < 3; ++k)
             u[k] = nodes.x[3 * points[p] + k] - nodes.x0[3 * points[p] + k];
         }));
   if (wants("velocity"))
-    columns.push_back(real_column("velocity", false, 3, n_points, [&](std::size_t p, double* v) {
+    columns.push_back(
+        real_column("velocity", false, 3, n_points, [&nodes, points](std::size_t p, double* v) {
       for (int k = 0; k < 3; ++k) v[k] = nodes.v[3 * points[p] + k];
     }));
 
   const auto cell_integers = [&](const char* name, FrameValue type, auto value_of) {
-    columns.push_back(integer_column(name, true, type, n_cells, [&cells, value_of](std::size_t c) {
+    columns.push_back(integer_column(name, true, type, n_cells, [cells, value_of](std::size_t c) {
       return value_of(cells[c]);
     }));
   };
@@ -117,12 +117,14 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, const std::vector
   cell_integers("material", FrameValue::i32, [&tets](LocalIndex t) { return tets.material[t]; });
 
   if (wants("stress")) {
-    columns.push_back(real_column("stress", true, 9, n_cells, [&](std::size_t c, double* sigma) {
+    columns.push_back(
+        real_column("stress", true, 9, n_cells, [&model, cells](std::size_t c, double* sigma) {
       const Mat3 cauchy = elastic_cauchy_stress(model, cells[c]);
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) sigma[3 * i + j] = cauchy(i, j);
     }));
-    columns.push_back(real_column("von_mises", true, 1, n_cells, [&](std::size_t c, double* mises) {
+    columns.push_back(
+        real_column("von_mises", true, 1, n_cells, [&model, cells](std::size_t c, double* mises) {
       const Mat3 cauchy = elastic_cauchy_stress(model, cells[c]);
       const Mat3 dev = cauchy - cauchy.trace() / 3.0 * Mat3::Identity();
       *mises = std::sqrt(1.5 * dev.squaredNorm());
@@ -134,8 +136,8 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, const std::vector
   return columns;
 }
 
-std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<LocalIndex>& cells,
-                                         const std::vector<LocalIndex>& points,
+std::vector<FrameArray> tet_frame_arrays(const Model& model, LocalSelection cells,
+                                         LocalSelection points,
                                          const std::vector<std::string>& fields,
                                          const std::vector<FrameField>& extra) {
   std::vector<FrameArray> arrays;

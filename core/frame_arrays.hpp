@@ -53,6 +53,28 @@ struct FrameColumn {
   FrameArray materialize() const;
 };
 
+// The local tets or nodes a frame writes, ascending: the entries of a list, which must outlive the
+// selection, or all of 0 … n−1 (a rank that writes every local tet and node builds no list).
+class LocalSelection {
+ public:
+  LocalSelection() = default;  // none
+  LocalSelection(const std::vector<LocalIndex>& list)  // NOLINT(google-explicit-constructor)
+      : list_(&list), size_(list.size()) {}
+  static LocalSelection first(std::size_t n) {
+    LocalSelection all;
+    all.size_ = n;
+    return all;
+  }
+  std::size_t size() const { return size_; }
+  LocalIndex operator[](std::size_t i) const {
+    return list_ ? (*list_)[i] : static_cast<LocalIndex>(i);
+  }
+
+ private:
+  const std::vector<LocalIndex>* list_ = nullptr;
+  std::size_t size_ = 0;
+};
+
 // Local tets this rank writes in a frame: the owned ones (TetArrays::is_owned), ascending, so in
 // ascending gid (all of them on one rank).
 std::vector<LocalIndex> owned_tets(const TetArrays& tets);
@@ -65,14 +87,14 @@ Mat3 elastic_cauchy_stress(const Model& model, LocalIndex t);
 // order: point data gid (i64), displacement (x − x0, m) and velocity (m/s) if in `fields`; cell
 // data gid (i64), piece, body, material (i32), stress (Cauchy, Pa, 9 row-major) and von_mises
 // (Pa) if "stress" is in `fields`; then the `extra` fields (filtered to cells / points).
-std::vector<FrameArray> tet_frame_arrays(const Model& model, const std::vector<LocalIndex>& cells,
-                                         const std::vector<LocalIndex>& points,
+std::vector<FrameArray> tet_frame_arrays(const Model& model, LocalSelection cells,
+                                         LocalSelection points,
                                          const std::vector<std::string>& fields,
                                          const std::vector<FrameField>& extra);
 // The same arrays as columns, in the same order, computed when a writer asks for their rows;
-// they read `model`, `cells`, `points` and `extra`, which must outlive them.
-std::vector<FrameColumn> tet_frame_columns(const Model& model, const std::vector<LocalIndex>& cells,
-                                           const std::vector<LocalIndex>& points,
+// they read `model`, the selections' lists and `extra`, which must outlive them.
+std::vector<FrameColumn> tet_frame_columns(const Model& model, LocalSelection cells,
+                                           LocalSelection points,
                                            const std::vector<std::string>& fields,
                                            const std::vector<FrameField>& extra);
 

@@ -158,8 +158,7 @@ void RunFiles::write_xdmf_tet_frame(double time, const Model& model,
   rows.tet_nodes.reserve(4 * cells.size());
   for (const LocalIndex t : cells)
     for (int c = 0; c < 4; ++c) rows.tet_nodes.push_back(model.tets.nodes[4 * t + c]);
-  std::vector<LocalIndex> points(static_cast<std::size_t>(nodes.n_owned));  // the owned nodes
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n) points[static_cast<std::size_t>(n)] = n;
+  const LocalSelection points = LocalSelection::first(static_cast<std::size_t>(nodes.n_owned));
   rows.arrays = tet_frame_columns(model, cells, points, fields_, extra);  // read when written
   const Communicator comm = xdmf_->comm ? *xdmf_->comm : process_communicator();
   const std::string file = xdmf_series_->next_frame_file();

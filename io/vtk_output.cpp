@@ -150,40 +150,56 @@ VtuArray vtu_array(const FrameColumn& c) {
   return a;
 }
 
-// The owned tets of `model` and the nodes they reference, renumbered in ascending local order
-// (on one rank with every node in a tet, the identity), as a streamed .vtu grid.  The grid's
-// arrays read the model and this object, which is neither copied nor moved.
+// The owned tets of `model` and the nodes they reference, renumbered in ascending local order,
+// as a streamed .vtu grid.  On one rank, where every tet is owned and every node in a tet, that
+// is the identity and no index list is built (they were ~40 B per tet at a frame, the run's peak
+// of a large jointed body).  The grid's arrays read the model and this object, which is neither
+// copied nor moved.
 class OwnedTetGrid {
  public:
   OwnedTetGrid(const Model& model, const std::vector<std::string>& fields,
-               const std::vector<FrameField>& extra)
-      : cells_(owned_tets(model.tets)) {  // ascending, so ascending gid
+               const std::vector<FrameField>& extra) {
     const NodeArrays& nodes = model.nodes;
     const TetArrays& tets = model.tets;
-    renumbered_.assign(static_cast<std::size_t>(nodes.size()), -1);
-    for (const LocalIndex t : cells_)
-      for (int c = 0; c < 4; ++c) renumbered_[tets.nodes[4 * t + c]] = 0;
-    for (LocalIndex i = 0; i < nodes.size(); ++i)
-      if (renumbered_[i] == 0) {
-        renumbered_[i] = static_cast<LocalIndex>(points_.size());
-        points_.push_back(i);
-      }
-    columns_ = tet_frame_columns(model, cells_, points_, fields, extra);
-    grid_.points = points_.size();
-    grid_.cells = cells_.size();
+    const auto n_nodes = static_cast<std::size_t>(nodes.size());
+    std::size_t owned = 0;
+    for (LocalIndex t = 0; t < tets.size(); ++t) owned += tets.is_owned(t) ? 1 : 0;
+    std::vector<bool> used(n_nodes, false);
+    for (LocalIndex t = 0; t < tets.size(); ++t)
+      if (tets.is_owned(t))
+        for (int c = 0; c < 4; ++c) used[static_cast<std::size_t>(tets.nodes[4 * t + c])] = true;
+    const auto n_used = static_cast<std::size_t>(std::count(used.begin(), used.end(), true));
+    identity_ = owned == static_cast<std::size_t>(tets.size()) && n_used == n_nodes;
+    if (!identity_) {
+      cells_ = owned_tets(tets);
+      renumbered_.assign(n_nodes, -1);
+      points_.reserve(n_used);
+      for (std::size_t i = 0; i < n_nodes; ++i)
+        if (used[i]) {
+          renumbered_[i] = static_cast<LocalIndex>(points_.size());
+          points_.push_back(static_cast<LocalIndex>(i));
+        }
+    }
+    const LocalSelection cells = identity_ ? LocalSelection::first(owned) : cells_;
+    const LocalSelection points = identity_ ? LocalSelection::first(n_nodes) : points_;
+    columns_ = tet_frame_columns(model, cells, points, fields, extra);
+    grid_.points = points.size();
+    grid_.cells = cells.size();
     for (const FrameColumn& c : columns_)
       (c.per_cell ? grid_.cell_data : grid_.point_data).push_back(vtu_array(c));
-    grid_.positions = {"Points", "Float64", 3, points_.size(),
-                       [this, &nodes](std::size_t first, std::size_t count, unsigned char* out) {
+    grid_.positions = {"Points", "Float64", 3, points.size(),
+                       [&nodes, points](std::size_t first, std::size_t count, unsigned char* out) {
                          for (std::size_t p = 0; p < count; ++p)
-                           std::memcpy(out + 24 * p, &nodes.x[3 * points_[first + p]], 24);
+                           std::memcpy(out + 24 * p, &nodes.x[3 * points[first + p]], 24);
                        }};
-    grid_.tet_corners = {"connectivity", "Int64", 4, cells_.size(),
-                         [this, &tets](std::size_t first, std::size_t count, unsigned char* out) {
+    grid_.tet_corners = {"connectivity", "Int64", 4, cells.size(),
+                         [this, &tets, cells](std::size_t first, std::size_t count,
+                                              unsigned char* out) {
                            for (std::size_t c = 0; c < count; ++c)
                              for (int k = 0; k < 4; ++k) {
-                               const LocalIndex n = tets.nodes[4 * cells_[first + c] + k];
-                               const auto point = static_cast<std::int64_t>(renumbered_[n]);
+                               const LocalIndex n = tets.nodes[4 * cells[first + c] + k];
+                               const auto point =
+                                   static_cast<std::int64_t>(identity_ ? n : renumbered_[n]);
                                std::memcpy(out + 32 * c + 8 * k, &point, 8);
                              }
                          }};
@@ -193,6 +209,7 @@ class OwnedTetGrid {
   const VtuGrid& grid() const { return grid_; }
 
  private:
+  bool identity_ = false;  // every local tet and node written, in local order
   std::vector<LocalIndex> cells_, renumbered_, points_;  // points: local nodes written, ascending
   std::vector<FrameColumn> columns_;
   VtuGrid grid_;
