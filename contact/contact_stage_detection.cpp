@@ -176,6 +176,11 @@ void ContactStage::run_detection(const Model& model, const double* x) {
   const auto keep = [&](LocalIndex a, LocalIndex b) { return keeps(model, x, tet(a), tet(b)); };
   const auto n = all ? model.tets.size() : static_cast<LocalIndex>(members.size());
   detector_.detect(lo_.data(), hi_.data(), n, buffer_, pairs_, keep);
+  // Boxes and grids are rebuilt by every detection: not held between them (~150 B per tet that may
+  // pair, most of what a large jointed body's run holds above its model).
+  detector_.release_workspace();
+  lo_ = {};
+  hi_ = {};
   if (!all)
     for (CandidatePair& p : pairs_) p = {tet(p.a), tet(p.b)};
   may_hold_friction_.assign(pairs_.size(), 1);

@@ -163,7 +163,11 @@ const PieceInfo& PieceTable::operator[](std::int32_t piece) const {
 
 std::int32_t count_fragments(const Model& model) {
   // Without joints the pieces at t = 0 are the connected components, and they stay so.
-  if (model.joints.size() == 0) return static_cast<std::int32_t>(model.pieces.size());
+  // With joints, while none has broken, too (a piece is a connected set of tets and joints).
+  if (model.joints.size() == 0 ||
+      std::find(model.joints.broken.begin(), model.joints.broken.end(), 1) ==
+          model.joints.broken.end())
+    return static_cast<std::int32_t>(model.pieces.size());
   // Union-find over nodes: a tet links its four nodes; an intact joint links its two tets.
   const LocalIndex n_nodes = model.nodes.size();
   std::vector<LocalIndex> parent(n_nodes);

@@ -83,6 +83,14 @@ StiffnessBounds stiffness_bounds(const Mat3& G, double volume, LameParameters la
   return out;
 }
 
+// The smallest float not below x (+infinity beyond float's range).
+float float_at_least(double x) {
+  if (!(x <= std::numeric_limits<float>::max())) return std::numeric_limits<float>::infinity();
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
 Mat3 second_moments(const Eigen::Matrix<double, 3, 4>& g, const double (&corner_mass)[4]) {
   Mat3 G = Mat3::Zero();
   for (int a = 0; a < 4; ++a) G += g.col(a) * g.col(a).transpose() / corner_mass[a];
@@ -96,30 +104,40 @@ double critical_time_step_lower_bound(const Model& model) {
   const NodeArrays& nodes = model.nodes;
   const LocalIndex n_tets = tets.size();
   const double unit[4] = {1.0, 1.0, 1.0, 1.0};
-  // Pass 1: bounds of each tet's weight (critical_time_step's λ_max with unit masses) and the sum
-  // of the upper bounds at each node.
-  std::vector<StiffnessBounds> weight(n_tets, StiffnessBounds{0.0, 0.0});
-  std::vector<double> node_upper(nodes.size(), 0.0);
+  // Bounds of a tet's weight (critical_time_step's λ_max with unit masses), computed in each pass
+  // rather than stored (16 B per tet at the run's memory peak).
+  const auto weight_of = [&](LocalIndex t, const TetReference& current) {
+    if (!(current.volume > 0.0)) return StiffnessBounds{0.0, 0.0};  // not in the exact split either
+    return stiffness_bounds(second_moments(shape_gradients(current.dm_inv), unit), current.volume,
+                            model.materials[tets.material[t]].lame);
+  };
+  // Pass 1: the sum of the upper bounds at each node, held in single precision rounded up (an
+  // upper bound still; 4 B per node instead of 8).
+  std::vector<float> node_upper(static_cast<std::size_t>(nodes.size()), 0.0f);
   for (LocalIndex t = 0; t < n_tets; ++t) {
-    const TetReference current = current_shape(model, t);
-    if (!(current.volume > 0.0)) continue;  // not in the exact split either
-    weight[t] = stiffness_bounds(second_moments(shape_gradients(current.dm_inv), unit),
-                                 current.volume, model.materials[tets.material[t]].lame);
-    for (int c = 0; c < 4; ++c) node_upper[tets.nodes[4 * t + c]] += weight[t].upper;
+    const double upper = weight_of(t, current_shape(model, t)).upper;
+    if (upper <= 0.0) continue;
+    for (int c = 0; c < 4; ++c) {
+      float& sum = node_upper[static_cast<std::size_t>(tets.nodes[4 * t + c])];
+      sum = float_at_least(static_cast<double>(sum) + upper);
+    }
   }
   // Pass 2: the corner mass m·w/(w + Σ others) is at least m·w_lo/(w_lo + Σ others' upper bounds)
   // (the sum, taken as a difference, is rounded up by a relative 1e-12).
   double dt = std::numeric_limits<double>::infinity();
   for (LocalIndex t = 0; t < n_tets; ++t) {
-    if (weight[t].upper <= 0.0 || !tets.is_owned(t)) continue;
+    if (!tets.is_owned(t)) continue;
+    const TetReference current = current_shape(model, t);
+    const StiffnessBounds weight = weight_of(t, current);
+    if (weight.upper <= 0.0) continue;
     double corner_mass[4];
     for (int c = 0; c < 4; ++c) {
       const LocalIndex n = tets.nodes[4 * t + c];
-      const double others = std::max(0.0, node_upper[n] - weight[t].upper) * (1.0 + 1e-12);
-      corner_mass[c] = nodes.mass[n] * weight[t].lower / (weight[t].lower + others);
+      const double sum = node_upper[static_cast<std::size_t>(n)];
+      const double others = std::max(0.0, sum - weight.upper) * (1.0 + 1e-12);
+      corner_mass[c] = nodes.mass[n] * weight.lower / (weight.lower + others);
     }
     const MaterialProperties& mat = model.materials[tets.material[t]];
-    const TetReference current = current_shape(model, t);
     const double omega_sq =
         stiffness_bounds(second_moments(shape_gradients(current.dm_inv), corner_mass),
                          current.volume, mat.lame)
