@@ -161,34 +161,49 @@ const PieceInfo& PieceTable::operator[](std::int32_t piece) const {
   return kept_[static_cast<std::size_t>(s)];
 }
 
-std::int32_t count_fragments(const Model& model) {
-  // Without joints the pieces at t = 0 are the connected components, and they stay so.
-  // With joints, while none has broken, too (a piece is a connected set of tets and joints).
-  if (model.joints.size() == 0 ||
-      std::find(model.joints.broken.begin(), model.joints.broken.end(), 1) ==
-          model.joints.broken.end())
-    return static_cast<std::int32_t>(model.pieces.size());
-  // Union-find over nodes: a tet links its four nodes; an intact joint links its two tets.
-  const LocalIndex n_nodes = model.nodes.size();
-  std::vector<LocalIndex> parent(n_nodes);
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&](LocalIndex i) {
+namespace {
+
+// Union-find over n entries, the smaller index the root.
+struct UnionFind {
+  std::vector<LocalIndex> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  LocalIndex find(LocalIndex i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
-  };
-  const auto unite = [&](LocalIndex a, LocalIndex b) {
+  }
+  void unite(LocalIndex a, LocalIndex b) {
     a = find(a);
     b = find(b);
     if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  };
-  const TetArrays& tets = model.tets;
-  for (LocalIndex t = 0; t < tets.size(); ++t)
-    for (int c = 1; c < 4; ++c) unite(tets.nodes[4 * t], tets.nodes[4 * t + c]);
+  }
+};
+
+}  // namespace
+
+std::int32_t count_fragments(const Model& model) {
+  // Without joints the pieces at t = 0 are the connected components, and they stay so.
+  if (model.joints.size() == 0) return static_cast<std::int32_t>(model.pieces.size());
   const JointArrays& joints = model.joints;
+  const TetArrays& tets = model.tets;
+  // While no joint has broken, the pieces linked by joints (interface joints join bodies): a
+  // union-find over pieces, not over nodes (5 B per node was the end of a large run's peak).
+  if (std::find(joints.broken.begin(), joints.broken.end(), 1) == joints.broken.end()) {
+    UnionFind pieces(model.pieces.size());
+    for (LocalIndex j = 0; j < joints.size(); ++j)
+      pieces.unite(tets.piece[joints.tets[2 * j]], tets.piece[joints.tets[2 * j + 1]]);
+    std::int32_t roots = 0;
+    for (std::size_t p = 0; p < model.pieces.size(); ++p)
+      roots += pieces.find(static_cast<LocalIndex>(p)) == static_cast<LocalIndex>(p) ? 1 : 0;
+    return roots;
+  }
+  // Union-find over nodes: a tet links its four nodes; an intact joint links its two tets.
+  UnionFind nodes(static_cast<std::size_t>(model.nodes.size()));
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    for (int c = 1; c < 4; ++c) nodes.unite(tets.nodes[4 * t], tets.nodes[4 * t + c]);
   for (LocalIndex j = 0; j < joints.size(); ++j)
-    if (!joints.broken[j]) unite(joints.nodes[6 * j], joints.nodes[6 * j + 3]);
-  std::vector<char> is_root(n_nodes, 0);
-  for (LocalIndex t = 0; t < tets.size(); ++t) is_root[find(tets.nodes[4 * t])] = 1;
+    if (!joints.broken[j]) nodes.unite(joints.nodes[6 * j], joints.nodes[6 * j + 3]);
+  std::vector<char> is_root(static_cast<std::size_t>(model.nodes.size()), 0);
+  for (LocalIndex t = 0; t < tets.size(); ++t) is_root[nodes.find(tets.nodes[4 * t])] = 1;
   return static_cast<std::int32_t>(std::count(is_root.begin(), is_root.end(), 1));
 }
 
