@@ -200,7 +200,8 @@ std::vector<double> ContactStage::positions_at_detection(const Model& model) con
 double ContactStage::travel_since_detection(const Model& model) const {
   if (!detected_) return 0.0;
   const double* x = model.nodes.x.data();
-  if (every_node_kept_) return max_node_displacement(x, x_at_detection_.data(), model.nodes.n_owned);
+  if (every_node_kept_)
+    return max_node_displacement(x, x_at_detection_.data(), model.nodes.n_owned);
   return max_node_displacement(x, x_at_detection_.data(), kept_nodes_.data(), kept_owned_);
 }
 

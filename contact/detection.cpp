@@ -20,8 +20,8 @@ double max_node_displacement(const double* x, const double* x_at_detection, Loca
   return std::sqrt(max_squared);
 }
 
-double max_node_displacement(const double* x, const double* x_at_detection,
-                             const LocalIndex* nodes, std::size_t count) {
+double max_node_displacement(const double* x, const double* x_at_detection, const LocalIndex* nodes,
+                             std::size_t count) {
   double max_squared = 0.0;
   for (std::size_t k = 0; k < count; ++k) {
     const double* p = x + 3 * static_cast<std::size_t>(nodes[k]);

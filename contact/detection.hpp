@@ -20,8 +20,8 @@ inline bool detection_needed(double max_travel, double buffer) {
 // that the caller always re-detects (and the detector then reports the non-finite box).
 double max_node_displacement(const double* x, const double* x_at_detection, LocalIndex n_nodes);
 // The same over the listed nodes only: x_at_detection holds 3 values per listed node, in order.
-double max_node_displacement(const double* x, const double* x_at_detection,
-                             const LocalIndex* nodes, std::size_t count);
+double max_node_displacement(const double* x, const double* x_at_detection, const LocalIndex* nodes,
+                             std::size_t count);
 
 // How far the nodes went, measured after a step: the largest travel since the last detection
 // (m, decides whether the next step detects; ContactStage::travel_since_detection) and the largest

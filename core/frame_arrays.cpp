@@ -36,11 +36,9 @@ FrameColumn filtered(const FrameField& f, std::size_t all_entries, LocalSelectio
   FDEM_VERIFY(f.values.size() == all_entries * static_cast<std::size_t>(f.components),
               "frame field size");
   const int n = f.components;
-  return real_column(f.name, f.per_cell, n, kept.size(),
-                     [&f, kept, n](std::size_t r, double* out) {
-                       for (int c = 0; c < n; ++c)
-                         out[c] = f.values[static_cast<std::size_t>(kept[r]) * n + c];
-                     });
+  return real_column(f.name, f.per_cell, n, kept.size(), [&f, kept, n](std::size_t r, double* out) {
+    for (int c = 0; c < n; ++c) out[c] = f.values[static_cast<std::size_t>(kept[r]) * n + c];
+  });
 }
 
 }  // namespace
@@ -91,8 +89,9 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, LocalSelection ce
   const std::size_t n_points = points.size(), n_cells = cells.size();
   std::vector<FrameColumn> columns;
 
-  columns.push_back(integer_column("gid", false, FrameValue::i64, n_points,
-                                   [&nodes, points](std::size_t p) { return nodes.gid[points[p]]; }));
+  columns.push_back(
+      integer_column("gid", false, FrameValue::i64, n_points,
+                     [&nodes, points](std::size_t p) { return nodes.gid[points[p]]; }));
   if (wants("displacement"))
     columns.push_back(
         real_column("displacement", false, 3, n_points, [&nodes, points](std::size_t p, double* u) {
@@ -102,8 +101,8 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, LocalSelection ce
   if (wants("velocity"))
     columns.push_back(
         real_column("velocity", false, 3, n_points, [&nodes, points](std::size_t p, double* v) {
-      for (int k = 0; k < 3; ++k) v[k] = nodes.v[3 * points[p] + k];
-    }));
+          for (int k = 0; k < 3; ++k) v[k] = nodes.v[3 * points[p] + k];
+        }));
 
   const auto cell_integers = [&](const char* name, FrameValue type, auto value_of) {
     columns.push_back(integer_column(name, true, type, n_cells, [cells, value_of](std::size_t c) {
@@ -119,16 +118,16 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, LocalSelection ce
   if (wants("stress")) {
     columns.push_back(
         real_column("stress", true, 9, n_cells, [&model, cells](std::size_t c, double* sigma) {
-      const Mat3 cauchy = elastic_cauchy_stress(model, cells[c]);
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) sigma[3 * i + j] = cauchy(i, j);
-    }));
+          const Mat3 cauchy = elastic_cauchy_stress(model, cells[c]);
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) sigma[3 * i + j] = cauchy(i, j);
+        }));
     columns.push_back(
         real_column("von_mises", true, 1, n_cells, [&model, cells](std::size_t c, double* mises) {
-      const Mat3 cauchy = elastic_cauchy_stress(model, cells[c]);
-      const Mat3 dev = cauchy - cauchy.trace() / 3.0 * Mat3::Identity();
-      *mises = std::sqrt(1.5 * dev.squaredNorm());
-    }));
+          const Mat3 cauchy = elastic_cauchy_stress(model, cells[c]);
+          const Mat3 dev = cauchy - cauchy.trace() / 3.0 * Mat3::Identity();
+          *mises = std::sqrt(1.5 * dev.squaredNorm());
+        }));
   }
   for (const FrameField& f : extra)
     columns.push_back(f.per_cell ? filtered(f, static_cast<std::size_t>(tets.size()), cells)

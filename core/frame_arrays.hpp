@@ -57,7 +57,7 @@ struct FrameColumn {
 // selection, or all of 0 … n−1 (a rank that writes every local tet and node builds no list).
 class LocalSelection {
  public:
-  LocalSelection() = default;  // none
+  LocalSelection() = default;                          // none
   LocalSelection(const std::vector<LocalIndex>& list)  // NOLINT(google-explicit-constructor)
       : list_(&list), size_(list.size()) {}
   static LocalSelection first(std::size_t n) {

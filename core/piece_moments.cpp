@@ -76,7 +76,8 @@ Vec3 rotation_of(const PieceSpread& spread) {
 OwnedPieces owned_pieces(const NodeArrays& nodes) {
   OwnedPieces owned;
   for (LocalIndex n = 0; n < nodes.n_owned; ++n)
-    if (owned.ids.empty() || owned.ids.back() != nodes.piece[n]) owned.ids.push_back(nodes.piece[n]);
+    if (owned.ids.empty() || owned.ids.back() != nodes.piece[n])
+      owned.ids.push_back(nodes.piece[n]);
   std::sort(owned.ids.begin(), owned.ids.end());
   owned.ids.erase(std::unique(owned.ids.begin(), owned.ids.end()), owned.ids.end());
   owned.ids.shrink_to_fit();

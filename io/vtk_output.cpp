@@ -192,17 +192,16 @@ class OwnedTetGrid {
                          for (std::size_t p = 0; p < count; ++p)
                            std::memcpy(out + 24 * p, &nodes.x[3 * points[first + p]], 24);
                        }};
-    grid_.tet_corners = {"connectivity", "Int64", 4, cells.size(),
-                         [this, &tets, cells](std::size_t first, std::size_t count,
-                                              unsigned char* out) {
-                           for (std::size_t c = 0; c < count; ++c)
-                             for (int k = 0; k < 4; ++k) {
-                               const LocalIndex n = tets.nodes[4 * cells[first + c] + k];
-                               const auto point =
-                                   static_cast<std::int64_t>(identity_ ? n : renumbered_[n]);
-                               std::memcpy(out + 32 * c + 8 * k, &point, 8);
-                             }
-                         }};
+    grid_.tet_corners = {
+        "connectivity", "Int64", 4, cells.size(),
+        [this, &tets, cells](std::size_t first, std::size_t count, unsigned char* out) {
+          for (std::size_t c = 0; c < count; ++c)
+            for (int k = 0; k < 4; ++k) {
+              const LocalIndex n = tets.nodes[4 * cells[first + c] + k];
+              const auto point = static_cast<std::int64_t>(identity_ ? n : renumbered_[n]);
+              std::memcpy(out + 32 * c + 8 * k, &point, 8);
+            }
+        }};
   }
   OwnedTetGrid(const OwnedTetGrid&) = delete;
   OwnedTetGrid& operator=(const OwnedTetGrid&) = delete;

@@ -3,7 +3,9 @@
 // hold.  Leaving them out changes no force (no left-out pair overlaps in a body deformed within
 // its joints' reach) and a broken joint of the body brings them back.
 #include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
+#include <memory>
 #include <random>
 #include <set>
 
@@ -15,6 +17,25 @@ using namespace fdem;
 using fdem::testing::jointed_scene;
 using fdem::testing::kuhn_cube;
 using fdem::testing::pairs_of;
+
+namespace {
+
+// Two stages of `model`, detected once: [0] leaves the enclosed tets out, [1] keeps them.  Pairs
+// are narrowed by face planes only: the exact distance would drop the enclosed tets' pairs of the
+// pressed cube too (test_tet_distance.cpp), leaving nothing for the skip to show.
+std::array<std::unique_ptr<ContactStage>, 2> detected_stages(const Model& model, double buffer) {
+  std::array<std::unique_ptr<ContactStage>, 2> stages = {
+      std::make_unique<ContactStage>(model, ContactSettings{buffer, true, false}),
+      std::make_unique<ContactStage>(model, ContactSettings{buffer, false, false})};
+  for (const auto& stage : stages) {
+    stage->set_bonds(model.tets.size(), testing::joint_bonds(model));
+    stage->enclose(model.tets.enclosed);
+    stage->detect(model);
+  }
+  return stages;
+}
+
+}  // namespace
 
 TEST_CASE("build_model marks the jointed tets with no corner on the mesh boundary as enclosed",
           "[contact][enclosed]") {
@@ -43,15 +64,9 @@ TEST_CASE("enclosed tets stay out of contact, change no force, and return when a
   // by 0.5 % of a cell, so its tets press into each other across the joints.
   Model model = testing::pressed_jointed_cube();
   const double buffer = 0.025;
-  // Narrowed by face planes only: the exact distance would drop the enclosed tets' pairs of
-  // this scene too (test_tet_distance.cpp), leaving nothing for the skip to show.
-  ContactStage skipping(model, ContactSettings{buffer, true, false});
-  ContactStage all(model, ContactSettings{buffer, false, false});
-  for (ContactStage* stage : {&skipping, &all}) {
-    stage->set_bonds(model.tets.size(), testing::joint_bonds(model));
-    stage->enclose(model.tets.enclosed);
-    stage->detect(model);
-  }
+  const auto stages = detected_stages(model, buffer);
+  ContactStage& skipping = *stages[0];
+  ContactStage& all = *stages[1];
   const long n_enclosed = std::count(model.tets.enclosed.begin(), model.tets.enclosed.end(), 1);
   REQUIRE(n_enclosed == 6 * 27);
   CHECK(skipping.left_out() == n_enclosed);
@@ -100,13 +115,9 @@ TEST_CASE("positions at detection are kept for the nodes of tets that may pair o
           "[contact][enclosed]") {
   Model model = testing::pressed_jointed_cube();
   const double buffer = 0.025;
-  ContactStage skipping(model, ContactSettings{buffer, true, false});
-  ContactStage all(model, ContactSettings{buffer, false, false});
-  for (ContactStage* stage : {&skipping, &all}) {
-    stage->set_bonds(model.tets.size(), testing::joint_bonds(model));
-    stage->enclose(model.tets.enclosed);
-    stage->detect(model);
-  }
+  const auto stages = detected_stages(model, buffer);
+  ContactStage& skipping = *stages[0];
+  ContactStage& all = *stages[1];
   REQUIRE(skipping.left_out() > 0);
   // A node of enclosed tets only (the jointed cube's tets have their own nodes) and a node of a
   // tet that may pair.
