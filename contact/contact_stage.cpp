@@ -160,7 +160,6 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
 
 void ContactStage::keep_positions(const Model& model, const double* x) {
   const std::size_t n_nodes = static_cast<std::size_t>(model.nodes.size());
-  kept_owned_ = 0;
   if (left_out_count_ == 0) {
     every_node_kept_ = true;
     kept_nodes_ = {};
@@ -181,7 +180,6 @@ void ContactStage::keep_positions(const Model& model, const double* x) {
     if (!kept[i]) continue;
     std::copy_n(x + 3 * i, 3, positions.data() + 3 * nodes.size());
     nodes.push_back(static_cast<LocalIndex>(i));
-    if (static_cast<LocalIndex>(i) < model.nodes.n_owned) ++kept_owned_;
   }
   kept_nodes_ = std::move(nodes);
   x_at_detection_ = std::move(positions);
@@ -202,7 +200,11 @@ double ContactStage::travel_since_detection(const Model& model) const {
   const double* x = model.nodes.x.data();
   if (every_node_kept_)
     return max_node_displacement(x, x_at_detection_.data(), model.nodes.n_owned);
-  return max_node_displacement(x, x_at_detection_.data(), kept_nodes_.data(), kept_owned_);
+  // Owned nodes come first: the kept ones below n_owned.
+  const auto owned = static_cast<std::size_t>(
+      std::lower_bound(kept_nodes_.begin(), kept_nodes_.end(), model.nodes.n_owned) -
+      kept_nodes_.begin());
+  return max_node_displacement(x, x_at_detection_.data(), kept_nodes_.data(), owned);
 }
 
 std::vector<GidPair> ContactStage::candidate_gids(const Model& model) const {

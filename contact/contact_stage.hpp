@@ -183,7 +183,6 @@ class ContactStage {
   // enclosed tets hold most of its nodes, whose positions no detection needs (24 B per node).
   std::vector<double> x_at_detection_;
   std::vector<LocalIndex> kept_nodes_;
-  std::size_t kept_owned_ = 0;  // kept_nodes_ below NodeArrays::n_owned (they come first)
   bool every_node_kept_ = true;
   // Keeps the positions x of the nodes the last mark_left_out() lets pair (or all of them).
   void keep_positions(const Model& model, const double* x);

@@ -163,11 +163,12 @@ class OwnedTetGrid {
     const TetArrays& tets = model.tets;
     const auto n_nodes = static_cast<std::size_t>(nodes.size());
     std::size_t owned = 0;
-    for (LocalIndex t = 0; t < tets.size(); ++t) owned += tets.is_owned(t) ? 1 : 0;
     std::vector<bool> used(n_nodes, false);
     for (LocalIndex t = 0; t < tets.size(); ++t)
-      if (tets.is_owned(t))
+      if (tets.is_owned(t)) {
+        ++owned;
         for (int c = 0; c < 4; ++c) used[static_cast<std::size_t>(tets.nodes[4 * t + c])] = true;
+      }
     const auto n_used = static_cast<std::size_t>(std::count(used.begin(), used.end(), true));
     identity_ = owned == static_cast<std::size_t>(tets.size()) && n_used == n_nodes;
     if (!identity_) {
