@@ -18,9 +18,12 @@ set(CMAKE_CXX_FLAGS_RELWITHDEBINFO "-O2 -g1 -DNDEBUG")
 # -ffp-contract=off: no a·b + c fused into one rounding where the CPU has FMA (-march=native, the
 # AVX2 clones), so every build rounds as the x86-64 baseline does and the kernels written twice
 # (one joint and four lanes) give the same bits.
+# -Wno-psabi: GCC notes that an AVX vector passed by value has another ABI without AVX; the
+# four-lane kernels' helpers (core/lanes.hpp) are inline, and the dispatched kernels take their
+# batches by reference, so no vector crosses a call between differently built code.
 function(fdem_target_options target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wno-unused-parameter
-                                           -ffp-contract=off)
+                                           -Wno-psabi -ffp-contract=off)
   if(FDEM_NATIVE)
     target_compile_options(${target} PRIVATE -march=native)
   endif()

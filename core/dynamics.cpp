@@ -2,67 +2,137 @@
 
 #include <cmath>
 
-#include "core/tet_kernels.hpp"
+#include "core/tet_force_kernel.hpp"
 
 namespace fdem {
 
 namespace {
 
-// The per-tet kernel is too large for the compiler's inlining heuristics; inlining it into the
-// element loop anyway (GCC, Clang) saves the call and the TetForce copy: ~5-10 % on the stage.
-#if defined(__GNUC__)
-#define FDEM_INLINE_CALLEES __attribute__((flatten))
-#else
-#define FDEM_INLINE_CALLEES
-#endif
+// What the element loop hands a scatter: tet t's force on corner c (node n), in N.
+using CornerForce = const double (&)[3];
 
-template <class Material, class Scatter>
-FDEM_INLINE_CALLEES inline void add_tet_force(const TetArrays& tets, LocalIndex t,
-                                              const Material& material, NodeArrays& nodes,
-                                              InternalForceSummary& sum, Scatter&& scatter) {
-  const double viscosity = tets.viscosity[t];
-  const LocalIndex* corner_node = tets.nodes.data() + 4 * static_cast<std::size_t>(t);
-  Vec3 x[4], v[4];
-  for (int c = 0; c < 4; ++c) x[c] = vec3_at(nodes.x.data(), corner_node[c]);
-  // The kernel reads velocities only for viscous damping: skip that gather when undamped.
-  for (int c = 0; c < 4; ++c)
-    v[c] = viscosity > 0.0 ? Vec3(vec3_at(nodes.v.data(), corner_node[c])) : Vec3::Zero();
-  const Eigen::Map<const Mat3> dm_inv(tets.dm_inv.data() + 9 * static_cast<std::size_t>(t));
-  const TetForce out = tet_internal_force(x, v, dm_inv, tets.volume0[t], material, viscosity);
-  for (int c = 0; c < 4; ++c) scatter(c, corner_node[c], out.force[c]);
+// One tet's result into the summary, in the order the tets are computed.
+inline void add_to_summary(const TetArrays& tets, LocalIndex t, double strain_energy,
+                           double damping_power, double jacobian, InternalForceSummary& sum) {
   if (tets.is_owned(t)) {  // halo tets are computed for their forces; their owner reports them
-    sum.strain_energy += out.strain_energy;
-    sum.damping_power += out.damping_power;
+    sum.strain_energy += strain_energy;
+    sum.damping_power += damping_power;
   }
-  if (!(out.jacobian >= sum.min_jacobian)) {  // NaN counts as worst
-    sum.min_jacobian = out.jacobian;
+  if (!(jacobian >= sum.min_jacobian)) {  // NaN counts as worst
+    sum.min_jacobian = jacobian;
     sum.min_jacobian_tet = t;
   }
 }
 
-// Runs `body(material)` with the tet's material law as a value type.
-template <class Body>
-inline void with_material(const MaterialProperties& mat, Body&& body) {
-  if (mat.model == ElasticModel::neo_hookean)
-    body(NeoHookean{mat.lame});
+template <class Scatter>
+void add_one_tet(const Model& model, LocalIndex t, InternalForceSummary& sum, Scatter& scatter) {
+  const TetArrays& tets = model.tets;
+  const double* x = model.nodes.x.data();
+  const double* v = model.nodes.v.data();
+  const MaterialProperties& material = model.materials[tets.material[t]];
+  const double viscosity = tets.viscosity[t];
+  const LocalIndex* corner_node = tets.nodes.data() + 4 * static_cast<std::size_t>(t);
+  double xs[4][3], vs[4][3] = {}, dm_inv[9];
+  for (int c = 0; c < 4; ++c)
+    for (int k = 0; k < 3; ++k) {
+      xs[c][k] = x[3 * static_cast<std::size_t>(corner_node[c]) + k];
+      if (viscosity > 0.0) vs[c][k] = v[3 * static_cast<std::size_t>(corner_node[c]) + k];
+    }
+  for (int e = 0; e < 9; ++e) dm_inv[e] = tets.dm_inv[9 * static_cast<std::size_t>(t) + e];
+  TetCornerForces<double> out;
+  const double lambda = material.lame.lambda, mu = material.lame.mu;
+  if (material.model == ElasticModel::neo_hookean)
+    tet_corner_forces(xs, vs, dm_inv, tets.volume0[t], NeoHookeanLaw<double>{lambda, mu}, viscosity,
+                      viscosity > 0.0, out);
   else
-    body(StVenantKirchhoff{mat.lame});
+    tet_corner_forces(xs, vs, dm_inv, tets.volume0[t], StVenantKirchhoffLaw<double>{lambda, mu},
+                      viscosity, viscosity > 0.0, out);
+  for (int c = 0; c < 4; ++c) scatter(t, c, corner_node[c], out.force[c]);
+  add_to_summary(tets, t, out.strain_energy, out.damping_power, out.jacobian, sum);
+}
+
+// Four tets of one elastic model side by side (core/tet_force_kernel.hpp); their forces are then
+// scattered tet by tet in the given order, so every node sums its contributions as one tet at a
+// time would.
+template <class Scatter>
+void add_four_tets(const Model& model, const LocalIndex (&t)[lane_count], ElasticModel law,
+                   TetLaneBatch& b, InternalForceSummary& sum, Scatter& scatter) {
+  const TetArrays& tets = model.tets;
+  const double* x = model.nodes.x.data();
+  const double* v = model.nodes.v.data();
+  const LocalIndex* node[lane_count];
+  for (int l = 0; l < lane_count; ++l)
+    node[l] = tets.nodes.data() + 4 * static_cast<std::size_t>(t[l]);
+  const auto gather = [&](const double* values, Lanes(&into)[4][3]) {
+    for (int c = 0; c < 4; ++c) {
+      const double* p[lane_count];
+      for (int l = 0; l < lane_count; ++l) p[l] = values + 3 * static_cast<std::size_t>(node[l][c]);
+      for (int k = 0; k < 3; ++k) into[c][k] = Lanes{p[0][k], p[1][k], p[2][k], p[3][k]};
+    }
+  };
+  const auto per_tet = [&](const std::vector<double>& values, std::size_t width, int e) {
+    const auto at = [&](int l) { return values[width * static_cast<std::size_t>(t[l]) + e]; };
+    return Lanes{at(0), at(1), at(2), at(3)};
+  };
+  gather(x, b.x);
+  for (int e = 0; e < 9; ++e) b.dm_inv[e] = per_tet(tets.dm_inv, 9, e);
+  b.volume0 = per_tet(tets.volume0, 1, 0);
+  b.viscosity = per_tet(tets.viscosity, 1, 0);
+  b.any_viscous = false;
+  for (int l = 0; l < lane_count; ++l) b.any_viscous = b.any_viscous || b.viscosity[l] > 0.0;
+  if (b.any_viscous) gather(v, b.v);
+  const auto lame = [&](int l) { return model.materials[tets.material[t[l]]].lame; };
+  b.lambda = Lanes{lame(0).lambda, lame(1).lambda, lame(2).lambda, lame(3).lambda};
+  b.mu = Lanes{lame(0).mu, lame(1).mu, lame(2).mu, lame(3).mu};
+  if (law == ElasticModel::neo_hookean)
+    neo_hookean_tet_lanes(b);
+  else
+    st_venant_kirchhoff_tet_lanes(b);
+  for (int l = 0; l < lane_count; ++l) {
+    for (int c = 0; c < 4; ++c) {
+      const double force[3] = {b.out.force[c][0][l], b.out.force[c][1][l], b.out.force[c][2][l]};
+      scatter(t[l], c, node[l][c], force);
+    }
+    add_to_summary(tets, t[l], b.out.strain_energy[l], b.out.damping_power[l], b.out.jacobian[l],
+                   sum);
+  }
+}
+
+// The internal forces of the tets listed, in list order: four at a time where four consecutive
+// tets share an elastic model, else one by one.  scatter(t, c, n, force) takes each corner force.
+template <class Scatter>
+void add_tet_forces(const Model& model, const LocalIndex* list, std::size_t count,
+                    InternalForceSummary& sum, Scatter&& scatter) {
+  const TetArrays& tets = model.tets;
+  TetLaneBatch batch;
+  std::size_t i = 0;
+  for (; i + lane_count <= count; i += lane_count) {
+    const LocalIndex t[lane_count] = {list[i], list[i + 1], list[i + 2], list[i + 3]};
+    const ElasticModel law = model.materials[tets.material[t[0]]].model;
+    bool same = true;
+    for (int l = 1; l < lane_count; ++l)
+      same = same && model.materials[tets.material[t[l]]].model == law;
+    if (same) {
+      add_four_tets(model, t, law, batch, sum, scatter);
+      continue;
+    }
+    for (const LocalIndex one : t) add_one_tet(model, one, sum, scatter);
+  }
+  for (; i < count; ++i) add_one_tet(model, list[i], sum, scatter);
 }
 
 }  // namespace
 
 InternalForceSummary compute_internal_forces(Model& model) {
-  const TetArrays& tets = model.tets;
   NodeArrays& nodes = model.nodes;
   std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
   InternalForceSummary sum;
   double* f = nodes.f.data();
-  const auto add_to_node = [f](int, LocalIndex n, const Vec3& force) { vec3_at(f, n) += force; };
   // Tets in ascending global id: each node receives its contributions in that one order.
-  for (const LocalIndex t : model.tet_force_order)
-    with_material(model.materials[tets.material[t]], [&](const auto& material) {
-      add_tet_force(tets, t, material, nodes, sum, add_to_node);
-    });
+  add_tet_forces(model, model.tet_force_order.data(), model.tet_force_order.size(), sum,
+                 [f](LocalIndex, int, LocalIndex n, CornerForce force) {
+                   for (int k = 0; k < 3; ++k) f[3 * static_cast<std::size_t>(n) + k] += force[k];
+                 });
   return sum;
 }
 
@@ -102,31 +172,23 @@ InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& s
   double* corner = split.corner_force.data();
   const LocalIndex* slot = split.corner_slot.data();
   const std::uint8_t* boundary = split.boundary.data();
-  LocalIndex t = 0;  // the tet being computed, for the scatters below
-  const auto parked = [&](int c) {
-    return Eigen::Map<Vec3>(corner + 12 * static_cast<std::size_t>(slot[t]) + 3 * c);
+  const auto parked = [&](LocalIndex t, int c, CornerForce force) {
+    double* to = corner + 12 * static_cast<std::size_t>(slot[t]) + 3 * c;
+    for (int k = 0; k < 3; ++k) to[k] = force[k];
   };
-  const auto early_scatter = [&](int c, LocalIndex n, const Vec3& force) {
+  const auto early_scatter = [&](LocalIndex t, int c, LocalIndex n, CornerForce force) {
     if (boundary[n])
-      parked(c) = force;
+      parked(t, c, force);
     else
-      vec3_at(f, n) += force;
+      for (int k = 0; k < 3; ++k) f[3 * static_cast<std::size_t>(n) + k] += force[k];
   };
-  const auto late_scatter = [&](int c, LocalIndex, const Vec3& force) { parked(c) = force; };
+  const auto late_scatter = [&](LocalIndex t, int c, LocalIndex, CornerForce force) {
+    parked(t, c, force);
+  };
   // Interior work while the ghost positions travel.
-  for (const LocalIndex e : split.early) {
-    t = e;
-    with_material(model.materials[tets.material[t]], [&](const auto& material) {
-      add_tet_force(tets, t, material, nodes, sum, early_scatter);
-    });
-  }
+  add_tet_forces(model, split.early.data(), split.early.size(), sum, early_scatter);
   if (complete_halo) complete_halo();
-  for (const LocalIndex l : split.late) {
-    t = l;
-    with_material(model.materials[tets.material[t]], [&](const auto& material) {
-      add_tet_force(tets, t, material, nodes, sum, late_scatter);
-    });
-  }
+  add_tet_forces(model, split.late.data(), split.late.size(), sum, late_scatter);
   // Boundary nodes: every contribution, in ascending tet gid.
   for (std::size_t k = 0; k < split.boundary_tets.size(); ++k) {
     const LocalIndex b = split.boundary_tets[k];

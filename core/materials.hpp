@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "core/small_matrix.hpp"
 #include "core/types.hpp"
 
 namespace fdem {
@@ -28,18 +29,62 @@ struct StressAndEnergy {
   double energy_density;  // W (J/m^3)
 };
 
+// The laws' arithmetic on F as nine values (column-major), for one element (T = double) or four
+// side by side (T = Lanes): P into `P` (Pa), W returned (J/m^3).  The element kernel's call; the
+// Mat3 interfaces below are defined through them, so there is one formula per law.
+template <class T>
+struct StVenantKirchhoffLaw {
+  T lambda, mu;  // Pa
+  T stress_and_energy(const T (&F)[9], T /*J*/, T (&P)[9]) const {
+    T C[9], E[9], S[9];
+    small_matrix::transposed_product(F, F, C);
+    for (int e = 0; e < 9; ++e) E[e] = 0.5 * (C[e] - identity(e));
+    const T trace = E[0] + (E[4] + E[8]);  // the order of Eigen's trace
+    const T lambda_trace = lambda * trace, two_mu = 2.0 * mu;
+    for (int e = 0; e < 9; ++e) S[e] = lambda_trace * identity(e) + two_mu * E[e];
+    small_matrix::product(F, S, P);
+    return ((0.5 * lambda) * trace) * trace + mu * small_matrix::contraction(E, E);
+  }
+  static double identity(int e) { return e % 4 == 0 ? 1.0 : 0.0; }
+};
+
+template <class T>
+struct NeoHookeanLaw {
+  T lambda, mu;  // Pa
+  // Valid for J > 0 only (the element kernel reports J ≤ 0 as an inverted element).
+  T stress_and_energy(const T (&F)[9], T J, T (&P)[9]) const {
+    const T log_j = log_of(J);  // stress and energy share it
+    T F_inv_T[9];
+    small_matrix::inverse_transposed(F, F_inv_T);
+    const T lambda_log_j = lambda * log_j;
+    for (int e = 0; e < 9; ++e) P[e] = mu * (F[e] - F_inv_T[e]) + lambda_log_j * F_inv_T[e];
+    return ((0.5 * mu) * (small_matrix::contraction(F, F) - 3.0) - mu * log_j) +
+           ((0.5 * lambda) * log_j) * log_j;
+  }
+};
+
+// A law's Mat3 interface over its nine-value arithmetic.
+template <template <class> class Law>
+inline StressAndEnergy stress_and_energy_of(LameParameters lame, const Mat3& F, double J) {
+  double f[9], p[9];
+  for (int e = 0; e < 9; ++e) f[e] = F.data()[e];
+  StressAndEnergy out;
+  out.energy_density = Law<double>{lame.lambda, lame.mu}.stress_and_energy(f, J, p);
+  out.first_piola = Eigen::Map<const Mat3>(p);
+  return out;
+}
+
 // St. Venant–Kirchhoff: S = λ tr(E) I + 2μ E with the Green–St. Venant strain E = ½(FᵀF − I).
 struct StVenantKirchhoff {
   LameParameters lame;
+  template <class T>
+  using Law = StVenantKirchhoffLaw<T>;
 
   // J is not used by this law.
   Mat3 first_piola(const Mat3& F) const { return stress_and_energy(F, 0.0).first_piola; }
   double energy_density(const Mat3& F) const { return stress_and_energy(F, 0.0).energy_density; }
-  StressAndEnergy stress_and_energy(const Mat3& F, double /*J*/) const {
-    const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
-    const double trE = E.trace();
-    const Mat3 S = lame.lambda * trE * Mat3::Identity() + 2.0 * lame.mu * E;
-    return {F * S, 0.5 * lame.lambda * trE * trE + lame.mu * E.squaredNorm()};
+  StressAndEnergy stress_and_energy(const Mat3& F, double J) const {
+    return stress_and_energy_of<StVenantKirchhoffLaw>(lame, F, J);
   }
 };
 
@@ -47,6 +92,8 @@ struct StVenantKirchhoff {
 // Valid for J > 0 only; the element kernel reports J ≤ 0 as an inverted element before calling it.
 struct NeoHookean {
   LameParameters lame;
+  template <class T>
+  using Law = NeoHookeanLaw<T>;
 
   Mat3 first_piola(const Mat3& F) const {
     return stress_and_energy(F, F.determinant()).first_piola;
@@ -54,13 +101,9 @@ struct NeoHookean {
   double energy_density(const Mat3& F) const {
     return stress_and_energy(F, F.determinant()).energy_density;
   }
-  // Stress and energy share one logarithm (the element kernel calls this, with its det F).
+  // Stress and energy share one logarithm (J = det F).
   StressAndEnergy stress_and_energy(const Mat3& F, double J) const {
-    const double logJ = std::log(J);
-    const Mat3 F_inv_T = F.inverse().transpose();
-    return {
-        lame.mu * (F - F_inv_T) + lame.lambda * logJ * F_inv_T,
-        0.5 * lame.mu * (F.squaredNorm() - 3.0) - lame.mu * logJ + 0.5 * lame.lambda * logJ * logJ};
+    return stress_and_energy_of<NeoHookeanLaw>(lame, F, J);
   }
 };
 

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/materials.hpp"
+#include "core/tet_force_kernel.hpp"
 #include "core/types.hpp"
 
 namespace fdem {
@@ -62,38 +63,27 @@ struct TetForce {
   double jacobian;       // det F; ≤ 0 means the element inverted (forces not computed)
 };
 
-// Internal force of one tetrahedron.  x, v: current corner positions (m) and velocities (m/s);
-// viscosity η (Pa·s) adds the viscous Cauchy stress 2η·sym(ḞF⁻¹).
+// Internal force of one tetrahedron (core/tet_force_kernel.hpp with Eigen types).  x, v: current
+// corner positions (m) and velocities (m/s); viscosity η (Pa·s) adds the viscous Cauchy stress
+// 2η·sym(ḞF⁻¹).
 template <class Material>
 inline TetForce tet_internal_force(const Vec3 (&x)[4], const Vec3 (&v)[4], const Mat3& dm_inv,
                                    double volume0, const Material& material, double viscosity) {
+  double xs[4][3], vs[4][3], d[9];
+  for (int c = 0; c < 4; ++c)
+    for (int i = 0; i < 3; ++i) {
+      xs[c][i] = x[c][i];
+      vs[c][i] = v[c][i];
+    }
+  for (int e = 0; e < 9; ++e) d[e] = dm_inv.data()[e];
+  TetCornerForces<double> f;
+  const typename Material::template Law<double> law{material.lame.lambda, material.lame.mu};
+  tet_corner_forces(xs, vs, d, volume0, law, viscosity, viscosity > 0.0, f);
   TetForce out;
-  const Mat3 F = edge_matrix(x) * dm_inv;
-  out.jacobian = F.determinant();
-  if (!(out.jacobian > 0.0)) {  // also catches NaN
-    for (auto& f : out.force) f.setZero();
-    out.strain_energy = 0.0;
-    out.damping_power = 0.0;
-    return out;
-  }
-  const StressAndEnergy elastic = material.stress_and_energy(F, out.jacobian);
-  Mat3 P = elastic.first_piola;
-  out.strain_energy = elastic.energy_density * volume0;
-  out.damping_power = 0.0;
-  if (viscosity > 0.0) {
-    const Mat3 F_dot = edge_matrix(v) * dm_inv;
-    const Mat3 F_inv = F.inverse();
-    const Mat3 L = F_dot * F_inv;
-    const Mat3 sigma_v = viscosity * (L + L.transpose());
-    const Mat3 P_v = out.jacobian * sigma_v * F_inv.transpose();
-    P += P_v;
-    out.damping_power = volume0 * (P_v.cwiseProduct(F_dot)).sum();
-  }
-  const Mat3 H = -volume0 * P * dm_inv.transpose();
-  out.force[1] = H.col(0);
-  out.force[2] = H.col(1);
-  out.force[3] = H.col(2);
-  out.force[0] = -(out.force[1] + out.force[2] + out.force[3]);
+  for (int c = 0; c < 4; ++c) out.force[c] = Vec3(f.force[c][0], f.force[c][1], f.force[c][2]);
+  out.strain_energy = f.strain_energy;
+  out.damping_power = f.damping_power;
+  out.jacobian = f.jacobian;
   return out;
 }
 

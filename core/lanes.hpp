@@ -1,0 +1,31 @@
+// Four doubles side by side: the vector type of the kernels that compute four elements (tets,
+// joints) at once, one per lane.  GCC/Clang vector extensions: one instruction for the four lanes
+// on AVX2, two on the x86-64 baseline (SSE2); every lane rounds exactly as the scalar operation
+// would (builds use -ffp-contract=off, so no a·b + c is fused), which is what lets a kernel written
+// once for `double` and for `Lanes` give the same bits on both.
+#pragma once
+
+#include <cmath>
+
+namespace fdem {
+
+using Lanes = double __attribute__((vector_size(32)));
+using LaneMask = long long __attribute__((vector_size(32)));
+constexpr int lane_count = 4;
+
+// The same operation on one value or on four, for kernels templated on their scalar type.
+inline double select(bool take_first, double a, double b) {
+  return take_first ? a : b;
+}
+// `take_first`: a lane comparison's result (a vector of 64-bit integers, −1 where true).
+template <class Mask>
+inline Lanes select(Mask take_first, Lanes a, Lanes b) {
+  return take_first ? a : b;
+}
+inline double log_of(double x) {
+  return std::log(x);
+}
+inline Lanes log_of(Lanes x) {  // libm's logarithm lane by lane: the scalar path's bits
+  return Lanes{std::log(x[0]), std::log(x[1]), std::log(x[2]), std::log(x[3])};
+}
+}  // namespace fdem
