@@ -41,23 +41,4 @@ double max_node_displacement(const double* x, const double* x_at_detection, cons
                               [nodes](std::size_t k) { return nodes[k]; });
 }
 
-NodeTravel step_travel(const double* v, double dt, LocalIndex n_nodes) {
-  NodeTravel out;
-  double max_speed2 = 0.0;
-  for (LocalIndex i = 0; i < n_nodes; ++i) {
-    const double s2 =
-        v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2];
-    if (!(s2 <= max_speed2)) {  // also true for NaN
-      out.fastest = i;
-      if (std::isnan(s2)) {
-        out.step = std::numeric_limits<double>::infinity();
-        return out;
-      }
-      max_speed2 = s2;
-    }
-  }
-  out.step = dt * std::sqrt(max_speed2);
-  return out;
-}
-
 }  // namespace fdem

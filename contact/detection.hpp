@@ -25,14 +25,12 @@ double max_node_displacement(const double* x, const double* x_at_detection, cons
 
 // How far the nodes went, measured after a step: the largest travel since the last detection
 // (m, decides whether the next step detects; ContactStage::travel_since_detection) and the largest
-// travel of the step itself, dt·|v| (m, the tunnelling guard), with the node that made it.  NaN
-// counts as +infinity.
+// travel of the step itself, |Δx| (m, the tunnelling guard; integrate_central_difference measures
+// it), with the node that made it.  NaN counts as +infinity.
 struct NodeTravel {
   double since_detection = 0.0;
   double step = 0.0;
   LocalIndex fastest = -1;  // node of `step`; −1 when no node moved
 };
-// The step's travel of the first n_nodes nodes (velocities v, 3 per node); since_detection 0.
-NodeTravel step_travel(const double* v, double dt, LocalIndex n_nodes);
 
 }  // namespace fdem

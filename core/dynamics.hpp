@@ -56,8 +56,11 @@ struct IntegrationSummary {
   // unbalanced force Σ|f_k| over free components, the supports' Σ|f_k| over prescribed ones (N),
   // and the mass (kg).
   double unbalanced_force = 0.0, support_force = 0.0, mass = 0.0;
-  double max_displacement_increment = 0.0;  // m, largest |Δx| of a node this step
-  bool finite = true;                       // false if any velocity became NaN or infinite
+  // m, largest |Δx| of a node this step (+inf if one is NaN; the tunnelling guard), and that node
+  // (−1 when none moved).
+  double max_displacement_increment = 0.0;
+  LocalIndex fastest_node = -1;
+  bool finite = true;  // false if any velocity became NaN or infinite
 };
 
 // Central difference: v⁺ = v⁻ + dt·f/m (prescribed components set), x += dt·v⁺, on owned nodes.

@@ -219,7 +219,8 @@ void Simulation::integrate(StepRecord& r) {
   r.contact_after = contact_->work_after(model_, dt_);  // friction and dashpots with v_n+½
   // How far the nodes went: whether the next step must detect, and whether a node crossed more
   // than the thinnest element in this step (tunnelling).
-  r.travel = step_travel(nodes.v.data(), dt_, nodes.n_owned);
+  r.travel.step = r.motion.max_displacement_increment;
+  r.travel.fastest = r.motion.fastest_node;
   r.travel.since_detection = contact_->travel_since_detection(model_);
   r.flags.detection_due = detection_needed(r.travel.since_detection, contact_->buffer());
   r.flags.tunnelling = r.travel.step > tunnel_size_ ? 1.0 : 0.0;
