@@ -125,6 +125,7 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
     pf.owned = it != local.end() && tets.is_owned(it->second);
   }
   detected_ = detected;
+  travel_bound_ = std::numeric_limits<double>::infinity();  // x_at_detection is not x now
   pairs_.clear();
   x_at_detection_ = {};
   kept_nodes_ = {};
@@ -205,6 +206,16 @@ double ContactStage::travel_since_detection(const Model& model) const {
       std::lower_bound(kept_nodes_.begin(), kept_nodes_.end(), model.nodes.n_owned) -
       kept_nodes_.begin());
   return max_node_displacement(x, x_at_detection_.data(), kept_nodes_.data(), owned);
+}
+
+bool ContactStage::detection_due_after_step(const Model& model, double step_travel,
+                                            double largest_coordinate) {
+  // x_n+1 = fl(x_n + Δx) differs from x_n + Δx by at most 2^-53·|x| per component, so a node's
+  // travel in the step is at most |Δx|·(1 + 2^-48) + 2^-51·max|x| (the first factor covers the
+  // rounding of |Δx| as measured).  The sum stays an upper bound of the travel since detection.
+  travel_bound_ += step_travel * (1.0 + 0x1p-48) + 0x1p-51 * largest_coordinate;
+  if (travel_bound_ * (1.0 + 1e-9) <= 0.5 * buffer_) return false;
+  return detection_needed(travel_since_detection(model), buffer_);
 }
 
 std::vector<GidPair> ContactStage::candidate_gids(const Model& model) const {

@@ -4,6 +4,7 @@
 // mesh carries their compression.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -119,6 +120,12 @@ class ContactStage {
   // Largest travel (m) since the last detection of an owned node of the tets that may pair
   // (+infinity for NaN); 0 before the first detection.
   double travel_since_detection(const Model& model) const;
+  // After each integrated step (model.nodes.x at x_n+1): does the next step have to detect
+  // (detection_needed on travel_since_detection)?  `step_travel` is the step's largest node
+  // travel and `largest_coordinate` the largest |x| component after it (m).  The steps' travels
+  // summed with their rounding bound the travel since the detection from above; while that bound
+  // is below the threshold the answer is no without a pass over the nodes.
+  bool detection_due_after_step(const Model& model, double step_travel, double largest_coordinate);
   std::vector<std::uint8_t> tet_joint_states() const;
   bool detected() const { return detected_; }
   // Adds contact forces to model.nodes.f (pairs in ascending (gid, gid) order).
@@ -184,6 +191,9 @@ class ContactStage {
   std::vector<double> x_at_detection_;
   std::vector<LocalIndex> kept_nodes_;
   bool every_node_kept_ = true;
+  // Upper bound of every owned node's travel since the last detection (m): 0 at a detection,
+  // then Σ (step travel + rounding); unknown (+inf) after a rebind until the next detection.
+  double travel_bound_ = std::numeric_limits<double>::infinity();
   // Keeps the positions x of the nodes the last mark_left_out() lets pair (or all of them).
   void keep_positions(const Model& model, const double* x);
   std::vector<CandidatePair> pairs_;

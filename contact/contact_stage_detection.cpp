@@ -103,6 +103,7 @@ void ContactStage::detect(const Model& model) {
       it = kept.count(it->first) ? std::next(it) : friction_.erase(it);
   }
   keep_positions(model, model.nodes.x.data());
+  travel_bound_ = 0.0;
   detected_ = true;
   ++detections_;
 }

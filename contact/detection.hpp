@@ -23,12 +23,10 @@ double max_node_displacement(const double* x, const double* x_at_detection, Loca
 double max_node_displacement(const double* x, const double* x_at_detection, const LocalIndex* nodes,
                              std::size_t count);
 
-// How far the nodes went, measured after a step: the largest travel since the last detection
-// (m, decides whether the next step detects; ContactStage::travel_since_detection) and the largest
-// travel of the step itself, |Δx| (m, the tunnelling guard; integrate_central_difference measures
-// it), with the node that made it.  NaN counts as +infinity.
+// How far the nodes went in a step: the largest travel |Δx| (m, the tunnelling guard and the
+// detection schedule's bound; integrate_central_difference measures it), with the node that made
+// it.  NaN counts as +infinity.
 struct NodeTravel {
-  double since_detection = 0.0;
   double step = 0.0;
   LocalIndex fastest = -1;  // node of `step`; −1 when no node moved
 };

@@ -214,11 +214,13 @@ struct IntegrationSums {
   double kinetic2 = 0.0, kinetic_half2 = 0.0;
   double damping_power_old = 0.0, damping_power_new = 0.0;  // W, Σ f_d·v⁻ and Σ f_d·v⁺
   double max_dx2 = 0.0;     // m², largest |Δx|² of a node (+inf once one is NaN)
+  double max_abs_x = 0.0;   // m, largest |x| component after the step
   LocalIndex fastest = -1;  // its node
   // Free undamped nodes four at a time: twelve components in three vectors, lane l of vector j
   // being component (4j + l) mod 3.
   Lanes kinetic2_lanes[3] = {}, kinetic_half2_lanes[3] = {};
   Lanes momentum_before_lanes[3] = {}, momentum_after_lanes[3] = {};
+  Lanes max_abs_x_lanes = {};
 
   void add_displacement(LocalIndex n, double dx2) {
     if (dx2 <= max_dx2) return;
@@ -266,6 +268,7 @@ inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, std::uint
     nodes.v[i] = v_new;
     const double dx = dt * v_new;
     nodes.x[i] += dx;
+    sum.max_abs_x = std::max(sum.max_abs_x, std::abs(nodes.x[i]));
     dx2 += dx * dx;
   }
   sum.add_displacement(n, dx2);
@@ -295,6 +298,8 @@ inline void integrate_four_free_nodes(double dt, NodeArrays& nodes, LocalIndex n
     sum.momentum_after_lanes[j] += mass[j] * v_new;
     const Lanes step = dt * v_new;
     position += step;
+    const Lanes magnitude = position < 0.0 ? -position : position;
+    sum.max_abs_x_lanes = sum.max_abs_x_lanes < magnitude ? magnitude : sum.max_abs_x_lanes;
     std::memcpy(v + 4 * j, &v_new, sizeof v_new);
     std::memcpy(x + 4 * j, &position, sizeof position);
     std::memcpy(dx + 4 * j, &step, sizeof step);
@@ -366,6 +371,9 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
   out.kinetic_energy_half_step = 0.5 * sum.kinetic_half2;
   out.max_displacement_increment = std::sqrt(sum.max_dx2);
   out.fastest_node = sum.fastest;
+  out.largest_coordinate = sum.max_abs_x;
+  for (int l = 0; l < lane_count; ++l)
+    out.largest_coordinate = std::max(out.largest_coordinate, sum.max_abs_x_lanes[l]);
   out.finite = std::isfinite(sum.kinetic2);
   return out;
 }

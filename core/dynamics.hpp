@@ -60,7 +60,8 @@ struct IntegrationSummary {
   // (−1 when none moved).
   double max_displacement_increment = 0.0;
   LocalIndex fastest_node = -1;
-  bool finite = true;  // false if any velocity became NaN or infinite
+  double largest_coordinate = 0.0;  // m, largest |x| component after the step (its rounding)
+  bool finite = true;               // false if any velocity became NaN or infinite
 };
 
 // Central difference: v⁺ = v⁻ + dt·f/m (prescribed components set), x += dt·v⁺, on owned nodes.

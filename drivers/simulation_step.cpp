@@ -221,8 +221,9 @@ void Simulation::integrate(StepRecord& r) {
   // than the thinnest element in this step (tunnelling).
   r.travel.step = r.motion.max_displacement_increment;
   r.travel.fastest = r.motion.fastest_node;
-  r.travel.since_detection = contact_->travel_since_detection(model_);
-  r.flags.detection_due = detection_needed(r.travel.since_detection, contact_->buffer());
+  r.flags.detection_due =
+      contact_->detection_due_after_step(model_, r.travel.step, r.motion.largest_coordinate) ? 1.0
+                                                                                             : 0.0;
   r.flags.tunnelling = r.travel.step > tunnel_size_ ? 1.0 : 0.0;
 }
 

@@ -2,9 +2,11 @@
 // released against a detection at the same positions.
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <random>
 
 #include "contact/contact_stage.hpp"
+#include "contact/detection.hpp"
 #include "jointed_cube.hpp"
 
 using namespace fdem;
@@ -79,4 +81,46 @@ TEST_CASE("a bond of a left-out tet released before its body cracked makes a det
   CHECK(stage.detection_due(model));
   stage.detect(model);
   CHECK_FALSE(stage.detection_due(model));
+}
+
+TEST_CASE(
+    "the schedule's running bound of the travel since detection answers as the travel itself, "
+    "step by step",
+    "[contact][stage]") {
+  // Random small steps of every node (one node faster), as the integration makes them; after each,
+  // the stage's answer from its running bound must be the answer of the exact travel.
+  Model model = testing::pressed_jointed_cube();
+  const double buffer = 0.025;
+  ContactStage stage(model, ContactSettings{buffer, true, true});
+  stage.set_bonds(model.tets.size(), testing::joint_bonds(model));
+  stage.enclose(model.tets.enclosed);
+  stage.detect(model);
+  std::mt19937_64 random(9);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int due = 0, quiet_steps = 0;
+  for (int step = 0; step < 400; ++step) {
+    double max_dx2 = 0.0, largest = 0.0;
+    for (LocalIndex n = 0; n < model.nodes.n_owned; ++n) {
+      const double speed = n == 7 ? 1.5e-4 : 2e-5;  // m per step
+      double dx2 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double dx = speed * (k == 0 ? 1.0 : unit(random));
+        model.nodes.x[3 * n + k] += dx;
+        largest = std::max(largest, std::abs(model.nodes.x[3 * n + k]));
+        dx2 += dx * dx;
+      }
+      max_dx2 = std::max(max_dx2, dx2);
+    }
+    const double travel = stage.travel_since_detection(model);
+    const bool answer = stage.detection_due_after_step(model, std::sqrt(max_dx2), largest);
+    INFO("step " << step << ": travel since detection " << travel);
+    REQUIRE(answer == detection_needed(travel, buffer));
+    quiet_steps += !answer && travel < 0.4 * buffer;
+    if (answer) {
+      ++due;
+      stage.detect(model);
+    }
+  }
+  CHECK(due >= 2);  // the threshold was crossed, and crossed again after a detection
+  CHECK(quiet_steps > 100);
 }
