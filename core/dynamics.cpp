@@ -13,6 +13,13 @@ namespace {
 // What the element loop hands a scatter: tet t's force on corner c (node n), in N.
 using CornerForce = const double (&)[3];
 
+// The scatter that adds each corner force to its node's force in f (N).
+inline auto added_to(double* f) {
+  return [f](LocalIndex, int, LocalIndex n, CornerForce force) {
+    for (int k = 0; k < 3; ++k) f[3 * static_cast<std::size_t>(n) + k] += force[k];
+  };
+}
+
 // One tet's result into the summary, in the order the tets are computed.
 inline void add_to_summary(const TetArrays& tets, LocalIndex t, double strain_energy,
                            double damping_power, double jacobian, InternalForceSummary& sum) {
@@ -132,9 +139,7 @@ InternalForceSummary compute_internal_forces(Model& model) {
   double* f = nodes.f.data();
   // Tets in ascending global id: each node receives its contributions in that one order.
   add_tet_forces(model, model.tet_force_order.data(), model.tet_force_order.size(), sum,
-                 [f](LocalIndex, int, LocalIndex n, CornerForce force) {
-                   for (int k = 0; k < 3; ++k) f[3 * static_cast<std::size_t>(n) + k] += force[k];
-                 });
+                 added_to(f));
   return sum;
 }
 
@@ -182,13 +187,16 @@ InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& s
     if (boundary[n])
       parked(t, c, force);
     else
-      for (int k = 0; k < 3; ++k) f[3 * static_cast<std::size_t>(n) + k] += force[k];
+      added_to(f)(t, c, n, force);
   };
   const auto late_scatter = [&](LocalIndex t, int c, LocalIndex, CornerForce force) {
     parked(t, c, force);
   };
-  // Interior work while the ghost positions travel.
-  add_tet_forces(model, split.early.data(), split.early.size(), sum, early_scatter);
+  // Interior work while the ghost positions travel (straight to the nodes when no node waits).
+  if (split.boundary_tets.empty())
+    add_tet_forces(model, split.early.data(), split.early.size(), sum, added_to(f));
+  else
+    add_tet_forces(model, split.early.data(), split.early.size(), sum, early_scatter);
   if (complete_halo) complete_halo();
   add_tet_forces(model, split.late.data(), split.late.size(), sum, late_scatter);
   // Boundary nodes: every contribution, in ascending tet gid.

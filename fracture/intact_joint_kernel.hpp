@@ -73,6 +73,16 @@ inline void set_lanes(IntactJointBatch& b, const double* node_x,
     for (int k = 0; k < 3; ++k) b.x[3 * i + k] = Lanes{p[0][k], p[1][k], p[2][k], p[3][k]};
   }
   b.w = Lanes{w[0], w[1], w[2], w[3]};
+  if (law[0] == law[1] && law[0] == law[2] && law[0] == law[3]) {  // one law: broadcast it
+    const IntactJointLaw& one = *law[0];
+    const Lanes zero = {0.0, 0.0, 0.0, 0.0};
+    b.k_n = zero + one.k_n;
+    b.k_t = zero + one.k_t;
+    b.peak = zero + one.peak;
+    b.cohesion = zero + one.cohesion;
+    b.friction = zero + one.friction;
+    return;
+  }
   b.k_n = Lanes{law[0]->k_n, law[1]->k_n, law[2]->k_n, law[3]->k_n};
   b.k_t = Lanes{law[0]->k_t, law[1]->k_t, law[2]->k_t, law[3]->k_t};
   b.peak = Lanes{law[0]->peak, law[1]->peak, law[2]->peak, law[3]->peak};

@@ -84,8 +84,9 @@ std::vector<JointHistory> JointStage::history() const {
 void JointStage::add_intact(Model& model, LocalIndex j, const IntactJointBatch& batch, int lane,
                             double share, JointStepSummary& out) {
   const LocalIndex* id = model.joints.nodes.data() + 6 * static_cast<std::size_t>(j);
+  double* f = model.nodes.f.data();
   for (int i = 0; i < 6; ++i) {
-    double* node_force = model.nodes.f.data() + 3 * static_cast<std::size_t>(id[i]);
+    double* node_force = f + 3 * static_cast<std::size_t>(id[i]);
     for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][lane];
   }
   out.stored_energy += share * batch.stored_energy[lane];  // nothing dissipated while pristine
@@ -166,14 +167,35 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
     }
     if (first_pristine >= 0) {
       const LocalIndex* lane_id[lanes];
+      bool all_pristine = count == lanes;
       for (int l = 0; l < lanes; ++l) {  // a lane without a pristine joint computes a copy
-        const int from = l < count && kind[l] == pristine ? l : first_pristine;
+        const bool here = l < count && kind[l] == pristine;
+        all_pristine = all_pristine && here;
+        const int from = here ? l : first_pristine;
         lane_id[l] = id[from];
         w[l] = w[from];
         law[l] = law[from];
       }
       set_lanes(batch, nodes.x.data(), lane_id, w, law);
       intact_joint_steps_for_this_cpu(batch);
+      bool all_done = all_pristine;
+      for (int l = 0; l < lanes; ++l) all_done = all_done && batch.step[l] == IntactStep::done;
+      if (all_done) {  // the common chunk in an intact body: four pristine joints that stay so
+        double* f = nodes.f.data();
+        for (int l = 0; l < lanes; ++l) {
+          for (int i = 0; i < 6; ++i) {
+            double* node_force = f + 3 * static_cast<std::size_t>(id[l][i]);
+            for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][l];
+          }
+          out.stored_energy += share[l] * batch.stored_energy[l];
+          IntactJointState& state = intact_[static_cast<std::size_t>(start + l)];
+          for (int i = 0; i < 3; ++i) {
+            state.previous_opening[i] = batch.opening[i][l];
+            state.previous_shear_sq[i] = batch.shear_sq[i][l];
+          }
+        }
+        continue;
+      }
     }
     for (int l = 0; l < count; ++l) {
       if (kind[l] == pristine && batch.step[l] != IntactStep::leaves)
