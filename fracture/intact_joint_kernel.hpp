@@ -102,7 +102,7 @@ inline void intact_joint_steps(IntactJointBatch& b) {
   const Lanes raw[3] = {e[1] * g[2] - e[2] * g[1], e[2] * g[0] - e[0] * g[2],
                         e[0] * g[1] - e[1] * g[0]};
   const Lanes n_len_sq = raw[0] * raw[0] + raw[1] * raw[1] + raw[2] * raw[2];
-  Lanes n_len;
+  Lanes n_len = zero;
   for (int l = 0; l < intact_lanes; ++l) n_len[l] = std::sqrt(n_len_sq[l]);
   const LaneMask flat = !(n_len > zero);
   const Lanes inv_n_len = one / (flat ? one : n_len);
@@ -159,7 +159,9 @@ inline void intact_joint_steps(IntactJointBatch& b) {
 
 // intact_joint_steps as built for this CPU: AVX2 (one instruction for the four lanes) where the
 // CPU has it, else the x86-64 baseline (two); chosen when the program loads.  AVX2 without FMA
-// rounds every operation as the baseline does, so both give the same bits (tested).
+// rounds every operation as the baseline does, so both give the same bits: the kernel test checks
+// that through this function, and the joint stage, whose loop is built the same two ways
+// (JointStage::add_forces), relies on it.
 void intact_joint_steps_for_this_cpu(IntactJointBatch& batch);
 
 }  // namespace fdem

@@ -120,7 +120,14 @@ void JointStage::add_full_law(Model& model, LocalIndex j, double share, double t
   newly_broken_.push_back(j);
 }
 
-JointStepSummary JointStage::add_forces(Model& model, double time) {
+// The whole loop built twice, AVX2 and the x86-64 baseline, chosen when the program loads: the
+// lanes' gathers and scatters and the inlined intact step then use the CPU's full vector width
+// (no FMA in either, so both give the same bits).
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default"), flatten))
+#endif
+JointStepSummary
+JointStage::add_forces(Model& model, double time) {
   JointStepSummary out;
   newly_broken_.clear();
   JointArrays& joints = model.joints;
@@ -177,7 +184,7 @@ JointStepSummary JointStage::add_forces(Model& model, double time) {
         law[l] = law[from];
       }
       set_lanes(batch, nodes.x.data(), lane_id, w, law);
-      intact_joint_steps_for_this_cpu(batch);
+      intact_joint_steps(batch);
       bool all_done = all_pristine;
       for (int l = 0; l < lanes; ++l) all_done = all_done && batch.step[l] == IntactStep::done;
       if (all_done) {  // the common chunk in an intact body: four pristine joints that stay so

@@ -64,7 +64,7 @@ TEST_CASE(
     set_lanes(batch, &x[0][0], id, w, law);
     IntactJointBatch baseline = batch;
     intact_joint_steps(baseline);            // as compiled here (x86-64 baseline)
-    intact_joint_steps_for_this_cpu(batch);  // the joint stage's (AVX2 where the CPU has it)
+    intact_joint_steps_for_this_cpu(batch);  // AVX2 where the CPU has it, as in the joint stage
     for (int l = 0; l < intact_lanes; ++l) REQUIRE(batch.step[l] == baseline.step[l]);
     for (int c = 0; c < 18; ++c)
       for (int l = 0; l < intact_lanes; ++l)
