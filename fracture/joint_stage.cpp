@@ -139,7 +139,7 @@ JointStage::add_forces(Model& model, double time) {
   // node receives its contributions in the same order as one joint at a time.
   constexpr int lanes = intact_lanes;
   constexpr LocalIndex prefetch_ahead = 2 * lanes;
-  enum Kind : unsigned char { elsewhere, pristine, live };
+  enum class Kind : unsigned char { elsewhere, pristine, live };
   IntactJointBatch batch;
   Kind kind[lanes];
   double share[lanes];  // 1 where this rank reports the joint's energies (it owns tet A)
@@ -162,12 +162,12 @@ JointStage::add_forces(Model& model, double time) {
         }
       const LocalIndex tet_a = joints.tets[2 * j], tet_b = joints.tets[2 * j + 1];
       kind[l] = joints.broken[j] || (!tets.is_active(tet_a) && !tets.is_active(tet_b))
-                    ? elsewhere  // broken, or computed by other ranks
-                : slot_[static_cast<std::size_t>(j)] < 0 ? pristine
-                                                         : live;
+                    ? Kind::elsewhere  // broken, or computed by other ranks
+                : slot_[static_cast<std::size_t>(j)] < 0 ? Kind::pristine
+                                                         : Kind::live;
       share[l] = tets.is_owned(tet_a) ? 1.0 : 0.0;
       id[l] = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
-      if (kind[l] != pristine) continue;
+      if (kind[l] != Kind::pristine) continue;
       w[l] = joints.area0[j] / 3.0;
       law[l] = &intact_laws_[joints.law[j]];
       if (first_pristine < 0) first_pristine = l;
@@ -176,7 +176,7 @@ JointStage::add_forces(Model& model, double time) {
       const LocalIndex* lane_id[lanes];
       bool all_pristine = count == lanes;
       for (int l = 0; l < lanes; ++l) {  // a lane without a pristine joint computes a copy
-        const bool here = l < count && kind[l] == pristine;
+        const bool here = l < count && kind[l] == Kind::pristine;
         all_pristine = all_pristine && here;
         const int from = here ? l : first_pristine;
         lane_id[l] = id[from];
@@ -205,9 +205,10 @@ JointStage::add_forces(Model& model, double time) {
       }
     }
     for (int l = 0; l < count; ++l) {
-      if (kind[l] == pristine && batch.step[l] != IntactStep::leaves)
+      if (kind[l] == Kind::pristine && batch.step[l] != IntactStep::leaves)
         add_intact(model, start + l, batch, l, share[l], out);
-      else if (kind[l] != elsewhere)  // a full history, or a pristine joint at its strength now
+      else if (kind[l] !=
+               Kind::elsewhere)  // a full history, or a pristine joint at its strength now
         add_full_law(model, start + l, share[l], time, out);
     }
   }
