@@ -23,12 +23,4 @@ double max_node_displacement(const double* x, const double* x_at_detection, Loca
 double max_node_displacement(const double* x, const double* x_at_detection, const LocalIndex* nodes,
                              std::size_t count);
 
-// How far the nodes went in a step: the largest travel |Δx| (m, the tunnelling guard and the
-// detection schedule's bound; integrate_central_difference measures it), with the node that made
-// it.  NaN counts as +infinity.
-struct NodeTravel {
-  double step = 0.0;
-  LocalIndex fastest = -1;  // node of `step`; −1 when no node moved
-};
-
 }  // namespace fdem

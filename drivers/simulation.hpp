@@ -115,7 +115,7 @@ class Simulation {
   double initial_residual_ = -1.0;      // −1: no initial stress
   std::string step_advice() const;
   void check_stable_step(const struct CriticalStep& deformed) const;
-  void check_tunnelling(const struct NodeTravel& travel) const;
+  void check_tunnelling(const struct IntegrationSummary& motion) const;
   std::string step_origin() const;
   // The stages of step(), in its order (drivers/simulation_step.cpp).
   void share_broken_joints();

@@ -219,12 +219,12 @@ void Simulation::integrate(StepRecord& r) {
   r.contact_after = contact_->work_after(model_, dt_);  // friction and dashpots with v_n+½
   // How far the nodes went: whether the next step must detect, and whether a node crossed more
   // than the thinnest element in this step (tunnelling).
-  r.travel.step = r.motion.max_displacement_increment;
-  r.travel.fastest = r.motion.fastest_node;
   r.flags.detection_due =
-      contact_->detection_due_after_step(model_, r.travel.step, r.motion.largest_coordinate) ? 1.0
-                                                                                             : 0.0;
-  r.flags.tunnelling = r.travel.step > tunnel_size_ ? 1.0 : 0.0;
+      contact_->detection_due_after_step(model_, r.motion.max_displacement_increment,
+                                         r.motion.largest_coordinate)
+          ? 1.0
+          : 0.0;
+  r.flags.tunnelling = r.motion.max_displacement_increment > tunnel_size_ ? 1.0 : 0.0;
 }
 
 void Simulation::start_halo_exchange() {
@@ -335,7 +335,7 @@ void Simulation::check_step(const StepRecord& r) {
     state();
   // Tunnelling first: a body that jumped an element in one step also deforms the tets that hold
   // ghost copies of its nodes (not yet exchanged), which the minimum-step guard would report.
-  if (r.flags.tunnelling > 0.0) domain_->run_collectively([&] { check_tunnelling(r.travel); });
+  if (r.flags.tunnelling > 0.0) domain_->run_collectively([&] { check_tunnelling(r.motion); });
   if (r.flags.step_too_large > 0.0)
     domain_->run_collectively([&] { check_stable_step(r.deformed); });
 }
@@ -487,16 +487,17 @@ void Simulation::check_stable_step(const CriticalStep& deformed) const {
 // Throws NumericalFailure when a node of this rank went further in one step than the thinnest
 // element is thick: contact only sees positions at whole steps, so it could have passed through an
 // element unseen (tunnelling), and a penetration that deep pushes the wrong way anyway.
-void Simulation::check_tunnelling(const NodeTravel& travel) const {
-  if (!(travel.step > tunnel_size_) || travel.fastest < 0) return;
+void Simulation::check_tunnelling(const IntegrationSummary& motion) const {
+  const double travel = motion.max_displacement_increment;
+  if (!(travel > tunnel_size_) || motion.fastest_node < 0) return;
   const NodeArrays& nodes = model_.nodes;
-  const LocalIndex n = travel.fastest;
+  const LocalIndex n = motion.fastest_node;
   const std::int32_t piece = nodes.piece[n];
-  const double speed = travel.step / dt_;
+  const double speed = travel / dt_;
   std::ostringstream msg;
   msg << "numerical failure at step " << steps_ << " (t = " << time_ << " s): node " << nodes.gid[n]
       << " of body '" << model_.body_names[model_.pieces.body_of(piece)] << "' (piece "
-      << model_.pieces.index_in_body(piece) << ") moved " << travel.step << " m in one step (speed "
+      << model_.pieces.index_in_body(piece) << ") moved " << travel << " m in one step (speed "
       << speed << " m/s), more than the smallest element size " << tunnel_size_
       << " m: contact only sees the positions at whole steps, so the body would pass through "
          "elements without touching them (tunnelling). Use a smaller time step (below "

@@ -33,7 +33,6 @@ struct StepRecord {
   IntegrationSummary motion;
   double boundary_before = 0.0, boundary_after = 0.0;  // J, absorbing dashpots' dissipation
   double surface_power_before = 0.0;                   // W, surface loads with v(t_n − dt/2)
-  NodeTravel travel;                                   // how far the owned nodes went
   CriticalStep deformed;  // stable step of the deformed mesh, when the guard checked it
   StepFlags flags;
 };

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "core/lanes.hpp"
 #include "fracture/cohesive_law.hpp"
 #include "fracture/joint_kernels.hpp"
 
@@ -40,11 +41,9 @@ enum class IntactStep : unsigned char {
   leaves,      // a point reached its strength: nothing to use, the full law takes over
 };
 
-// Four joints side by side: GCC/Clang vector extensions, one instruction for all four on AVX2,
-// two on the x86-64 baseline (SSE2); every lane rounds exactly as a scalar operation would.
-using Lanes = double __attribute__((vector_size(32)));
-using LaneMask = long long __attribute__((vector_size(32)));
-constexpr int intact_lanes = 4;
+// Four joints side by side (core/lanes.hpp): one instruction for all four on AVX2, two on the
+// x86-64 baseline (SSE2); every lane rounds exactly as a scalar operation would.
+constexpr int intact_lanes = lane_count;
 
 // One batch: the caller fills the inputs of every lane (set_lanes; an unused lane with any valid
 // joint, e.g. lane 0's) and reads the outputs of the lanes whose step is not `leaves`.

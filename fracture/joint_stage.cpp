@@ -174,41 +174,19 @@ JointStage::add_forces(Model& model, double time) {
     }
     if (first_pristine >= 0) {
       const LocalIndex* lane_id[lanes];
-      bool all_pristine = count == lanes;
       for (int l = 0; l < lanes; ++l) {  // a lane without a pristine joint computes a copy
-        const bool here = l < count && kind[l] == Kind::pristine;
-        all_pristine = all_pristine && here;
-        const int from = here ? l : first_pristine;
+        const int from = l < count && kind[l] == Kind::pristine ? l : first_pristine;
         lane_id[l] = id[from];
         w[l] = w[from];
         law[l] = law[from];
       }
       set_lanes(batch, nodes.x.data(), lane_id, w, law);
       intact_joint_steps(batch);
-      bool all_done = all_pristine;
-      for (int l = 0; l < lanes; ++l) all_done = all_done && batch.step[l] == IntactStep::done;
-      if (all_done) {  // the common chunk in an intact body: four pristine joints that stay so
-        double* f = nodes.f.data();
-        for (int l = 0; l < lanes; ++l) {
-          for (int i = 0; i < 6; ++i) {
-            double* node_force = f + 3 * static_cast<std::size_t>(id[l][i]);
-            for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][l];
-          }
-          out.stored_energy += share[l] * batch.stored_energy[l];
-          IntactJointState& state = intact_[static_cast<std::size_t>(start + l)];
-          for (int i = 0; i < 3; ++i) {
-            state.previous_opening[i] = batch.opening[i][l];
-            state.previous_shear_sq[i] = batch.shear_sq[i][l];
-          }
-        }
-        continue;
-      }
     }
     for (int l = 0; l < count; ++l) {
       if (kind[l] == Kind::pristine && batch.step[l] != IntactStep::leaves)
         add_intact(model, start + l, batch, l, share[l], out);
-      else if (kind[l] !=
-               Kind::elsewhere)  // a full history, or a pristine joint at its strength now
+      else if (kind[l] != Kind::elsewhere)  // a full history, or a pristine joint now at strength
         add_full_law(model, start + l, share[l], time, out);
     }
   }
