@@ -156,7 +156,7 @@ void Simulation::add_internal_forces(StepRecord& r) {
 void Simulation::add_joint_forces(StepRecord& r) {
   if (!plan_.joints) return;
   Timed timed(clocks_[joints]);
-  r.joints = joints_->add_forces(model_, time_);
+  r.joints = joints_->add_forces(model_, time_, dt_);
   // 3 fracture: the joints that broke here, shared at the start of the next step.
   for (LocalIndex b : joints_->newly_broken()) {
     const LocalIndex a = model_.joints.tets[2 * b], c = model_.joints.tets[2 * b + 1];

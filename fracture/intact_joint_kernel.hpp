@@ -1,7 +1,9 @@
 // The pristine joint's step for a batch of joints at once: the hot loop of an intact jointed body.
 //
 // Same arithmetic, operation for operation, as joint_frame + joint_intact_step
-// (fracture/joint_kernels.hpp), so forces, energies and states are bit-identical to it (tested).
+// (fracture/joint_kernels.hpp), so forces and energies are bit-identical to it (tested).  It
+// leaves no state: the joint stage rebuilds a joint's last pristine state only when the joint
+// leaves that state (intact_state_at).
 // Four joints go side by side in vector lanes, without branches, so that one instruction computes
 // all four: the reference version works on one joint's Eigen 3-vectors, which leave most of a
 // vector register empty and stall on packed stores reloaded as scalars.  The reference stays the
@@ -36,7 +38,7 @@ struct IntactJointLaw {
 };
 
 enum class IntactStep : unsigned char {
-  done,        // forces and energy written, state advanced
+  done,        // forces and energy written
   degenerate,  // the mid-surface has no area: no force (as joint_force reports it)
   leaves,      // a point reached its strength: nothing to use, the full law takes over
 };
@@ -54,9 +56,8 @@ struct IntactJointBatch {
   Lanes k_n, k_t, peak, cohesion, friction;  // the joint's law
   // Outputs.
   IntactStep step[intact_lanes];
-  Lanes force[18];                // on a0 … b2 (N); 0 when degenerate
-  Lanes stored_energy;            // J; 0 when degenerate
-  Lanes opening[3], shear_sq[3];  // the new IntactJointState
+  Lanes force[18];      // on a0 … b2 (N); 0 when degenerate
+  Lanes stored_energy;  // J; 0 when degenerate
 };
 
 // The batch's inputs: lane l is the joint whose six nodes are node_x[3·id[l][0…5]] (m), with
@@ -108,17 +109,16 @@ inline void intact_joint_steps(IntactJointBatch& b) {
   const Lanes n[3] = {raw[0] * inv_n_len, raw[1] * inv_n_len, raw[2] * inv_n_len};
 
   // Gap, opening and shear of each point; a point at its strength ends the intact state.
-  Lanes gap[3][3], dn[3];
+  Lanes gap[3][3], dn[3], shear_sq[3];
   LaneMask weak = flat & 0;
   for (int i = 0; i < 3; ++i) {
     for (int k = 0; k < 3; ++k) gap[i][k] = b.x[9 + 3 * i + k] - b.x[3 * i + k];
     dn[i] = gap[i][0] * n[0] + gap[i][1] * n[1] + gap[i][2] * n[2];
     const Lanes gap_sq = gap[i][0] * gap[i][0] + gap[i][1] * gap[i][1] + gap[i][2] * gap[i][2];
     const Lanes shear = b.k_t * b.k_t * (gap_sq - dn[i] * dn[i]);
-    b.shear_sq[i] = zero < shear ? shear : zero;  // std::max(0, ·)
+    shear_sq[i] = zero < shear ? shear : zero;  // std::max(0, ·)
     const Lanes strength = b.cohesion - b.friction * (zero < dn[i] ? zero : dn[i]);  // min(dn, 0)
-    weak |= (dn[i] > b.peak) | (b.shear_sq[i] > strength * strength);
-    b.opening[i] = dn[i] < zero ? zero : dn[i];  // std::max(dn, 0)
+    weak |= (dn[i] > b.peak) | (shear_sq[i] > strength * strength);
   }
   // φ = ½k_t|Δ|² + ½(k_n − k_t)(Δ·n)²; v = Σ w(k_n − k_t)(Δ·n)·(I − nnᵀ)Δ is the energy's pull on
   // n.
@@ -134,7 +134,7 @@ inline void intact_joint_steps(IntactJointBatch& b) {
       b.force[9 + 3 * i + k] = zero - b.w * traction;
       v[k] += pull * (gap[i][k] - dn[i] * n[k]);
     }
-    b.stored_energy += b.w * (half * b.k_n * dn[i] * dn[i] + half * b.shear_sq[i] / b.k_t);
+    b.stored_energy += b.w * (half * b.k_n * dn[i] * dn[i] + half * shear_sq[i] / b.k_t);
   }
   // δψ = v·δN/|N| with δN = δe × g + e × δg; each node takes half of its mid-point's gradient.
   const Lanes grad_e[3] = {(g[1] * v[2] - g[2] * v[1]) * inv_n_len,

@@ -107,6 +107,24 @@ inline bool joint_frame(const Vec3 (&x)[6], JointFrame& frame) {
   return true;
 }
 
+// What a pristine joint's step leaves in its state at positions x (m), by joint_intact_step's own
+// arithmetic: the joint stage keeps no state for pristine joints and, when one first leaves the
+// pristine state, rebuilds the previous step's from the previous positions.  False (state
+// zeroed) when the mid-surface has no area.
+inline bool intact_state_at(const Vec3 (&x)[6], const CohesiveLaw& law, IntactJointState& state) {
+  state = IntactJointState{};
+  JointFrame frame;
+  if (!joint_frame(x, frame)) return false;
+  const double k_t = law.tangential_stiffness();
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 gap = x[3 + i] - x[i];
+    const double dn = gap.dot(frame.n);
+    state.previous_opening[i] = std::max(dn, 0.0);
+    state.previous_shear_sq[i] = std::max(0.0, k_t * k_t * (gap.squaredNorm() - dn * dn));
+  }
+  return true;
+}
+
 // Fast path of joint_force for a pristine joint whose points stay below strength:
 // φ = ½k_t|Δ|² + ½(k_n − k_t)(Δ·n)², which depends on the frame only through n, so t1, t2 are not
 // needed.  Returns false (and changes nothing) when a point reaches its strength.

@@ -36,7 +36,6 @@ JointStage::JointStage(const Model& model) {
   }
   const JointArrays& joints = model.joints;
   slot_.assign(static_cast<std::size_t>(joints.size()), -1);
-  intact_.assign(static_cast<std::size_t>(joints.size()), IntactJointState{});
   for (LocalIndex j = 0; j < joints.size(); ++j) {
     FDEM_VERIFY(joints.law[j] >= 0 && joints.law[j] < static_cast<int>(laws_.size()),
                 "joint law index");
@@ -55,29 +54,15 @@ std::int32_t JointStage::promote(LocalIndex j) {
   if (slot >= 0) return slot;
   FDEM_VERIFY(live_.size() < static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()),
               "joint history slots");
-  JointHistory h;
-  const IntactJointState& state = intact_[static_cast<std::size_t>(j)];
-  for (int i = 0; i < 3; ++i) {
-    h.point[i].previous_opening = state.previous_opening[i];
-    h.point[i].previous_shear_sq = state.previous_shear_sq[i];
-  }
   slot = static_cast<std::int32_t>(live_.size());
-  live_.push_back(h);
+  live_.push_back(JointHistory{});
   return slot;
 }
 
 std::vector<JointHistory> JointStage::history() const {
   std::vector<JointHistory> out(slot_.size());
-  for (std::size_t j = 0; j < slot_.size(); ++j) {
-    if (slot_[j] >= 0) {
-      out[j] = live_[static_cast<std::size_t>(slot_[j])];
-      continue;
-    }
-    for (int i = 0; i < 3; ++i) {
-      out[j].point[i].previous_opening = intact_[j].previous_opening[i];
-      out[j].point[i].previous_shear_sq = intact_[j].previous_shear_sq[i];
-    }
-  }
+  for (std::size_t j = 0; j < slot_.size(); ++j)
+    if (slot_[j] >= 0) out[j] = live_[static_cast<std::size_t>(slot_[j])];
   return out;
 }
 
@@ -90,22 +75,27 @@ void JointStage::add_intact(Model& model, LocalIndex j, const IntactJointBatch& 
     for (int k = 0; k < 3; ++k) node_force[k] += batch.force[3 * i + k][lane];
   }
   out.stored_energy += share * batch.stored_energy[lane];  // nothing dissipated while pristine
-  if (batch.step[lane] != IntactStep::done) return;        // degenerate: no force, state kept
-  IntactJointState& state = intact_[static_cast<std::size_t>(j)];
-  for (int i = 0; i < 3; ++i) {
-    state.previous_opening[i] = batch.opening[i][lane];
-    state.previous_shear_sq[i] = batch.shear_sq[i][lane];
-  }
 }
 
-void JointStage::add_full_law(Model& model, LocalIndex j, double share, double time,
+void JointStage::add_full_law(Model& model, LocalIndex j, double share, double time, double step,
                               JointStepSummary& out) {
   JointArrays& joints = model.joints;
   const LocalIndex* id = joints.nodes.data() + 6 * static_cast<std::size_t>(j);
+  const bool was_pristine = slot_[static_cast<std::size_t>(j)] < 0;
   const std::int32_t slot = promote(j);
   Vec3 x[6];
   for (int i = 0; i < 6; ++i) x[i] = vec3_at(model.nodes.x.data(), id[i]);
   JointHistory& h = live_[static_cast<std::size_t>(slot)];
+  if (was_pristine) {  // the previous step's opening and shear, for the energy terms
+    Vec3 previous[6];
+    for (int i = 0; i < 6; ++i) previous[i] = x[i] - step * vec3_at(model.nodes.v.data(), id[i]);
+    IntactJointState state;
+    intact_state_at(previous, laws_[joints.law[j]], state);
+    for (int i = 0; i < 3; ++i) {
+      h.point[i].previous_opening = state.previous_opening[i];
+      h.point[i].previous_shear_sq = state.previous_shear_sq[i];
+    }
+  }
   const JointForce f = joint_force(x, joints.area0[j], laws_[joints.law[j]], h);
   for (int i = 0; i < 6; ++i) vec3_at(model.nodes.f.data(), id[i]) += f.force[i];
   out.stored_energy += share * f.stored_energy;
@@ -127,7 +117,7 @@ void JointStage::add_full_law(Model& model, LocalIndex j, double share, double t
 __attribute__((target_clones("avx2", "default"), flatten))
 #endif
 JointStepSummary
-JointStage::add_forces(Model& model, double time) {
+JointStage::add_forces(Model& model, double time, double step) {
   JointStepSummary out;
   newly_broken_.clear();
   JointArrays& joints = model.joints;
@@ -187,7 +177,7 @@ JointStage::add_forces(Model& model, double time) {
       if (kind[l] == Kind::pristine && batch.step[l] != IntactStep::leaves)
         add_intact(model, start + l, batch, l, share[l], out);
       else if (kind[l] != Kind::elsewhere)  // a full history, or a pristine joint now at strength
-        add_full_law(model, start + l, share[l], time, out);
+        add_full_law(model, start + l, share[l], time, step, out);
     }
   }
   // Count the ones this rank reports (tet A owned); the ranks that hold a joint without computing
@@ -205,22 +195,15 @@ void JointStage::rebind(const Model& model, std::vector<JointHistory> history) {
   FDEM_VERIFY(history.size() == static_cast<std::size_t>(model.joints.size()),
               "one history per local joint");
   slot_.assign(history.size(), -1);
-  intact_.assign(history.size(), IntactJointState{});
   live_.clear();
   for (std::size_t j = 0; j < history.size(); ++j) {
     const JointHistory& h = history[j];
     bool zero = pristine(h) && !h.broken && h.mode == FailureMode::none;
     for (const auto& p : h.point)
       zero = zero && p.damage == 0.0 && p.plastic_slip[0] == 0.0 && p.plastic_slip[1] == 0.0;
-    if (!zero) {
-      slot_[j] = static_cast<std::int32_t>(live_.size());
-      live_.push_back(h);
-      continue;
-    }
-    for (int i = 0; i < 3; ++i) {
-      intact_[j].previous_opening[i] = h.point[i].previous_opening;
-      intact_[j].previous_shear_sq[i] = h.point[i].previous_shear_sq;
-    }
+    if (zero) continue;  // pristine: no state (its energy terms come from the positions)
+    slot_[j] = static_cast<std::int32_t>(live_.size());
+    live_.push_back(h);
   }
   live_.shrink_to_fit();
   newly_broken_.clear();

@@ -3,10 +3,11 @@
 // failure time and mode, and the caller hands their two tets over to contact.
 //
 // The cohesive history of every integration point lives here, sized to what is live: a pristine
-// joint (no point past its peak or slipping, the common case in an intact body) keeps only its
-// IntactJointState (48 bytes); the first update that damages or slips it gives it a full
-// JointHistory (184 bytes) in a pool.  The model's JointArrays mirror what other parts read:
-// broken flag, mode, failure time, damage.
+// joint (no point past its peak or slipping, the common case in an intact body) keeps nothing
+// but its slot index (4 bytes); the first update that damages or slips it gives it a full
+// JointHistory (184 bytes) in a pool, whose energy terms start from the previous step's opening
+// and shear, rebuilt from the previous positions x − Δt·v.  The model's JointArrays mirror what
+// other parts read: broken flag, mode, failure time, damage.
 #pragma once
 
 #include <vector>
@@ -43,7 +44,10 @@ class JointStage {
   // is owned count in the energies and in JointStepSummary::newly_broken.
   // The dissipation terms cover the motion since the previous call, so for the trapezoid
   // accumulators of core/energy.hpp they are all "before" work (see docs/fracture-model.md).
-  JointStepSummary add_forces(Model& model, double time);
+  // `step` (s) is the time step that brought the nodes here (x = x_prev + step·v, with v the
+  // nodes' velocities of the last half step): a joint leaving the pristine state takes its
+  // previous opening and shear from x − step·v.
+  JointStepSummary add_forces(Model& model, double time, double step);
 
   // Joints (indices) that broke in the last add_forces call: every one computed here (with parallel
   // roles the owners of both tets compute a joint, and each tells the ranks holding its tet).
@@ -68,19 +72,19 @@ class JointStage {
   std::size_t live_histories() const { return live_.size(); }
 
  private:
-  // Gives joint j a full history made from its intact state; returns its slot in live_.
+  // Gives joint j a full history (zero; pristine joints keep no state); returns its slot in live_.
   std::int32_t promote(LocalIndex j);
   // Joint j's forces and energies from lane `lane` of a computed batch (its step not `leaves`).
   void add_intact(Model& model, LocalIndex j, const IntactJointBatch& batch, int lane, double share,
                   JointStepSummary& out);
-  // Joint j through the full law on a full history (promoted first when pristine); marks it broken
-  // at `time` when it breaks.
-  void add_full_law(Model& model, LocalIndex j, double share, double time, JointStepSummary& out);
+  // Joint j through the full law on a full history (promoted first when pristine, its energy
+  // terms from the positions x − step·v); marks it broken at `time` when it breaks.
+  void add_full_law(Model& model, LocalIndex j, double share, double time, double step,
+                    JointStepSummary& out);
 
   std::vector<CohesiveLaw> laws_;
   std::vector<IntactJointLaw> intact_laws_;  // what the pristine joints' step reads, per law
   std::vector<std::int32_t> slot_;           // per joint: index in live_, or −1 (pristine)
-  std::vector<IntactJointState> intact_;     // per joint: its state while pristine
   std::vector<JointHistory> live_;           // histories of the joints that left the pristine state
   std::vector<LocalIndex> newly_broken_;
   LocalIndex broken_ = 0;

@@ -1,17 +1,5 @@
 #include "io/vtk_output.hpp"
 
-#include <vtkCellArray.h>
-#include <vtkCellData.h>
-#include <vtkDoubleArray.h>
-#include <vtkErrorCode.h>
-#include <vtkNew.h>
-#include <vtkPointData.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
-#include <vtkSmartPointer.h>
-#include <vtkXMLPPolyDataWriter.h>
-#include <vtkXMLPolyDataWriter.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -107,21 +95,6 @@ namespace {
 // 0.47 → 0.155 s, for frames 10–25 % larger (1.51 → 1.66 MB).
 constexpr int frame_compression_level = 1;
 
-vtkNew<vtkDoubleArray> make_array(const std::string& name, int components, vtkIdType tuples) {
-  vtkNew<vtkDoubleArray> a;
-  a->SetName(name.c_str());
-  a->SetNumberOfComponents(components);
-  a->SetNumberOfTuples(tuples);
-  return a;
-}
-
-vtkNew<vtkDoubleArray> full_array(const FrameField& f, vtkIdType tuples, const char* what) {
-  FDEM_VERIFY(static_cast<vtkIdType>(f.values.size()) == tuples * f.components, what);
-  auto a = make_array(f.name, f.components, tuples);
-  for (vtkIdType i = 0; i < tuples * f.components; ++i) a->SetValue(i, f.values[i]);
-  return a;
-}
-
 // A frame column as a streamed .vtu array: f64 → Float64, i64 → Int64, i32 → Int32.
 VtuArray vtu_array(const FrameColumn& c) {
   const char* type = c.type == FrameValue::f64   ? "Float64"
@@ -215,71 +188,58 @@ class OwnedTetGrid {
   VtuGrid grid_;
 };
 
-vtkSmartPointer<vtkPolyData> point_poly(const std::vector<double>& points,
-                                        const std::vector<FrameField>& point_fields) {
-  const vtkIdType n = static_cast<vtkIdType>(points.size() / 3);
-  auto poly = vtkSmartPointer<vtkPolyData>::New();
-  vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  pts->SetNumberOfPoints(n);
-  vtkNew<vtkCellArray> verts;
-  for (vtkIdType i = 0; i < n; ++i) {
-    pts->SetPoint(i, &points[3 * i]);
-    verts->InsertNextCell(1, &i);
-  }
-  poly->SetPoints(pts);
-  poly->SetVerts(verts);
+// A per-point or per-cell field as a streamed array (Float64), its size checked.
+VtuArray field_array(const FrameField& f, std::size_t tuples, const char* what) {
+  FDEM_VERIFY(f.values.size() == tuples * static_cast<std::size_t>(f.components), what);
+  const std::size_t n = static_cast<std::size_t>(f.components);
+  return {f.name, "Float64", f.components, tuples,
+          [&f, n](std::size_t first, std::size_t count, unsigned char* out) {
+            std::memcpy(out, f.values.data() + first * n, count * n * sizeof(double));
+          }};
+}
+
+VtuArray position_array(const std::vector<double>& points) {
+  return {"Points", "Float64", 3, points.size() / 3,
+          [&points](std::size_t first, std::size_t count, unsigned char* out) {
+            std::memcpy(out, points.data() + 3 * first, 24 * count);
+          }};
+}
+
+// Contact points: one vertex cell per point.  The arrays read the caller's vectors.
+VtpPolys point_polys(const std::vector<double>& points,
+                     const std::vector<FrameField>& point_fields) {
+  VtpPolys polys;
+  polys.kind = VtpPolys::Cells::vertices;
+  polys.points = polys.cells = points.size() / 3;
+  polys.positions = position_array(points);
+  polys.corners = {"connectivity", "Int64", 1, polys.cells,
+                   [](std::size_t first, std::size_t count, unsigned char* out) {
+                     for (std::size_t c = 0; c < count; ++c) {
+                       const auto point = static_cast<std::int64_t>(first + c);
+                       std::memcpy(out + 8 * c, &point, 8);
+                     }
+                   }};
   for (const FrameField& f : point_fields)
-    poly->GetPointData()->AddArray(full_array(f, n, "point field size"));
-  return poly;
+    polys.point_data.push_back(field_array(f, polys.points, "point field size"));
+  return polys;
 }
 
-vtkSmartPointer<vtkPolyData> triangle_poly(const std::vector<double>& points,
-                                           const std::vector<std::int64_t>& triangles,
-                                           const std::vector<FrameField>& cell_fields) {
-  const vtkIdType n_points = static_cast<vtkIdType>(points.size() / 3);
-  const vtkIdType n_cells = static_cast<vtkIdType>(triangles.size() / 3);
-  auto poly = vtkSmartPointer<vtkPolyData>::New();
-  vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  pts->SetNumberOfPoints(n_points);
-  for (vtkIdType i = 0; i < n_points; ++i) pts->SetPoint(i, &points[3 * i]);
-  vtkNew<vtkCellArray> polys;
-  for (vtkIdType t = 0; t < n_cells; ++t) {
-    const vtkIdType ids[3] = {triangles[3 * t], triangles[3 * t + 1], triangles[3 * t + 2]};
-    polys->InsertNextCell(3, ids);
-  }
-  poly->SetPoints(pts);
-  poly->SetPolys(polys);
+// Crack triangles: corners index `points`.
+VtpPolys triangle_polys(const std::vector<double>& points,
+                        const std::vector<std::int64_t>& triangles,
+                        const std::vector<FrameField>& cell_fields) {
+  VtpPolys polys;
+  polys.kind = VtpPolys::Cells::triangles;
+  polys.points = points.size() / 3;
+  polys.cells = triangles.size() / 3;
+  polys.positions = position_array(points);
+  polys.corners = {"connectivity", "Int64", 3, polys.cells,
+                   [&triangles](std::size_t first, std::size_t count, unsigned char* out) {
+                     std::memcpy(out, triangles.data() + 3 * first, 24 * count);
+                   }};
   for (const FrameField& f : cell_fields)
-    poly->GetCellData()->AddArray(full_array(f, n_cells, "triangle field size"));
-  return poly;
-}
-
-// Writes and reports failure by the return value only: VTK's own error dump (object addresses,
-// source lines) is silenced, fdem reports the failure as one message.
-// `system_error` receives errno as the write left it (0 if it set none).
-bool write_succeeded(vtkXMLWriter* writer, int& system_error) {
-  const int warnings = vtkObject::GetGlobalWarningDisplay();
-  vtkObject::GlobalWarningDisplayOff();
-  errno = 0;
-  const bool ok = writer->Write() == 1 && writer->GetErrorCode() == vtkErrorCode::NoError;
-  system_error = errno;
-  vtkObject::SetGlobalWarningDisplay(warnings);
-  return ok;
-}
-
-// The reason of a failed VTK write: the system's when it set one, else VTK's error code.
-std::string write_failure(vtkXMLWriter* writer, int system_error) {
-  if (system_error != 0) return std::strerror(system_error);
-  switch (writer->GetErrorCode()) {
-    case vtkErrorCode::OutOfDiskSpaceError:
-      return "out of disk space";
-    case vtkErrorCode::CannotOpenFileError:
-      return "cannot open the file";
-    default:
-      return "VTK error code " + std::to_string(writer->GetErrorCode());
-  }
+    polys.cell_data.push_back(field_array(f, polys.cells, "triangle field size"));
+  return polys;
 }
 
 // `tmp` renamed to `path` (removed if that fails).
@@ -292,115 +252,24 @@ void rename_into_place(const std::string& tmp, const std::string& path) {
   }
 }
 
-// One-rank frame: `data` to `path` through `<path>.tmp`.
-template <class Writer>
-void write_serial(const std::string& path, vtkDataObject* data) {
+void write_serial_polys(const std::string& path, const VtpPolys& polys) {
   const std::string tmp = path + ".tmp";
-  vtkNew<Writer> writer;
-  writer->SetFileName(tmp.c_str());
-  writer->SetInputData(data);
-  writer->SetDataModeToAppended();
-  writer->EncodeAppendedDataOff();
-  writer->SetCompressionLevel(frame_compression_level);
-  int system_error = 0;
-  if (!write_succeeded(writer, system_error)) {
-    const std::string reason = write_failure(writer, system_error);
-    remove_partial(tmp);
-    throw IoError("cannot write the frame " + path + ": " + reason);
-  }
+  write_vtp(tmp, polys, frame_compression_level, "cannot write the frame " + path);
   rename_into_place(tmp, path);
 }
 
-// VTK's parallel XML writer (vtkXMLPUnstructuredGridWriter, vtkXMLPPolyDataWriter) adapted to
-// ranks that each write their own piece without a VTK MPI controller:
-// - VTK skips a piece with no points and no cells; here it is written (same arrays, zero tuples),
-//   so every piece the summary lists exists;
-// - without a controller VTK lists in the summary only the pieces that this process wrote; here
-//   the summary lists all NumberOfPieces (each rank writes its piece);
-// - a piece is written under `<piece>.tmp` and renamed.
-template <class ParallelWriter>
-class EveryPieceWriter : public ParallelWriter {
- public:
-  int SystemError = 0;  // errno of a failed piece write (its reason), 0 if none
-
-  static EveryPieceWriter* New() {
-    auto* writer = new EveryPieceWriter;
-    writer->InitializeObjectBase();
-    return writer;
-  }
-
- protected:
-  int WritePieceInternal() override {
-    const int piece = this->GetCurrentPiece();
-    if (!this->WritePiece(piece)) return 0;
-    this->PieceWrittenFlags[piece] = 1;
-    return 1;
-  }
-
-  void PrepareSummaryFile() override {
-    std::fill_n(this->PieceWrittenFlags, this->NumberOfPieces, static_cast<unsigned char>(1));
-  }
-
-  // vtkXMLPDataWriter::WritePiece with the piece writer's settings, through a temporary name.
-  int WritePiece(int index) override {
-    vtkXMLWriter* piece = this->CreatePieceWriter(index);
-    char* name = this->CreatePieceFileName(index, this->PathName);
-    const std::string path = name;
-    delete[] name;
-    const std::string tmp = path + ".tmp";
-    piece->SetFileName(tmp.c_str());
-    piece->SetCompressor(this->GetCompressor());
-    piece->SetDataMode(this->GetDataMode());
-    piece->SetByteOrder(this->GetByteOrder());
-    piece->SetEncodeAppendedData(this->GetEncodeAppendedData());
-    piece->SetHeaderType(this->GetHeaderType());
-    piece->SetBlockSize(this->GetBlockSize());
-    errno = 0;
-    int result = piece->Write();
-    if (errno != 0) this->SystemError = errno;
-    const unsigned long error = piece->GetErrorCode();
-    piece->Delete();
-    this->SetErrorCode(error);
-    if (result != 1 || error != vtkErrorCode::NoError) {
-      remove_partial(tmp);
-      return 0;
-    }
-    std::error_code renamed;
-    std::filesystem::rename(tmp, path, renamed);
-    if (renamed) {
-      remove_partial(tmp);
-      this->SetErrorCode(vtkErrorCode::CannotOpenFileError);
-      result = 0;
-    }
-    return result;
-  }
-};
-
-// Piece `rank` of `ranks` of frame `stem`; rank 0 also writes the summary (through its .tmp).
-template <class ParallelWriter>
-void write_piece(const std::string& stem, const std::string& extension, vtkDataObject* data,
-                 int rank, int ranks) {
-  const std::string summary = frame_file_name(stem, extension, ranks);
-  vtkSmartPointer<EveryPieceWriter<ParallelWriter>> writer =
-      vtkSmartPointer<EveryPieceWriter<ParallelWriter>>::Take(
-          EveryPieceWriter<ParallelWriter>::New());
-  writer->SetController(nullptr);        // ranks are plain numbers here; no VTK communication
-  writer->SetFileName(summary.c_str());  // sets the piece names: <stem>_<rank>.<extension>
-  writer->SetInputData(data);
-  writer->SetNumberOfPieces(ranks);
-  writer->SetStartPiece(rank);
-  writer->SetEndPiece(rank);
-  writer->SetGhostLevel(0);
-  writer->SetWriteSummaryFile(rank == 0);
-  writer->SetWriteToOutputString(rank == 0);  // the summary goes to a string, then atomically out
-  writer->SetDataModeToAppended();
-  writer->EncodeAppendedDataOff();
-  writer->SetCompressionLevel(frame_compression_level);
-  int system_error = 0;
-  if (!write_succeeded(writer, system_error))
-    throw IoError("cannot write the frame piece " + frame_piece_name(stem, extension, rank) + ": " +
-                  write_failure(writer, writer->SystemError ? writer->SystemError : system_error));
-  if (rank == 0) write_file_atomically(summary, writer->GetOutputString());
+// Piece `rank` of `ranks` of frame `stem` (written even when empty, with the same arrays, so
+// every piece the summary lists exists); rank 0 also writes the summary.
+void write_polys_piece(const std::string& stem, const VtpPolys& polys, int rank, int ranks) {
+  const std::string piece = frame_piece_name(stem, "vtp", rank);
+  write_vtp(piece + ".tmp", polys, frame_compression_level,
+            "cannot write the frame piece " + piece);
+  rename_into_place(piece + ".tmp", piece);
+  if (rank != 0) return;
+  std::vector<std::string> pieces;
+  for (int r = 0; r < ranks; ++r)
+    pieces.push_back(std::filesystem::path(frame_piece_name(stem, "vtp", r)).filename().string());
+  write_file_atomically(frame_file_name(stem, "vtp", ranks), pvtp_summary(polys, pieces));
 }
 
 // Checks the rank numbers; true on one rank (a plain .vtu/.vtp, no pieces).
@@ -438,20 +307,20 @@ void write_parallel_tet_frame(const std::string& stem, const Model& model,
 
 void write_point_frame(const std::string& path, const std::vector<double>& points,
                        const std::vector<FrameField>& point_fields) {
-  write_serial<vtkXMLPolyDataWriter>(path, point_poly(points, point_fields));
+  write_serial_polys(path, point_polys(points, point_fields));
 }
 
 void write_parallel_point_frame(const std::string& stem, const std::vector<double>& points,
                                 const std::vector<FrameField>& point_fields, int rank, int ranks) {
   if (single_rank(rank, ranks))
     return write_point_frame(frame_file_name(stem, "vtp", 1), points, point_fields);
-  write_piece<vtkXMLPPolyDataWriter>(stem, "vtp", point_poly(points, point_fields), rank, ranks);
+  write_polys_piece(stem, point_polys(points, point_fields), rank, ranks);
 }
 
 void write_triangle_frame(const std::string& path, const std::vector<double>& points,
                           const std::vector<std::int64_t>& triangles,
                           const std::vector<FrameField>& cell_fields) {
-  write_serial<vtkXMLPolyDataWriter>(path, triangle_poly(points, triangles, cell_fields));
+  write_serial_polys(path, triangle_polys(points, triangles, cell_fields));
 }
 
 void write_parallel_triangle_frame(const std::string& stem, const std::vector<double>& points,
@@ -460,8 +329,7 @@ void write_parallel_triangle_frame(const std::string& stem, const std::vector<do
                                    int ranks) {
   if (single_rank(rank, ranks))
     return write_triangle_frame(frame_file_name(stem, "vtp", 1), points, triangles, cell_fields);
-  write_piece<vtkXMLPPolyDataWriter>(stem, "vtp", triangle_poly(points, triangles, cell_fields),
-                                     rank, ranks);
+  write_polys_piece(stem, triangle_polys(points, triangles, cell_fields), rank, ranks);
 }
 
 }  // namespace fdem

@@ -4,9 +4,10 @@
 // N ranks (owner computes): every rank calls the parallel writer with the same path stem; rank r
 // writes the piece `<stem>_<r>.vtu` (VTK's own piece naming) and rank 0 also writes the summary
 // `<stem>.pvtu` that lists all N pieces (.vtp/.pvtp likewise).  A rank with nothing to write still
-// writes an empty piece with the same arrays, so the summary is always complete.  Pieces are
-// written with VTK's vtkXMLPUnstructuredGridWriter / vtkXMLPPolyDataWriter (StartPiece = EndPiece
-// = rank, no MPI controller); nothing in io/ calls MPI.
+// writes an empty piece with the same arrays, so the summary is always complete.  Files are
+// streamed by io/vtu_stream in the layout VTK's own XML writers use (appended zlib blocks), so
+// the engine does not link VTK (its libraries were ~9.5 MB resident in every rank); nothing in io/
+// calls MPI.
 //
 // Atomicity: every file (.vtu, .vtp, piece, .pvtu, .pvtp, .pvd) is written under `<name>.tmp` and
 // renamed, so a crash never leaves a torn file under its final name.  Between ranks there is no

@@ -112,6 +112,43 @@ void write_compressed(VtuFile& file, const VtuArray& a, int level) {
   file.seek(end);
 }
 
+// The appended data of `order` (each array with the position of its offset placeholder), the end
+// of the file, and every placeholder filled in.
+void write_appended_data(VtuFile& file,
+                         const std::vector<std::pair<const VtuArray*, std::int64_t>>& order,
+                         int level) {
+  file.write("  <AppendedData encoding=\"raw\">\n   _");
+  const std::int64_t data_start = file.tell();
+  std::vector<std::int64_t> offsets_in_data;
+  for (const auto& [array, placeholder] : order) {
+    offsets_in_data.push_back(file.tell() - data_start);
+    write_compressed(file, *array, level);
+  }
+  file.write("\n  </AppendedData>\n</VTKFile>\n");
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    file.seek(order[i].second);
+    file.write(std::to_string(offsets_in_data[i]));
+  }
+  file.close();
+}
+
+// Cell offsets 1, 2, ... or 3, 6, ...: the end of each cell's corners.
+VtuArray cell_offsets(std::size_t cells, int corners) {
+  return {"offsets", "Int64", 1, cells,
+          [corners](std::size_t first, std::size_t count, unsigned char* out) {
+            for (std::size_t c = 0; c < count; ++c) {
+              const std::int64_t end = corners * static_cast<std::int64_t>(first + c + 1);
+              std::memcpy(out + 8 * c, &end, 8);
+            }
+          }};
+}
+
+std::string file_head(const char* type) {
+  return std::string("<?xml version=\"1.0\"?>\n<VTKFile type=\"") + type +
+         "\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+         "compressor=\"vtkZLibDataCompressor\">\n";
+}
+
 }  // namespace
 
 std::size_t vtu_value_bytes(const char* type) {
@@ -125,13 +162,7 @@ std::size_t vtu_value_bytes(const char* type) {
 void write_vtu(const std::string& path, const VtuGrid& grid, int level, const std::string& what) {
   FDEM_VERIFY(grid.positions.tuples == grid.points && grid.tet_corners.tuples == grid.cells,
               "vtu grid sizes");
-  const VtuArray offsets{"offsets", "Int64", 1, grid.cells,
-                         [](std::size_t first, std::size_t count, unsigned char* out) {
-                           for (std::size_t c = 0; c < count; ++c) {
-                             const std::int64_t end = 4 * static_cast<std::int64_t>(first + c + 1);
-                             std::memcpy(out + 8 * c, &end, 8);
-                           }
-                         }};
+  const VtuArray offsets = cell_offsets(grid.cells, 4);
   const VtuArray types{"types", "UInt8", 1, grid.cells,
                        [](std::size_t, std::size_t count, unsigned char* out) {
                          std::fill_n(out, count, vtk_tetra);
@@ -141,9 +172,7 @@ void write_vtu(const std::string& path, const VtuGrid& grid, int level, const st
 
   VtuFile file(path, what);
   std::ostringstream head;
-  head << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
-          "byte_order=\"LittleEndian\" header_type=\"UInt64\" "
-          "compressor=\"vtkZLibDataCompressor\">\n  <UnstructuredGrid>\n"
+  head << file_head("UnstructuredGrid") << "  <UnstructuredGrid>\n"
        << "    <Piece NumberOfPoints=\"" << grid.points << "\" NumberOfCells=\"" << grid.cells
        << "\">\n      <PointData>\n";
   file.write(head.str());
@@ -162,28 +191,13 @@ void write_vtu(const std::string& path, const VtuGrid& grid, int level, const st
   declare(connectivity, false, "        ");
   declare(offsets, false, "        ");
   declare(types, false, "        ");
-  file.write(
-      "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n"
-      "   _");
-  const std::int64_t data_start = file.tell();
-  std::vector<std::int64_t> offsets_in_data;
-  for (const auto& [array, placeholder] : order) {
-    offsets_in_data.push_back(file.tell() - data_start);
-    write_compressed(file, *array, level);
-  }
-  file.write("\n  </AppendedData>\n</VTKFile>\n");
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    file.seek(order[i].second);
-    file.write(std::to_string(offsets_in_data[i]));
-  }
-  file.close();
+  file.write("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n");
+  write_appended_data(file, order, level);
 }
 
 std::string pvtu_summary(const VtuGrid& grid, const std::vector<std::string>& pieces) {
   std::ostringstream xml;
-  xml << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\" "
-         "byte_order=\"LittleEndian\" header_type=\"UInt64\" "
-         "compressor=\"vtkZLibDataCompressor\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n";
+  xml << file_head("PUnstructuredGrid") << "  <PUnstructuredGrid GhostLevel=\"0\">\n";
   const auto declare = [&](const VtuArray& a) {
     xml << "      <PDataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
     if (a.components != 1) xml << " NumberOfComponents=\"" << a.components << "\"";
@@ -198,6 +212,62 @@ std::string pvtu_summary(const VtuGrid& grid, const std::vector<std::string>& pi
   xml << "    </PPoints>\n";
   for (const std::string& piece : pieces) xml << "    <Piece Source=\"" << piece << "\"/>\n";
   xml << "  </PUnstructuredGrid>\n</VTKFile>\n";
+  return xml.str();
+}
+
+void write_vtp(const std::string& path, const VtpPolys& polys, int level, const std::string& what) {
+  const int corners = polys.kind == VtpPolys::Cells::vertices ? 1 : 3;
+  FDEM_VERIFY(polys.positions.tuples == polys.points && polys.corners.tuples == polys.cells &&
+                  polys.corners.components == corners,
+              "vtp poly data sizes");
+  const VtuArray offsets = cell_offsets(polys.cells, corners);
+  VtuArray connectivity = polys.corners;
+  connectivity.name = "connectivity";  // a tuple per cell, declared as one flat list
+  const bool vertices = polys.kind == VtpPolys::Cells::vertices;
+
+  VtuFile file(path, what);
+  std::ostringstream head;
+  head << file_head("PolyData") << "  <PolyData>\n"
+       << "    <Piece NumberOfPoints=\"" << polys.points << "\" NumberOfVerts=\""
+       << (vertices ? polys.cells : 0) << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
+       << "NumberOfPolys=\"" << (vertices ? 0 : polys.cells) << "\">\n      <PointData>\n";
+  file.write(head.str());
+  std::vector<std::pair<const VtuArray*, std::int64_t>> order;
+  const auto declare = [&](const VtuArray& a, bool show_components) {
+    order.emplace_back(&a, 0);
+    data_array_xml(file, a, show_components, order.back().second, "        ");
+  };
+  for (const VtuArray& a : polys.point_data) declare(a, true);
+  file.write("      </PointData>\n      <CellData>\n");
+  for (const VtuArray& a : polys.cell_data) declare(a, true);
+  file.write("      </CellData>\n      <Points>\n");
+  declare(polys.positions, true);
+  file.write("      </Points>\n");
+  file.write(vertices ? "      <Verts>\n" : "      <Polys>\n");
+  declare(connectivity, false);
+  declare(offsets, false);
+  file.write(vertices ? "      </Verts>\n" : "      </Polys>\n");
+  file.write("    </Piece>\n  </PolyData>\n");
+  write_appended_data(file, order, level);
+}
+
+std::string pvtp_summary(const VtpPolys& polys, const std::vector<std::string>& pieces) {
+  std::ostringstream xml;
+  xml << file_head("PPolyData") << "  <PPolyData GhostLevel=\"0\">\n";
+  const auto declare = [&](const VtuArray& a) {
+    xml << "      <PDataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
+    if (a.components != 1) xml << " NumberOfComponents=\"" << a.components << "\"";
+    xml << "/>\n";
+  };
+  xml << "    <PPointData>\n";
+  for (const VtuArray& a : polys.point_data) declare(a);
+  xml << "    </PPointData>\n    <PCellData>\n";
+  for (const VtuArray& a : polys.cell_data) declare(a);
+  xml << "    </PCellData>\n    <PPoints>\n";
+  declare(polys.positions);
+  xml << "    </PPoints>\n";
+  for (const std::string& piece : pieces) xml << "    <Piece Source=\"" << piece << "\"/>\n";
+  xml << "  </PPolyData>\n</VTKFile>\n";
   return xml.str();
 }
 

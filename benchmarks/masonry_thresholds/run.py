@@ -6,7 +6,7 @@ from the start at `ratio` × the rigid-block threshold and held under local damp
 
   benchmarks/masonry_thresholds/run.py [--fdem build/drivers/fdem] [--cases all|NAME,...]
                                        [--ratios all|R,...] [--hold-scale 1]
-                                       [--equilibrium-ratio R]
+                                       [--equilibrium-ratio R] [--penalty-factor F]
                                        [--csv docs/data/masonry_thresholds.csv]
   benchmarks/masonry_thresholds/run.py --references   # the rigid-block values only
 
@@ -25,6 +25,8 @@ d1 = |u(T)| − |u(T − w)|, d0 = |u(T − w)| − |u(T − 2w)|:
   stands     d1 < `still` (the problem's tolerance: the structure has stopped or turns back)
   turns      d1 > `moving` and d1 ≥ d0 (a mechanism accelerating)
   undecided  otherwise (still creeping: a longer hold would decide)
+With --penalty-factor F the contact penalty is F·E instead of the default (auto: 10 E): how
+the thresholds move with the hinges' contact stiffness.
 With --equilibrium-ratio R every hold also ends at equilibrium (quasi_static.equilibrium_ratio:
 the mean unbalanced-force ratio below R); a hold that ends so `stands (equilibrium)`, before its
 full time.
@@ -247,6 +249,8 @@ def main():
     p.add_argument("--references", action="store_true")
     p.add_argument("--hold-scale", type=float, default=1.0,
                    help="multiplies every hold (a quick check of the script: 0.1)")
+    p.add_argument("--penalty-factor", type=float, default=0.0,
+                   help="contact penalty as a multiple of E (default: the scene's auto, 10 E)")
     p.add_argument("--equilibrium-ratio", type=float, default=0.0,
                    help="end holds at equilibrium (quasi_static.equilibrium_ratio), e.g. 1e-4")
     a = p.parse_args()
@@ -273,6 +277,9 @@ def main():
             text = text.replace("quasi_static: {local_damping: 0.8}",
                                 "quasi_static: {local_damping: 0.8, equilibrium_ratio: %g}" %
                                 a.equilibrium_ratio)
+        if a.penalty_factor > 0:
+            text = text.replace("contact: {friction: 0.8}",
+                                "contact: {friction: 0.8, penalty: %g}" % (a.penalty_factor * 1.0e9))
         with tempfile.TemporaryDirectory() as workdir:
             rows, cpu, steps, at_equilibrium = run(a.fdem, text, workdir)
         verdict, end, d1 = outcome(rows, still, moving)
@@ -282,6 +289,7 @@ def main():
                                                                   d1, verdict), flush=True)
         results.append({"problem": name, "ratio": ratio, "reference": refs[name], "hold_s": hold,
                         "equilibrium_ratio": a.equilibrium_ratio,
+                        "penalty_factor": a.penalty_factor or 10.0,
                         "steps": steps, "cpu_s": cpu, "displacement_m": end,
                         "last_window_m": d1, "outcome": verdict})
     os.makedirs(os.path.dirname(a.csv), exist_ok=True)

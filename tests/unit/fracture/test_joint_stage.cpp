@@ -66,6 +66,19 @@ Model jointed_column() {
 }
 
 // Whether tet t lies in the upper cell (centroid above z = 1).
+// The pull below moves the upper cell's nodes by `lift` (m) a step; the stage reads the step
+// back from x − step·v, so they get the matching velocity.
+constexpr double kStep = 1e-3, kLift = 2.5e-6;
+
+bool upper(const Model& m, LocalIndex t);
+
+void set_lift_velocity(Model& m) {
+  for (LocalIndex t = 0; t < m.tets.size(); ++t)
+    if (upper(m, t))
+      for (int c = 0; c < 4; ++c)
+        m.nodes.v[3 * static_cast<std::size_t>(m.tets.nodes[4 * t + c]) + 2] = kLift / kStep;
+}
+
 bool upper(const Model& m, LocalIndex t) {
   double z = 0.0;
   for (int c = 0; c < 4; ++c)
@@ -82,7 +95,8 @@ TEST_CASE(
   Model model = jointed_column();
   REQUIRE(model.joints.size() > 0);
   JointStage stage(model);
-  JointStepSummary s = stage.add_forces(model, 0.0);
+  set_lift_velocity(model);
+  JointStepSummary s = stage.add_forces(model, 0.0, kStep);
   CHECK(s.newly_broken == 0);
   CHECK(s.stored_energy == 0.0);
 
@@ -95,9 +109,9 @@ TEST_CASE(
     for (LocalIndex t = 0; t < model.tets.size(); ++t)
       if (upper(model, t))
         for (int c = 0; c < 4; ++c)
-          model.nodes.x[3 * static_cast<std::size_t>(model.tets.nodes[4 * t + c]) + 2] += 2.5e-6;
+          model.nodes.x[3 * static_cast<std::size_t>(model.tets.nodes[4 * t + c]) + 2] += kLift;
     std::fill(model.nodes.f.begin(), model.nodes.f.end(), 0.0);
-    s = stage.add_forces(model, 0.001 * step);
+    s = stage.add_forces(model, 0.001 * step, kStep);
     dissipated += s.fracture_dissipated;
     newly += s.newly_broken;
     CHECK(static_cast<LocalIndex>(stage.newly_broken().size()) == s.newly_broken);
@@ -132,7 +146,8 @@ TEST_CASE(
     for (double& x : m->nodes.x) x *= 1.0 + 1e-6;  // a small stretch of everything
     std::fill(m->nodes.f.begin(), m->nodes.f.end(), 0.0);
   }
-  const JointStepSummary a = stage.add_forces(model, 1.0), b = rebound.add_forces(copy, 1.0);
+  const JointStepSummary a = stage.add_forces(model, 1.0, kStep),
+                         b = rebound.add_forces(copy, 1.0, kStep);
   CHECK(a.newly_broken == 0);  // the marked joint broke before: not new
   CHECK(a.broken == b.broken);
   CHECK(std::memcmp(model.nodes.f.data(), copy.nodes.f.data(),
@@ -141,11 +156,12 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "joint stage: pristine joints keep 48 bytes, those that damage get a full history, and the "
-    "forces and energies equal joint_force on full histories bit for bit",
+    "joint stage: pristine joints keep no state, those that damage get a full history, and the "
+    "forces and energies equal joint_force on full histories",
     "[fracture][stage]") {
   Model model = jointed_column();
   JointStage stage(model);
+  set_lift_velocity(model);
   CHECK(stage.live_histories() == 0);
   // Reference: every joint computed by joint_force with a full JointHistory of its own.
   JointStage full_laws(model);
@@ -173,21 +189,25 @@ TEST_CASE(
     for (LocalIndex t = 0; t < model.tets.size(); ++t)
       if (upper(model, t))
         for (int c = 0; c < 4; ++c)
-          model.nodes.x[3 * static_cast<std::size_t>(model.tets.nodes[4 * t + c]) + 2] += 2.5e-6;
+          model.nodes.x[3 * static_cast<std::size_t>(model.tets.nodes[4 * t + c]) + 2] += kLift;
     double stored = 0.0, fracture = 0.0;
     const std::vector<double> f_reference = reference_forces(stored, fracture);
     std::fill(model.nodes.f.begin(), model.nodes.f.end(), 0.0);
-    const JointStepSummary s = stage.add_forces(model, 0.001 * step);
+    const JointStepSummary s = stage.add_forces(model, 0.001 * step, kStep);
     for (LocalIndex j : stage.newly_broken()) reference[j].broken = true;
     INFO("step " << step);
     REQUIRE(std::memcmp(model.nodes.f.data(), f_reference.data(),
                         f_reference.size() * sizeof(double)) == 0);
     CHECK(std::memcmp(&s.stored_energy, &stored, sizeof(double)) == 0);
-    CHECK(std::memcmp(&s.fracture_dissipated, &fracture, sizeof(double)) == 0);
+    // Forces and stored energy bit for bit.  The dissipation of the step in which a joint leaves
+    // the pristine state starts from the previous step's opening and shear, which the stage
+    // rebuilds from x − step·v (the reference kept them): equal to round-off of the positions.
+    CHECK(s.fracture_dissipated == Approx(fracture).epsilon(1e-9).margin(1e-300));
     if (step == 1) CHECK(stage.live_histories() == 0);
     if (s.broken == 0) live_before_break = stage.live_histories();
   }
-  // Only the joints between the cells left the pristine state; history() writes all of them out.
+  // Only the joints between the cells left the pristine state; history() writes all of them out
+  // (the pristine ones as fresh histories: they keep no state).
   long across = 0;
   for (LocalIndex j = 0; j < model.joints.size(); ++j)
     across += upper(model, model.joints.tets[2 * j]) != upper(model, model.joints.tets[2 * j + 1]);
@@ -200,6 +220,13 @@ TEST_CASE(
   REQUIRE(written.size() == reference.size());
   for (std::size_t j = 0; j < written.size(); ++j) {
     CHECK(written[j].broken == reference[j].broken);
+    if (pristine(reference[j])) {
+      CHECK(pristine(written[j]));
+      for (int i = 0; i < 3; ++i)
+        CHECK((written[j].point[i].damage == 0.0 && written[j].point[i].previous_opening == 0.0 &&
+               written[j].point[i].previous_shear_sq == 0.0));
+      continue;
+    }
     for (int i = 0; i < 3; ++i) {
       CHECK(written[j].point[i].damage == reference[j].point[i].damage);
       CHECK(written[j].point[i].previous_opening == reference[j].point[i].previous_opening);
