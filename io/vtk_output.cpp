@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <sstream>
 
@@ -259,17 +260,30 @@ void write_serial_polys(const std::string& path, const VtpPolys& polys) {
 }
 
 // Piece `rank` of `ranks` of frame `stem` (written even when empty, with the same arrays, so
-// every piece the summary lists exists); rank 0 also writes the summary.
-void write_polys_piece(const std::string& stem, const VtpPolys& polys, int rank, int ranks) {
-  const std::string piece = frame_piece_name(stem, "vtp", rank);
-  write_vtp(piece + ".tmp", polys, frame_compression_level,
-            "cannot write the frame piece " + piece);
+// every piece the summary lists exists) through `write(path, what)`; rank 0 also writes the
+// summary that `summary(piece file names)` makes.
+void write_piece_and_summary(
+    const std::string& stem, const char* extension, int rank, int ranks,
+    const std::function<void(const std::string&, const std::string&)>& write,
+    const std::function<std::string(const std::vector<std::string>&)>& summary) {
+  const std::string piece = frame_piece_name(stem, extension, rank);
+  write(piece + ".tmp", "cannot write the frame piece " + piece);
   rename_into_place(piece + ".tmp", piece);
   if (rank != 0) return;
   std::vector<std::string> pieces;
   for (int r = 0; r < ranks; ++r)
-    pieces.push_back(std::filesystem::path(frame_piece_name(stem, "vtp", r)).filename().string());
-  write_file_atomically(frame_file_name(stem, "vtp", ranks), pvtp_summary(polys, pieces));
+    pieces.push_back(
+        std::filesystem::path(frame_piece_name(stem, extension, r)).filename().string());
+  write_file_atomically(frame_file_name(stem, extension, ranks), summary(pieces));
+}
+
+void write_polys_piece(const std::string& stem, const VtpPolys& polys, int rank, int ranks) {
+  write_piece_and_summary(
+      stem, "vtp", rank, ranks,
+      [&](const std::string& path, const std::string& what) {
+        write_vtp(path, polys, frame_compression_level, what);
+      },
+      [&](const std::vector<std::string>& pieces) { return pvtp_summary(polys, pieces); });
 }
 
 // Checks the rank numbers; true on one rank (a plain .vtu/.vtp, no pieces).
@@ -294,15 +308,12 @@ void write_parallel_tet_frame(const std::string& stem, const Model& model,
   if (single_rank(rank, ranks))
     return write_tet_frame(frame_file_name(stem, "vtu", 1), model, fields, extra);
   const OwnedTetGrid owned(model, fields, extra);
-  const std::string piece = frame_piece_name(stem, "vtu", rank);
-  write_vtu(piece + ".tmp", owned.grid(), frame_compression_level,
-            "cannot write the frame piece " + piece);
-  rename_into_place(piece + ".tmp", piece);
-  if (rank != 0) return;
-  std::vector<std::string> pieces;
-  for (int r = 0; r < ranks; ++r)
-    pieces.push_back(std::filesystem::path(frame_piece_name(stem, "vtu", r)).filename().string());
-  write_file_atomically(frame_file_name(stem, "vtu", ranks), pvtu_summary(owned.grid(), pieces));
+  write_piece_and_summary(
+      stem, "vtu", rank, ranks,
+      [&](const std::string& path, const std::string& what) {
+        write_vtu(path, owned.grid(), frame_compression_level, what);
+      },
+      [&](const std::vector<std::string>& pieces) { return pvtu_summary(owned.grid(), pieces); });
 }
 
 void write_point_frame(const std::string& path, const std::vector<double>& points,

@@ -149,6 +149,30 @@ std::string file_head(const char* type) {
          "compressor=\"vtkZLibDataCompressor\">\n";
 }
 
+// The summary (`type`: PUnstructuredGrid or PPolyData) of `pieces`, declaring the arrays' names,
+// types and components.
+std::string parallel_summary(const char* type, const std::vector<VtuArray>& point_data,
+                             const std::vector<VtuArray>& cell_data, const VtuArray& positions,
+                             const std::vector<std::string>& pieces) {
+  std::ostringstream xml;
+  xml << file_head(type) << "  <" << type << " GhostLevel=\"0\">\n";
+  const auto declare = [&](const VtuArray& a) {
+    xml << "      <PDataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
+    if (a.components != 1) xml << " NumberOfComponents=\"" << a.components << "\"";
+    xml << "/>\n";
+  };
+  xml << "    <PPointData>\n";
+  for (const VtuArray& a : point_data) declare(a);
+  xml << "    </PPointData>\n    <PCellData>\n";
+  for (const VtuArray& a : cell_data) declare(a);
+  xml << "    </PCellData>\n    <PPoints>\n";
+  declare(positions);
+  xml << "    </PPoints>\n";
+  for (const std::string& piece : pieces) xml << "    <Piece Source=\"" << piece << "\"/>\n";
+  xml << "  </" << type << ">\n</VTKFile>\n";
+  return xml.str();
+}
+
 }  // namespace
 
 std::size_t vtu_value_bytes(const char* type) {
@@ -196,23 +220,8 @@ void write_vtu(const std::string& path, const VtuGrid& grid, int level, const st
 }
 
 std::string pvtu_summary(const VtuGrid& grid, const std::vector<std::string>& pieces) {
-  std::ostringstream xml;
-  xml << file_head("PUnstructuredGrid") << "  <PUnstructuredGrid GhostLevel=\"0\">\n";
-  const auto declare = [&](const VtuArray& a) {
-    xml << "      <PDataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
-    if (a.components != 1) xml << " NumberOfComponents=\"" << a.components << "\"";
-    xml << "/>\n";
-  };
-  xml << "    <PPointData>\n";
-  for (const VtuArray& a : grid.point_data) declare(a);
-  xml << "    </PPointData>\n    <PCellData>\n";
-  for (const VtuArray& a : grid.cell_data) declare(a);
-  xml << "    </PCellData>\n    <PPoints>\n";
-  declare(grid.positions);
-  xml << "    </PPoints>\n";
-  for (const std::string& piece : pieces) xml << "    <Piece Source=\"" << piece << "\"/>\n";
-  xml << "  </PUnstructuredGrid>\n</VTKFile>\n";
-  return xml.str();
+  return parallel_summary("PUnstructuredGrid", grid.point_data, grid.cell_data, grid.positions,
+                          pieces);
 }
 
 void write_vtp(const std::string& path, const VtpPolys& polys, int level, const std::string& what) {
@@ -252,23 +261,7 @@ void write_vtp(const std::string& path, const VtpPolys& polys, int level, const 
 }
 
 std::string pvtp_summary(const VtpPolys& polys, const std::vector<std::string>& pieces) {
-  std::ostringstream xml;
-  xml << file_head("PPolyData") << "  <PPolyData GhostLevel=\"0\">\n";
-  const auto declare = [&](const VtuArray& a) {
-    xml << "      <PDataArray type=\"" << a.type << "\" Name=\"" << a.name << "\"";
-    if (a.components != 1) xml << " NumberOfComponents=\"" << a.components << "\"";
-    xml << "/>\n";
-  };
-  xml << "    <PPointData>\n";
-  for (const VtuArray& a : polys.point_data) declare(a);
-  xml << "    </PPointData>\n    <PCellData>\n";
-  for (const VtuArray& a : polys.cell_data) declare(a);
-  xml << "    </PCellData>\n    <PPoints>\n";
-  declare(polys.positions);
-  xml << "    </PPoints>\n";
-  for (const std::string& piece : pieces) xml << "    <Piece Source=\"" << piece << "\"/>\n";
-  xml << "  </PPolyData>\n</VTKFile>\n";
-  return xml.str();
+  return parallel_summary("PPolyData", polys.point_data, polys.cell_data, polys.positions, pieces);
 }
 
 }  // namespace fdem
