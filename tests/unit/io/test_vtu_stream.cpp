@@ -1,6 +1,6 @@
-// The streamed .vtu writer against VTK: a grid whose arrays span several zlib blocks (whole and
-// partial last blocks, every value type) is read back by VTK's reader bit for bit, and equals the
-// same grid written by VTK's own writer.
+// The streamed .vtu and .vtp writers against VTK: a grid whose arrays span several zlib blocks
+// (whole and partial last blocks, every value type) is read back by VTK's reader bit for bit, and
+// equals the same grid written by VTK's own writer.
 #include <unistd.h>
 #include <vtkCellData.h>
 #include <vtkDataArray.h>
@@ -10,8 +10,10 @@
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
+#include <vtkPolyData.h>
 #include <vtkTypeInt64Array.h>
 #include <vtkUnstructuredGrid.h>
+#include <vtkXMLPolyDataReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridWriter.h>
 
@@ -183,5 +185,95 @@ TEST_CASE("a .vtu that cannot be written: an IoError naming it, no file left", "
   CHECK_THROWS_WITH(fdem::write_vtu(path, grid(), 1, "cannot write the frame " + path),
                     Contains("cannot write the frame " + path + ": No such file or directory"));
   CHECK_FALSE(fs::exists(path));
+  fs::remove_all(dir);
+}
+
+namespace {
+
+// Poly data: triangles over the same points (3 Int64 corners a cell: 1365 a block, 3000 cells in
+// three blocks, the last partial), a per-triangle Float64 × 3 array; vertices one per point with
+// a per-point Float64 × 3 array.
+double cell_value(std::size_t c, int k) {
+  return std::sin(0.013 * c * (k + 1)) * 1e3;
+}
+
+fdem::VtpPolys polys(fdem::VtpPolys::Cells kind) {
+  fdem::VtpPolys p;
+  p.kind = kind;
+  p.points = n_points;
+  p.positions = array<double>("Points", "Float64", 3, n_points, coordinate);
+  if (kind == fdem::VtpPolys::Cells::triangles) {
+    p.cells = n_cells;
+    p.corners = array<std::int64_t>("connectivity", "Int64", 3, n_cells, corner);
+    p.cell_data.push_back(array<double>("traction", "Float64", 3, n_cells, cell_value));
+  } else {
+    p.cells = n_points;
+    p.corners = array<std::int64_t>("connectivity", "Int64", 1, n_points,
+                                    [](std::size_t v, int) { return std::int64_t(v); });
+    p.point_data.push_back(array<double>("force", "Float64", 3, n_points, cell_value));
+  }
+  return p;
+}
+
+// How many values of the poly data read from `path` differ from polys(kind).
+std::size_t wrong_values(const std::string& path, fdem::VtpPolys::Cells kind) {
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  REQUIRE(reader->GetErrorCode() == 0);
+  vtkPolyData* p = reader->GetOutput();
+  const bool triangles = kind == fdem::VtpPolys::Cells::triangles;
+  REQUIRE(p->GetNumberOfPoints() == static_cast<vtkIdType>(n_points));
+  REQUIRE(p->GetNumberOfCells() == static_cast<vtkIdType>(triangles ? n_cells : n_points));
+  REQUIRE(p->GetNumberOfPolys() == (triangles ? static_cast<vtkIdType>(n_cells) : 0));
+  REQUIRE(p->GetNumberOfVerts() == (triangles ? 0 : static_cast<vtkIdType>(n_points)));
+  vtkDataArray* values =
+      triangles ? p->GetCellData()->GetArray("traction") : p->GetPointData()->GetArray("force");
+  REQUIRE(values);
+  REQUIRE(values->GetNumberOfComponents() == 3);
+  std::size_t wrong = 0;
+  for (std::size_t q = 0; q < n_points; ++q) {
+    double x[3];
+    p->GetPoint(q, x);
+    for (int k = 0; k < 3; ++k) wrong += x[k] != coordinate(q, k);
+  }
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType c = 0; c < p->GetNumberOfCells(); ++c) {
+    p->GetCellPoints(c, ids);
+    wrong += ids->GetNumberOfIds() != (triangles ? 3 : 1);
+    for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
+      wrong += ids->GetId(k) != (triangles ? corner(c, k) : c);
+    for (int k = 0; k < 3; ++k) wrong += values->GetComponent(c, k) != cell_value(c, k);
+  }
+  return wrong;
+}
+
+}  // namespace
+
+TEST_CASE("a streamed .vtp of triangles or of vertices reads back bit for bit with VTK's reader",
+          "[io][vtk]") {
+  const std::string dir = temp_dir();
+  for (const auto kind : {fdem::VtpPolys::Cells::triangles, fdem::VtpPolys::Cells::vertices}) {
+    const std::string path = dir + "/streamed.vtp";
+    fdem::write_vtp(path, polys(kind), 1, "cannot write the test frame");
+    CHECK(wrong_values(path, kind) == 0);
+  }
+  // An empty piece (as a rank without contacts writes): zero points and cells, same arrays.
+  fdem::VtpPolys empty = polys(fdem::VtpPolys::Cells::vertices);
+  empty.points = empty.cells = empty.positions.tuples = empty.corners.tuples = 0;
+  empty.point_data[0].tuples = 0;
+  fdem::write_vtp(dir + "/empty.vtp", empty, 1, "cannot write the test frame");
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName((dir + "/empty.vtp").c_str());
+  reader->Update();
+  CHECK(reader->GetErrorCode() == 0);
+  CHECK(reader->GetOutput()->GetNumberOfPoints() == 0);
+  CHECK(reader->GetOutput()->GetPointData()->GetArray("force") != nullptr);
+  // A .vtp that cannot be written: an IoError naming it, no file left.
+  const std::string missing = dir + "/missing/frame.vtp";
+  CHECK_THROWS_WITH(fdem::write_vtp(missing, polys(fdem::VtpPolys::Cells::vertices), 1,
+                                    "cannot write the frame " + missing),
+                    Contains("cannot write the frame " + missing + ": No such file or directory"));
+  CHECK_FALSE(fs::exists(missing));
   fs::remove_all(dir);
 }
