@@ -107,21 +107,30 @@ inline bool joint_frame(const Vec3 (&x)[6], JointFrame& frame) {
   return true;
 }
 
-// What a pristine joint's step leaves in its state at positions x (m), by joint_intact_step's own
-// arithmetic: the joint stage keeps no state for pristine joints and, when one first leaves the
+// The three points' gap Δ = b_i − a_i (m), opening Δ·n (m) and shear stress squared
+// max(0, k_t²(|Δ|² − (Δ·n)²)) (Pa²) in the frame's normal n: what the intact step tests against
+// the strength and what it leaves in the state.
+inline void intact_point_measures(const Vec3 (&x)[6], const Vec3& n, double k_t, Vec3 (&gap)[3],
+                                  double (&dn)[3], double (&shear_sq)[3]) {
+  for (int i = 0; i < 3; ++i) {
+    gap[i] = x[3 + i] - x[i];
+    dn[i] = gap[i].dot(n);
+    shear_sq[i] = std::max(0.0, k_t * k_t * (gap[i].squaredNorm() - dn[i] * dn[i]));
+  }
+}
+
+// What a pristine joint's step leaves in its state at positions x (m), by the step's own
+// measures: the joint stage keeps no state for pristine joints and, when one first leaves the
 // pristine state, rebuilds the previous step's from the previous positions.  False (state
 // zeroed) when the mid-surface has no area.
 inline bool intact_state_at(const Vec3 (&x)[6], const CohesiveLaw& law, IntactJointState& state) {
   state = IntactJointState{};
   JointFrame frame;
   if (!joint_frame(x, frame)) return false;
-  const double k_t = law.tangential_stiffness();
-  for (int i = 0; i < 3; ++i) {
-    const Vec3 gap = x[3 + i] - x[i];
-    const double dn = gap.dot(frame.n);
-    state.previous_opening[i] = std::max(dn, 0.0);
-    state.previous_shear_sq[i] = std::max(0.0, k_t * k_t * (gap.squaredNorm() - dn * dn));
-  }
+  Vec3 gap[3];
+  double dn[3];
+  intact_point_measures(x, frame.n, law.tangential_stiffness(), gap, dn, state.previous_shear_sq);
+  for (int i = 0; i < 3; ++i) state.previous_opening[i] = std::max(dn[i], 0.0);
   return true;
 }
 
@@ -136,10 +145,8 @@ inline bool joint_intact_step(const Vec3 (&x)[6], const JointFrame& frame, doubl
   const double friction = k_n * law.tan_friction();  // σc·tanφ = −dn·k_n·tanφ
   Vec3 gap[3];
   double dn[3], shear_sq[3];
+  intact_point_measures(x, n, k_t, gap, dn, shear_sq);
   for (int i = 0; i < 3; ++i) {
-    gap[i] = x[3 + i] - x[i];
-    dn[i] = gap[i].dot(n);
-    shear_sq[i] = std::max(0.0, k_t * k_t * (gap[i].squaredNorm() - dn[i] * dn[i]));
     const double strength = cohesion - friction * std::min(dn[i], 0.0);
     if (dn[i] > peak || shear_sq[i] > strength * strength) return false;
   }

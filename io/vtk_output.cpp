@@ -167,7 +167,7 @@ class OwnedTetGrid {
                          for (std::size_t p = 0; p < count; ++p)
                            std::memcpy(out + 24 * p, &nodes.x[3 * points[first + p]], 24);
                        }};
-    grid_.tet_corners = {
+    grid_.corners = {
         "connectivity", "Int64", 4, cells.size(),
         [this, &tets, cells](std::size_t first, std::size_t count, unsigned char* out) {
           for (std::size_t c = 0; c < count; ++c)

@@ -151,8 +151,7 @@ std::string file_head(const char* type) {
 
 // The summary (`type`: PUnstructuredGrid or PPolyData) of `pieces`, declaring the arrays' names,
 // types and components.
-std::string parallel_summary(const char* type, const std::vector<VtuArray>& point_data,
-                             const std::vector<VtuArray>& cell_data, const VtuArray& positions,
+std::string parallel_summary(const char* type, const VtuGrid& grid,
                              const std::vector<std::string>& pieces) {
   std::ostringstream xml;
   xml << file_head(type) << "  <" << type << " GhostLevel=\"0\">\n";
@@ -162,11 +161,11 @@ std::string parallel_summary(const char* type, const std::vector<VtuArray>& poin
     xml << "/>\n";
   };
   xml << "    <PPointData>\n";
-  for (const VtuArray& a : point_data) declare(a);
+  for (const VtuArray& a : grid.point_data) declare(a);
   xml << "    </PPointData>\n    <PCellData>\n";
-  for (const VtuArray& a : cell_data) declare(a);
+  for (const VtuArray& a : grid.cell_data) declare(a);
   xml << "    </PCellData>\n    <PPoints>\n";
-  declare(positions);
+  declare(grid.positions);
   xml << "    </PPoints>\n";
   for (const std::string& piece : pieces) xml << "    <Piece Source=\"" << piece << "\"/>\n";
   xml << "  </" << type << ">\n</VTKFile>\n";
@@ -184,14 +183,14 @@ std::size_t vtu_value_bytes(const char* type) {
 }
 
 void write_vtu(const std::string& path, const VtuGrid& grid, int level, const std::string& what) {
-  FDEM_VERIFY(grid.positions.tuples == grid.points && grid.tet_corners.tuples == grid.cells,
+  FDEM_VERIFY(grid.positions.tuples == grid.points && grid.corners.tuples == grid.cells,
               "vtu grid sizes");
   const VtuArray offsets = cell_offsets(grid.cells, 4);
   const VtuArray types{"types", "UInt8", 1, grid.cells,
                        [](std::size_t, std::size_t count, unsigned char* out) {
                          std::fill_n(out, count, vtk_tetra);
                        }};
-  VtuArray connectivity = grid.tet_corners;
+  VtuArray connectivity = grid.corners;
   connectivity.name = "connectivity";
 
   VtuFile file(path, what);
@@ -220,8 +219,7 @@ void write_vtu(const std::string& path, const VtuGrid& grid, int level, const st
 }
 
 std::string pvtu_summary(const VtuGrid& grid, const std::vector<std::string>& pieces) {
-  return parallel_summary("PUnstructuredGrid", grid.point_data, grid.cell_data, grid.positions,
-                          pieces);
+  return parallel_summary("PUnstructuredGrid", grid, pieces);
 }
 
 void write_vtp(const std::string& path, const VtpPolys& polys, int level, const std::string& what) {
@@ -261,7 +259,7 @@ void write_vtp(const std::string& path, const VtpPolys& polys, int level, const 
 }
 
 std::string pvtp_summary(const VtpPolys& polys, const std::vector<std::string>& pieces) {
-  return parallel_summary("PPolyData", polys.point_data, polys.cell_data, polys.positions, pieces);
+  return parallel_summary("PPolyData", polys, pieces);
 }
 
 }  // namespace fdem

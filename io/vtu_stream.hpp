@@ -28,12 +28,14 @@ struct VtuArray {
 // The size in bytes of one value of VTK type `type`.
 std::size_t vtu_value_bytes(const char* type);
 
+// Points with their arrays, and cells as point indices with theirs.
 struct VtuGrid {
   std::size_t points = 0, cells = 0;
   std::vector<VtuArray> point_data, cell_data;
   VtuArray positions;  // Float64 × 3 per point
-  // Tet corners as point indices (Int64 × 4 per cell); offsets and types are derived.
-  VtuArray tet_corners;
+  // Cell corners as point indices (Int64 × corners per cell: 4 in a .vtu, whose cells are tets;
+  // 1 or 3 in a .vtp); offsets and types are derived.
+  VtuArray corners;
 };
 
 // Writes `grid` to `path` with zlib at `level`.  Throws IoError ("cannot write <what> <path>:
@@ -46,14 +48,9 @@ std::string pvtu_summary(const VtuGrid& grid, const std::vector<std::string>& pi
 
 // Poly data of one kind of cell: vertices (one point each: contact points) or triangles (crack
 // faces).  Written as VTK's own poly-data writer does (appended raw zlib blocks, UInt64 headers).
-struct VtpPolys {
+struct VtpPolys : VtuGrid {
   enum class Cells { vertices, triangles };
   Cells kind = Cells::vertices;
-  std::size_t points = 0, cells = 0;
-  std::vector<VtuArray> point_data, cell_data;
-  VtuArray positions;  // Float64 × 3 per point
-  // Point indices (Int64 × 1 or 3 per cell); offsets are derived.
-  VtuArray corners;
 };
 
 void write_vtp(const std::string& path, const VtpPolys& polys, int level, const std::string& what);

@@ -76,7 +76,7 @@ fdem::VtuGrid grid() {
   g.cell_data.push_back(array<std::int32_t>("piece", "Int32", 1, n_cells,
                                             [](std::size_t c, int) { return piece(c); }));
   g.positions = array<double>("Points", "Float64", 3, n_points, coordinate);
-  g.tet_corners = array<std::int64_t>("connectivity", "Int64", 4, n_cells, corner);
+  g.corners = array<std::int64_t>("connectivity", "Int64", 4, n_cells, corner);
   return g;
 }
 
