@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <initializer_list>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -172,6 +173,36 @@ std::string parallel_summary(const char* type, const VtuGrid& grid,
   return xml.str();
 }
 
+// One piece of `type` (UnstructuredGrid or PolyData) with `piece_attributes` (its counts): the
+// grid's point and cell arrays, its positions, and its cells in `cells_element` as the corners
+// (connectivity, one tuple a cell, declared as one flat list) followed by `cell_arrays`.
+void write_grid_file(const std::string& path, const std::string& what, int level, const char* type,
+                     const std::string& piece_attributes, const VtuGrid& grid,
+                     const char* cells_element,
+                     std::initializer_list<const VtuArray*> cell_arrays) {
+  VtuArray connectivity = grid.corners;
+  connectivity.name = "connectivity";
+  VtuFile file(path, what);
+  file.write(file_head(type) + "  <" + type + ">\n    <Piece " + piece_attributes +
+             ">\n      <PointData>\n");
+  // Arrays in the order of the XML, each with the position of its offset placeholder.
+  std::vector<std::pair<const VtuArray*, std::int64_t>> order;
+  const auto declare = [&](const VtuArray& a, bool show_components) {
+    order.emplace_back(&a, 0);
+    data_array_xml(file, a, show_components, order.back().second, "        ");
+  };
+  for (const VtuArray& a : grid.point_data) declare(a, true);
+  file.write("      </PointData>\n      <CellData>\n");
+  for (const VtuArray& a : grid.cell_data) declare(a, true);
+  file.write("      </CellData>\n      <Points>\n");
+  declare(grid.positions, true);
+  file.write(std::string("      </Points>\n      <") + cells_element + ">\n");
+  declare(connectivity, false);
+  for (const VtuArray* a : cell_arrays) declare(*a, false);
+  file.write(std::string("      </") + cells_element + ">\n    </Piece>\n  </" + type + ">\n");
+  write_appended_data(file, order, level);
+}
+
 }  // namespace
 
 std::size_t vtu_value_bytes(const char* type) {
@@ -190,32 +221,10 @@ void write_vtu(const std::string& path, const VtuGrid& grid, int level, const st
                        [](std::size_t, std::size_t count, unsigned char* out) {
                          std::fill_n(out, count, vtk_tetra);
                        }};
-  VtuArray connectivity = grid.corners;
-  connectivity.name = "connectivity";
-
-  VtuFile file(path, what);
-  std::ostringstream head;
-  head << file_head("UnstructuredGrid") << "  <UnstructuredGrid>\n"
-       << "    <Piece NumberOfPoints=\"" << grid.points << "\" NumberOfCells=\"" << grid.cells
-       << "\">\n      <PointData>\n";
-  file.write(head.str());
-  // Arrays in the order of the XML, each with the position of its offset placeholder.
-  std::vector<std::pair<const VtuArray*, std::int64_t>> order;
-  const auto declare = [&](const VtuArray& a, bool show_components, const char* indent) {
-    order.emplace_back(&a, 0);
-    data_array_xml(file, a, show_components, order.back().second, indent);
-  };
-  for (const VtuArray& a : grid.point_data) declare(a, true, "        ");
-  file.write("      </PointData>\n      <CellData>\n");
-  for (const VtuArray& a : grid.cell_data) declare(a, true, "        ");
-  file.write("      </CellData>\n      <Points>\n");
-  declare(grid.positions, true, "        ");
-  file.write("      </Points>\n      <Cells>\n");
-  declare(connectivity, false, "        ");
-  declare(offsets, false, "        ");
-  declare(types, false, "        ");
-  file.write("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n");
-  write_appended_data(file, order, level);
+  std::ostringstream piece;
+  piece << "NumberOfPoints=\"" << grid.points << "\" NumberOfCells=\"" << grid.cells << "\"";
+  write_grid_file(path, what, level, "UnstructuredGrid", piece.str(), grid, "Cells",
+                  {&offsets, &types});
 }
 
 std::string pvtu_summary(const VtuGrid& grid, const std::vector<std::string>& pieces) {
@@ -223,39 +232,18 @@ std::string pvtu_summary(const VtuGrid& grid, const std::vector<std::string>& pi
 }
 
 void write_vtp(const std::string& path, const VtpPolys& polys, int level, const std::string& what) {
-  const int corners = polys.kind == VtpPolys::Cells::vertices ? 1 : 3;
+  const bool vertices = polys.kind == VtpPolys::Cells::vertices;
+  const int corners = vertices ? 1 : 3;
   FDEM_VERIFY(polys.positions.tuples == polys.points && polys.corners.tuples == polys.cells &&
                   polys.corners.components == corners,
               "vtp poly data sizes");
   const VtuArray offsets = cell_offsets(polys.cells, corners);
-  VtuArray connectivity = polys.corners;
-  connectivity.name = "connectivity";  // a tuple per cell, declared as one flat list
-  const bool vertices = polys.kind == VtpPolys::Cells::vertices;
-
-  VtuFile file(path, what);
-  std::ostringstream head;
-  head << file_head("PolyData") << "  <PolyData>\n"
-       << "    <Piece NumberOfPoints=\"" << polys.points << "\" NumberOfVerts=\""
-       << (vertices ? polys.cells : 0) << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
-       << "NumberOfPolys=\"" << (vertices ? 0 : polys.cells) << "\">\n      <PointData>\n";
-  file.write(head.str());
-  std::vector<std::pair<const VtuArray*, std::int64_t>> order;
-  const auto declare = [&](const VtuArray& a, bool show_components) {
-    order.emplace_back(&a, 0);
-    data_array_xml(file, a, show_components, order.back().second, "        ");
-  };
-  for (const VtuArray& a : polys.point_data) declare(a, true);
-  file.write("      </PointData>\n      <CellData>\n");
-  for (const VtuArray& a : polys.cell_data) declare(a, true);
-  file.write("      </CellData>\n      <Points>\n");
-  declare(polys.positions, true);
-  file.write("      </Points>\n");
-  file.write(vertices ? "      <Verts>\n" : "      <Polys>\n");
-  declare(connectivity, false);
-  declare(offsets, false);
-  file.write(vertices ? "      </Verts>\n" : "      </Polys>\n");
-  file.write("    </Piece>\n  </PolyData>\n");
-  write_appended_data(file, order, level);
+  std::ostringstream piece;
+  piece << "NumberOfPoints=\"" << polys.points << "\" NumberOfVerts=\""
+        << (vertices ? polys.cells : 0) << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
+        << "NumberOfPolys=\"" << (vertices ? 0 : polys.cells) << "\"";
+  write_grid_file(path, what, level, "PolyData", piece.str(), polys, vertices ? "Verts" : "Polys",
+                  {&offsets});
 }
 
 std::string pvtp_summary(const VtpPolys& polys, const std::vector<std::string>& pieces) {
