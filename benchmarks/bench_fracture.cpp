@@ -75,7 +75,7 @@ Case run(const std::string& name, int cells, long steps) {
   // (the jointed body breaks apart within a few wave transits), 0.5 m/s stays elastic.
   const double v0 = name == "fragmenting" ? 20.0 : 0.5;
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    model.nodes.v[3 * n] = v0 * (2 * model.nodes.x0[3 * n] / size - 1);
+    model.nodes.v[3 * n] = v0 * (2 * model.nodes.x0(n)[0] / size - 1);
   sim->step();  // first detection outside the timing
   const double t0 = cpu_seconds();
   for (long s = 0; s < steps; ++s) sim->step();

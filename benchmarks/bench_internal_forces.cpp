@@ -166,7 +166,7 @@ void perturb(Model& model, double cell_size, std::uint64_t seed) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   NodeArrays& nodes = model.nodes;
   for (std::size_t i = 0; i < nodes.x.size(); ++i) {
-    nodes.x[i] = nodes.x0[i] + 1e-3 * cell_size * u(rng);
+    nodes.x[i] = nodes.x0(i / 3)[i % 3] + 1e-3 * cell_size * u(rng);
     nodes.v[i] = 1e-3 * u(rng);
   }
 }

@@ -36,7 +36,7 @@ Model slab_and_post(double length) {
 void slide_post(Model& model, double shift) {
   NodeArrays& n = model.nodes;
   for (LocalIndex i = 0; i < n.size(); ++i)
-    if (n.x0[3 * i + 2] > 0.205) n.x[3 * i] += shift;
+    if (n.x0(i)[2] > 0.205) n.x[3 * i] += shift;
 }
 
 }  // namespace

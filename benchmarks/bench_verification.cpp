@@ -109,8 +109,8 @@ double face_position(const Model& model, int body, int k, double at, bool displa
   int n = 0;
   for (LocalIndex i = 0; i < model.nodes.size(); ++i)
     if (model.pieces[model.nodes.piece[i]].body == body &&
-        std::abs(model.nodes.x0[3 * i + k] - at) < 1e-9) {
-      sum += model.nodes.x[3 * i + k] - (displacement ? model.nodes.x0[3 * i + k] : 0.0);
+        std::abs(model.nodes.x0(i)[k] - at) < 1e-9) {
+      sum += model.nodes.x[3 * i + k] - (displacement ? model.nodes.x0(i)[k] : 0.0);
       ++n;
     }
   return sum / n;
@@ -152,11 +152,11 @@ std::vector<Measure> stopped_bar(const Setting& s) {
   std::vector<LocalIndex> probe, free_end;
   for (LocalIndex t = 0; t < model.tets.size(); ++t) {
     double cx = 0;
-    for (int c = 0; c < 4; ++c) cx += 0.25 * model.nodes.x0[3 * model.tets.nodes[4 * t + c]];
+    for (int c = 0; c < 4; ++c) cx += 0.25 * model.nodes.x0(model.tets.nodes[4 * t + c])[0];
     if (std::abs(cx - L / 2) < std::max(L / 160, 0.5 * L / nx)) probe.push_back(t);
   }
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.nodes.x0[3 * n] == L) free_end.push_back(n);
+    if (model.nodes.x0(n)[0] == L) free_end.push_back(n);
   const StVenantKirchhoff law{model.materials[0].lame};
   auto probe_stress = [&]() {
     double sum = 0;
@@ -310,7 +310,7 @@ std::vector<Measure> axial_frequency(const Setting& s) {
   auto sim = quiet_simulation(scene);
   Model& model = sim->model();
   for (LocalIndex i = 0; i < model.nodes.size(); ++i)
-    model.nodes.v[3 * i] = 0.01 * std::cos(M_PI * model.nodes.x0[3 * i] / L);
+    model.nodes.v[3 * i] = 0.01 * std::cos(M_PI * model.nodes.x0(i)[0] / L);
   CrossingCounter crossings;
   while (sim->time() < scene.time.end) {
     sim->step();
@@ -336,7 +336,7 @@ std::vector<Measure> bending_frequency(const Setting& s) {
   const double bl = beta * L;
   const double sigma = (std::cosh(bl) - std::cos(bl)) / (std::sinh(bl) - std::sin(bl));
   for (LocalIndex i = 0; i < model.nodes.size(); ++i) {
-    const double x = beta * model.nodes.x0[3 * i];
+    const double x = beta * model.nodes.x0(i)[0];
     model.nodes.v[3 * i + 2] =
         1e-3 * (std::cosh(x) + std::cos(x) - sigma * (std::sinh(x) + std::sin(x)));
   }
@@ -346,8 +346,7 @@ std::vector<Measure> bending_frequency(const Setting& s) {
     double zm = 0, ze = 0;
     int nm = 0, ne = 0;
     for (LocalIndex i = 0; i < model.nodes.size(); ++i) {
-      const double X = model.nodes.x0[3 * i],
-                   u = model.nodes.x[3 * i + 2] - model.nodes.x0[3 * i + 2];
+      const double X = model.nodes.x0(i)[0], u = model.nodes.x[3 * i + 2] - model.nodes.x0(i)[2];
       if (std::abs(X - L / 2) < 1e-9) zm += u, ++nm;
       if (X == 0 || X == L) ze += u, ++ne;
     }

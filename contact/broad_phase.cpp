@@ -8,19 +8,19 @@
 
 namespace fdem {
 
-void inflate_boxes(const double* lo, const double* hi, LocalIndex n, double buffer,
-                   std::vector<double>& boxes) {
+void inflate_boxes_in_place(std::vector<double>& boxes, LocalIndex n, double buffer) {
   if (!(buffer >= 0.0) || !std::isfinite(buffer)) {
     throw InputError("contact detection: the buffer must be a finite distance >= 0 (m), got " +
                      std::to_string(buffer) + ".");
   }
   if (n < 0) throw InputError("contact detection: negative element count.");
+  FDEM_VERIFY(boxes.size() == 6 * static_cast<std::size_t>(n), "6 doubles per box");
   const double half = 0.5 * buffer;
-  boxes.resize(6 * static_cast<std::size_t>(n));
   for (LocalIndex i = 0; i < n; ++i) {
+    double* box = boxes.data() + 6 * static_cast<std::size_t>(i);
     for (int k = 0; k < 3; ++k) {
-      const double l = lo[3 * i + k];
-      const double h = hi[3 * i + k];
+      const double l = box[k];
+      const double h = box[3 + k];
       if (!std::isfinite(l) || !std::isfinite(h)) {
         throw NumericalFailure("contact detection: element " + std::to_string(i) +
                                " has a non-finite bounding box (its nodes left the finite range); "
@@ -30,10 +30,21 @@ void inflate_boxes(const double* lo, const double* hi, LocalIndex n, double buff
         throw InputError("contact detection: element " + std::to_string(i) +
                          " has a bounding box with min > max on axis " + std::to_string(k) + ".");
       }
-      boxes[6 * i + k] = l - half;
-      boxes[6 * i + 3 + k] = h + half;
+      box[k] = l - half;
+      box[3 + k] = h + half;
     }
   }
+}
+
+void inflate_boxes(const double* lo, const double* hi, LocalIndex n, double buffer,
+                   std::vector<double>& boxes) {
+  boxes.resize(6 * static_cast<std::size_t>(std::max<LocalIndex>(n, 0)));
+  for (LocalIndex i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      boxes[6 * static_cast<std::size_t>(i) + k] = lo[3 * i + k];
+      boxes[6 * static_cast<std::size_t>(i) + 3 + k] = hi[3 * i + k];
+    }
+  inflate_boxes_in_place(boxes, n, buffer);
 }
 
 void sort_pairs(std::vector<CandidatePair>& pairs, LocalIndex n,

@@ -59,6 +59,9 @@ class PairFilter {
 // coordinates (a run that blew up).
 void inflate_boxes(const double* lo, const double* hi, LocalIndex n, double buffer,
                    std::vector<double>& boxes);
+// The same for boxes given as 6 doubles per element [lo xyz, hi xyz], inflated in place (the same
+// arithmetic and checks): a detection then holds one copy of the boxes, not two.
+void inflate_boxes_in_place(std::vector<double>& boxes, LocalIndex n, double buffer);
 
 // The one overlap predicate (closed boxes, 6 doubles each as produced by inflate_boxes).
 // Bitwise & on purpose: all six comparisons, one hard-to-predict branch fewer per test.

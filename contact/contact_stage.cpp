@@ -127,8 +127,8 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
   detected_ = detected;
   travel_bound_ = std::numeric_limits<double>::infinity();  // x_at_detection is not x now
   pairs_.clear();
-  x_at_detection_ = {};
-  kept_nodes_ = {};
+  release(x_at_detection_);
+  release(kept_nodes_);
   every_node_kept_ = true;
   if (!detected_) return;  // positions at detection are taken by the first detection
   // The positions the last detection saw: of the nodes it looks at, once left_out_ is known.
@@ -163,7 +163,7 @@ void ContactStage::keep_positions(const Model& model, const double* x) {
   const std::size_t n_nodes = static_cast<std::size_t>(model.nodes.size());
   if (left_out_count_ == 0) {
     every_node_kept_ = true;
-    kept_nodes_ = {};
+    release(kept_nodes_);
     x_at_detection_.assign(x, x + 3 * n_nodes);
     return;
   }
@@ -226,15 +226,14 @@ std::vector<GidPair> ContactStage::candidate_gids(const Model& model) const {
 }
 
 void ContactStage::release_until_rebind() {
-  pairs_ = {};
-  overlapping_ = {};
-  may_hold_friction_ = {};
-  records_ = {};
-  lo_ = {};
-  hi_ = {};
-  x_at_detection_ = {};
-  kept_nodes_ = {};
-  friction_ = {};
+  release(pairs_);
+  release(overlapping_);
+  release(may_hold_friction_);
+  release(records_);
+  release(boxes_);
+  release(x_at_detection_);
+  release(kept_nodes_);
+  release(friction_);
   detector_.release_workspace();
 }
 

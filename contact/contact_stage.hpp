@@ -173,7 +173,7 @@ class ContactStage {
 
  private:
   static bool piece_fixed(const Model& model, std::int32_t piece);
-  // Boxes (lo_, hi_) of every tet, or of `members` only (in their order).
+  // Boxes (boxes_) of every tet, or of `members` only (in their order).
   void compute_boxes(const Model& model, const double* x,
                      const std::vector<LocalIndex>* members = nullptr);
   ContactWork work_against(const Model& model, double dt) const;
@@ -184,7 +184,7 @@ class ContactStage {
   double buffer_ = 0.0;
   std::vector<double> penalty_;
   NbsDetector detector_;
-  std::vector<double> lo_, hi_;
+  std::vector<double> boxes_;  // 6 per tet: lo xyz, hi xyz (m); between compute_boxes and detection
   // Positions at the last detection (m, xyz): of every local node while every_node_kept_, else
   // of kept_nodes_ (ascending), the nodes of the tets that may pair.  An intact jointed body's
   // enclosed tets hold most of its nodes, whose positions no detection needs (24 B per node).

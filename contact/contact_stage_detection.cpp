@@ -16,8 +16,7 @@ void ContactStage::compute_boxes(const Model& model, const double* x,
                                  const std::vector<LocalIndex>* members) {
   const TetArrays& tets = model.tets;
   const std::size_t n = members ? members->size() : static_cast<std::size_t>(tets.size());
-  lo_.resize(3 * n);
-  hi_.resize(3 * n);
+  boxes_.resize(6 * n);
   for (std::size_t i = 0; i < n; ++i) {
     const LocalIndex t = members ? (*members)[i] : static_cast<LocalIndex>(i);
     for (int k = 0; k < 3; ++k) {
@@ -31,8 +30,8 @@ void ContactStage::compute_boxes(const Model& model, const double* x,
         throw NumericalFailure("contact detection: tet " + std::to_string(tets.gid[t]) +
                                " has a non-finite bounding box (its nodes left the finite "
                                "range); reduce the time step or check the loads.");
-      lo_[3 * i + k] = lo;
-      hi_[3 * i + k] = hi;
+      boxes_[6 * i + k] = lo;
+      boxes_[6 * i + 3 + k] = hi;
     }
   }
 }
@@ -41,11 +40,11 @@ namespace {
 
 // True if two tets have a node at the same reference position (nodes split from one mesh node).
 bool share_reference_node(const Model& model, LocalIndex a, LocalIndex b) {
-  const double* x0 = model.nodes.x0.data();
+  const NodeArrays& nodes = model.nodes;
   for (int i = 0; i < 4; ++i) {
-    const double* p = x0 + 3 * model.tets.nodes[4 * a + i];
+    const double* p = nodes.x0(model.tets.nodes[4 * a + i]).data();
     for (int j = 0; j < 4; ++j) {
-      const double* q = x0 + 3 * model.tets.nodes[4 * b + j];
+      const double* q = nodes.x0(model.tets.nodes[4 * b + j]).data();
       if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) return true;
     }
   }
@@ -176,12 +175,11 @@ void ContactStage::run_detection(const Model& model, const double* x) {
   compute_boxes(model, x, all ? nullptr : &members);
   const auto keep = [&](LocalIndex a, LocalIndex b) { return keeps(model, x, tet(a), tet(b)); };
   const auto n = all ? model.tets.size() : static_cast<LocalIndex>(members.size());
-  detector_.detect(lo_.data(), hi_.data(), n, buffer_, pairs_, keep);
-  // Boxes and grids are rebuilt by every detection: not held between them (~150 B per tet that may
+  detector_.detect(std::move(boxes_), n, buffer_, pairs_, keep);  // inflated in place there
+  // Boxes and grids are rebuilt by every detection: not held between them (~100 B per tet that may
   // pair, most of what a large jointed body's run holds above its model).
   detector_.release_workspace();
-  lo_ = {};
-  hi_ = {};
+  release(boxes_);
   if (!all)
     for (CandidatePair& p : pairs_) p = {tet(p.a), tet(p.b)};
   may_hold_friction_.assign(pairs_.size(), 1);
@@ -206,8 +204,8 @@ void ContactStage::add_pairs_of(const Model& model, const std::vector<LocalIndex
   const double half = 0.5 * buffer_;
   const auto box_of = [&](LocalIndex t, double(&box)[6]) {
     for (int k = 0; k < 3; ++k) {
-      box[k] = lo_[3 * t + k] - half;
-      box[3 + k] = hi_[3 * t + k] + half;
+      box[k] = boxes_[6 * static_cast<std::size_t>(t) + k] - half;
+      box[3 + k] = boxes_[6 * static_cast<std::size_t>(t) + 3 + k] + half;
     }
   };
   std::vector<CandidatePair> added;
@@ -223,6 +221,7 @@ void ContactStage::add_pairs_of(const Model& model, const std::vector<LocalIndex
         added.push_back(pair);
     }
   }
+  release(boxes_);
   std::sort(added.begin(), added.end());
   added.erase(std::unique(added.begin(), added.end()), added.end());
   const std::size_t old_size = pairs_.size();

@@ -61,20 +61,33 @@ std::size_t NbsDetector::workspace_bytes() const {
 }
 
 void NbsDetector::release_workspace() {
-  levels_ = {};  // head arrays are built afresh (all −1) for new levels
-  boxes_ = {};
-  extent_ = {};
-  extent_scratch_ = {};
-  remaining_ = {};
-  large_ = {};
-  scratch_ = {};
-  counts_ = {};
+  release(levels_);  // head arrays are built afresh (all −1) for new levels
+  release(boxes_);
+  release(extent_);
+  release(extent_scratch_);
+  release(remaining_);
+  release(large_);
+  release(scratch_);
+  release(counts_);
   heads_clean_ = true;
 }
 
 void NbsDetector::detect(const double* lo, const double* hi, LocalIndex n, double buffer,
                          std::vector<CandidatePair>& out, PairFilter keep) {
-  inflate_boxes(lo, hi, n, buffer, boxes_);
+  std::vector<double> boxes = std::move(boxes_);  // the workspace's capacity, reused
+  boxes.resize(6 * static_cast<std::size_t>(std::max<LocalIndex>(n, 0)));
+  for (LocalIndex i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      boxes[6 * static_cast<std::size_t>(i) + k] = lo[3 * i + k];
+      boxes[6 * static_cast<std::size_t>(i) + 3 + k] = hi[3 * i + k];
+    }
+  detect(std::move(boxes), n, buffer, out, keep);
+}
+
+void NbsDetector::detect(std::vector<double>&& boxes, LocalIndex n, double buffer,
+                         std::vector<CandidatePair>& out, PairFilter keep) {
+  boxes_ = std::move(boxes);
+  inflate_boxes_in_place(boxes_, n, buffer);
   out.clear();
   stats_ = NbsStats{};
   stats_.elements = n;

@@ -69,6 +69,10 @@ class NbsDetector {
   // overlapping inflated boxes that keep() accepts, sorted by a then b.
   void detect(const double* lo, const double* hi, LocalIndex n, double buffer,
               std::vector<CandidatePair>& out, PairFilter keep = {});
+  // The same with the boxes as 6 doubles per element [lo xyz, hi xyz], taken over (moved from)
+  // and inflated in place: the caller's copy is the detector's, none is made.
+  void detect(std::vector<double>&& boxes, LocalIndex n, double buffer,
+              std::vector<CandidatePair>& out, PairFilter keep = {});
 
   const NbsStats& stats() const { return stats_; }
   std::size_t workspace_bytes() const;

@@ -65,8 +65,7 @@ std::vector<AbsorbingFace> find_absorbing_faces(const std::vector<AbsorbingSpec>
       const auto range = std::equal_range(all.begin(), all.end(), key);
       if (range.second - range.first != 1) continue;
       if (std::binary_search(bonded.begin(), bonded.end(), key)) continue;
-      const Vec3 a = vec3_at(nodes.x0.data(), f[0]), b = vec3_at(nodes.x0.data(), f[1]),
-                 c = vec3_at(nodes.x0.data(), f[2]);
+      const Vec3 a = nodes.x0(f[0]), b = nodes.x0(f[1]), c = nodes.x0(f[2]);
       std::int32_t spec = -1;
       for (std::size_t s = 0; s < specs.size() && spec < 0; ++s) {
         const AbsorbingSpec& sp = specs[s];
@@ -84,8 +83,7 @@ std::vector<AbsorbingFace> find_absorbing_faces(const std::vector<AbsorbingSpec>
       Vec3 n = (b - a).cross(c - a);
       face.area = 0.5 * n.norm();
       n /= n.norm();
-      const Vec3 opposite =
-          vec3_at(nodes.x0.data(), tets.nodes[4 * static_cast<std::size_t>(t) + k]);
+      const Vec3 opposite = nodes.x0(tets.nodes[4 * static_cast<std::size_t>(t) + k]);
       if (n.dot(a - opposite) < 0.0) n = -n;  // outward: away from the tet's fourth node
       face.normal = n;
       const MaterialProperties& m = model.materials[static_cast<std::size_t>(tets.material[t])];

@@ -118,11 +118,13 @@ struct Field {
   }
 };
 
-// Nodes (besides gid and n_owned, their identity and roles).
+// Nodes (besides gid and n_owned, their identity and roles, and reference_positions, the table
+// `reference` indexes).  A node's reference position travels as its three doubles, after the
+// fields (parallel/distribution_rows.hpp): its index means nothing on another rank.
 inline const std::array<Field<NodeArrays>, 8> node_fields = {{
     {"x", &NodeArrays::x, 3,
      FieldUse::migrates | FieldUse::halo | FieldUse::checkpoint | FieldUse::hash},
-    {"x0", &NodeArrays::x0, 3, FieldUse::migrates},
+    {"reference", &NodeArrays::reference, 1, 0, -1.0},
     {"v", &NodeArrays::v, 3,
      FieldUse::migrates | FieldUse::halo | FieldUse::checkpoint | FieldUse::hash},
     {"f", &NodeArrays::f, 3, 0},  // summed anew every step
@@ -146,14 +148,11 @@ inline const std::array<Field<TetArrays>, 6> tet_fields = {{
 }};
 
 // Joints (besides gid, nodes and tets, their identity).
-inline const std::array<Field<JointArrays>, 6> joint_fields = {{
+inline const std::array<Field<JointArrays>, 4> joint_fields = {{
     {"area0", &JointArrays::area0, 1, FieldUse::migrates},
     {"law", &JointArrays::law, 1, FieldUse::migrates},
     {"broken", &JointArrays::broken, 1, FieldUse::migrates | FieldUse::checkpoint},
     {"mode", &JointArrays::mode, 1, FieldUse::migrates | FieldUse::checkpoint},
-    {"failure_time", &JointArrays::failure_time, 1, FieldUse::migrates | FieldUse::checkpoint,
-     -1.0},
-    {"damage", &JointArrays::damage, 1, FieldUse::migrates | FieldUse::checkpoint},
 }};
 
 // The stages' per-node and per-tet state that travels (TravellingState): the contact stage's

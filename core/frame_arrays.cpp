@@ -95,8 +95,7 @@ std::vector<FrameColumn> tet_frame_columns(const Model& model, LocalSelection ce
   if (wants("displacement"))
     columns.push_back(
         real_column("displacement", false, 3, n_points, [&nodes, points](std::size_t p, double* u) {
-          for (int k = 0; k < 3; ++k)
-            u[k] = nodes.x[3 * points[p] + k] - nodes.x0[3 * points[p] + k];
+          for (int k = 0; k < 3; ++k) u[k] = nodes.x[3 * points[p] + k] - nodes.x0(points[p])[k];
         }));
   if (wants("velocity"))
     columns.push_back(

@@ -11,14 +11,14 @@ namespace {
 void add_node(const NodeArrays& nodes, LocalIndex n, GroupSums& sums) {
   const double m = nodes.mass[n];
   sums.mass.add(m);
-  for (int k = 0; k < 3; ++k) sums.moment[k].add(m * (nodes.x[3 * n + k] - nodes.x0[3 * n + k]));
+  for (int k = 0; k < 3; ++k) sums.moment[k].add(m * (nodes.x[3 * n + k] - nodes.x0(n)[k]));
 }
 
 }  // namespace
 
 bool load_holds_node(const LoadSpec& load, const Model& model, LocalIndex n) {
   if (load.region) {
-    const Vec3 X = vec3_at(model.nodes.x0.data(), n);
+    const Vec3 X = model.nodes.x0(n);
     return (X.array() >= load.region->min.array()).all() &&
            (X.array() <= load.region->max.array()).all();
   }
@@ -56,7 +56,7 @@ std::array<double, 4> reference_barycentric(const Model& model, LocalIndex t, co
   const LocalIndex* corner = model.tets.nodes.data() + 4 * static_cast<std::size_t>(t);
   const Eigen::Map<const Mat3> dm_inv(model.tets.dm_inv.data() + 9 * static_cast<std::size_t>(t));
   // Dm⁻¹ maps X − X0 to the coordinates along the reference edges: λ1, λ2, λ3.
-  const Vec3 xi = dm_inv * (X - vec3_at(model.nodes.x0.data(), corner[0]));
+  const Vec3 xi = dm_inv * (X - model.nodes.x0(corner[0]));
   return {1.0 - xi.sum(), xi.x(), xi.y(), xi.z()};
 }
 
@@ -78,7 +78,7 @@ MonitorValues monitor_values(const Model& model, LocalIndex t, const Vec3& X) {
   MonitorValues out;
   for (int c = 0; c < 4; ++c) {
     const LocalIndex n = model.tets.nodes[4 * static_cast<std::size_t>(t) + c];
-    out.displacement += lambda[c] * (vec3_at(nodes.x.data(), n) - vec3_at(nodes.x0.data(), n));
+    out.displacement += lambda[c] * (vec3_at(nodes.x.data(), n) - nodes.x0(n));
     out.velocity += lambda[c] * vec3_at(nodes.v.data(), n);
   }
   out.stress = elastic_cauchy_stress(model, t);

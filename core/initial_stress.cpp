@@ -40,8 +40,7 @@ std::vector<double> initial_stresses(const std::vector<InitialStressSpec>& specs
     }
     Vec3 centroid = Vec3::Zero();
     for (int c = 0; c < 4; ++c)
-      centroid +=
-          0.25 * vec3_at(model.nodes.x0.data(), tets.nodes[4 * static_cast<std::size_t>(t) + c]);
+      centroid += 0.25 * model.nodes.x0(tets.nodes[4 * static_cast<std::size_t>(t) + c]);
     // Height along −g; ground above the tet: surface − height (none above the surface).
     const double depth = std::max(spec->surface + down.dot(centroid), 0.0);
     const double rho = model.materials[static_cast<std::size_t>(tets.material[t])].density;

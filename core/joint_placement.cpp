@@ -191,9 +191,8 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
       const LocalIndex n = tets.nodes[4 * d.tet_a + c];
       if (n != d.a[0] && n != d.a[1] && n != d.a[2]) opposite = n;
     }
-    const double* x0 = nodes.x0.data();
-    if (joint_face_turned(vec3_at(x0, d.a[0]), vec3_at(x0, d.a[1]), vec3_at(x0, d.a[2]),
-                          vec3_at(x0, opposite))) {
+    if (joint_face_turned(nodes.x0(d.a[0]), nodes.x0(d.a[1]), nodes.x0(d.a[2]),
+                          nodes.x0(opposite))) {
       std::swap(d.a[1], d.a[2]);
       std::swap(d.b[1], d.b[2]);
     }
@@ -309,7 +308,7 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     if (drafts.size() == before) throw InputError(no_interface_match_message(scene, k, tol));
   }
 
-  faces = {};  // the joints are drafted: the face lists go before the joint arrays come
+  release(faces);  // the joints are drafted: the face lists go before the joint arrays come
 
   // Canonical order: ascending (gid A, gid B); a joint's gid is its rank in it.
   std::vector<std::size_t> order(drafts.size());
@@ -330,7 +329,6 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
         joint_strength_bin(scene, drafts[order[j]].group, joints.gid[j], model.gid_offset)};
   };
   std::set<JointLawKey> used;
-  const double* x0 = nodes.x0.data();
   for (std::size_t j = 0; j < order.size(); ++j) {
     const JointDraft& d = drafts[order[j]];
     joints.gid[j] = model.gid_offset + static_cast<GlobalId>(j);
@@ -340,8 +338,7 @@ void place_joints(const Scene& scene, const std::vector<BodyMesh>& meshes,
     }
     joints.tets[2 * j] = d.tet_a;
     joints.tets[2 * j + 1] = d.tet_b;
-    joints.area0[j] =
-        joint_face_area(vec3_at(x0, d.a[0]), vec3_at(x0, d.a[1]), vec3_at(x0, d.a[2]));
+    joints.area0[j] = joint_face_area(nodes.x0(d.a[0]), nodes.x0(d.a[1]), nodes.x0(d.a[2]));
     used.insert(law_key(j));
   }
   const std::vector<JointLawKey> keys(used.begin(), used.end());  // ascending

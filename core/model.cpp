@@ -1,9 +1,11 @@
 #include "core/model.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <string>
+#include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/fields.hpp"
@@ -27,6 +29,7 @@ struct NodeArraysShape {
   bool has_prescribed_velocity;
   std::vector<GlobalId> gid;
   AnyArray fields[std::tuple_size_v<decltype(node_fields)>];
+  std::vector<double> reference_positions;
 };
 struct TetArraysShape {
   LocalIndex n_owned;
@@ -50,8 +53,47 @@ void NodeArrays::resize(LocalIndex n) {
   if (has_prescribed_velocity)
     resize_exact(prescribed_velocity, 3 * static_cast<std::size_t>(n), 0.0);
   else
-    prescribed_velocity = {};
+    release(prescribed_velocity);
   for (const auto& field : node_fields) field.resize(*this, static_cast<std::size_t>(n));
+}
+
+void NodeArrays::add_reference(LocalIndex n, const double* position) {
+  FDEM_VERIFY(reference_positions.size() / 3 <
+                  static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()),
+              "reference positions fit 32-bit indices");
+  reference[static_cast<std::size_t>(n)] =
+      static_cast<std::int32_t>(reference_positions.size() / 3);
+  reference_positions.insert(reference_positions.end(), position, position + 3);
+}
+
+void NodeArrays::compact_references() {
+  // Equal positions by their bits (a position is a value here, so +0 and -0 stay apart).
+  struct Bits {
+    std::uint64_t w[3];
+    bool operator==(const Bits& o) const {
+      return w[0] == o.w[0] && w[1] == o.w[1] && w[2] == o.w[2];
+    }
+  };
+  struct Hash {
+    std::size_t operator()(const Bits& b) const {
+      std::uint64_t h = 0xcbf29ce484222325ULL;
+      for (std::uint64_t w : b.w) h = (h ^ w) * 0x100000001b3ULL;
+      return static_cast<std::size_t>(h ^ (h >> 29));
+    }
+  };
+  std::unordered_map<Bits, std::int32_t, Hash> index;
+  std::vector<double> kept;
+  for (std::int32_t& r : reference) {
+    Bits b;
+    std::memcpy(b.w, reference_positions.data() + 3 * static_cast<std::size_t>(r), sizeof b.w);
+    const auto [it, added] = index.emplace(b, static_cast<std::int32_t>(kept.size() / 3));
+    if (added)
+      kept.insert(kept.end(), reference_positions.data() + 3 * static_cast<std::size_t>(r),
+                  reference_positions.data() + 3 * static_cast<std::size_t>(r) + 3);
+    r = it->second;
+  }
+  kept.shrink_to_fit();
+  reference_positions = std::move(kept);
 }
 
 LocalIndex NodeArrays::find(GlobalId id) const {

@@ -30,8 +30,12 @@ struct NodeArrays {
   // rank; resize() allocates the array only when true.
   bool has_prescribed_velocity = true;
   std::vector<GlobalId> gid;
-  std::vector<double> x;                    // current position (m)
-  std::vector<double> x0;                   // reference position (m)
+  std::vector<double> x;  // current position (m)
+  // Reference positions, each distinct one stored once: the nodes a `joints: all` body splits
+  // from one mesh node (a node per tet corner there) share an entry, 4 bytes per node instead
+  // of 24.  Read them with x0(n).
+  std::vector<std::int32_t> reference;      // index into reference_positions
+  std::vector<double> reference_positions;  // 3 per distinct reference position (m)
   std::vector<double> v;                    // velocity at the last half step (m/s)
   std::vector<double> f;                    // total force at the current step (N)
   std::vector<double> mass;                 // lumped mass (kg)
@@ -41,6 +45,16 @@ struct NodeArrays {
 
   LocalIndex size() const { return static_cast<LocalIndex>(gid.size()); }
   void resize(LocalIndex n);
+  // Reference position of node n (m).
+  Eigen::Map<const Vec3> x0(LocalIndex n) const {
+    return vec3_at(reference_positions.data(), reference[static_cast<std::size_t>(n)]);
+  }
+  // Node n's reference position appended to the table (no search: compact_references merges
+  // equal ones afterwards).
+  void add_reference(LocalIndex n, const double* position);
+  // The table reduced to the distinct positions the nodes use (equal bits merge), in order of
+  // first use; the nodes' indices follow.
+  void compact_references();
   // Component i (3 per node) of the prescribed velocity: 0 without the array.
   double prescribed_velocity_at(std::size_t i) const {
     return prescribed_velocity.empty() ? 0.0 : prescribed_velocity[i];
@@ -120,8 +134,8 @@ struct JointArrays {
   std::vector<std::int32_t> law;     // index into Model::joint_laws
   std::vector<std::uint8_t> broken;  // 1 once all three points reached D = 1
   std::vector<std::uint8_t> mode;    // FailureMode code (fracture/joint_kernels.hpp), 0 intact
-  std::vector<double> failure_time;  // s; −1 while intact
-  std::vector<double> damage;        // mean D of the three points (output)
+  // A joint's damage and failure time live in the joint stage's history, which only joints that
+  // left the pristine state keep (fracture/joint_stage.hpp: JointStage::damage, failure_time).
 
   LocalIndex size() const { return static_cast<LocalIndex>(gid.size()); }
   void resize(LocalIndex n);

@@ -136,7 +136,7 @@ void set_initial_velocities(const Scene& scene, Model& model) {
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
     const PieceInfo& piece = model.pieces[nodes.piece[n]];
     const BodySpec& body = scene.bodies[piece.body];
-    const Vec3 r = vec3_at(nodes.x0.data(), n) - piece.centroid0;
+    const Vec3 r = nodes.x0(n) - piece.centroid0;
     vec3_at(nodes.v.data(), n) = body.velocity + body.angular_velocity.cross(r);
   }
 }
@@ -247,18 +247,29 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
   nodes.has_prescribed_velocity = scene.prescribes_velocities();
   nodes.resize(n_nodes);
   nodes.n_owned = n_nodes;
-  std::fill(nodes.v.begin(), nodes.v.end(), 0.0);
-  std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
+  // Velocities and forces (48 B per node, most of a jointed body's start-up) are not read
+  // before the joints are placed: they come after, so that the start-up's peak holds neither.
+  release(nodes.v);
+  release(nodes.f);
   std::fill(nodes.mass.begin(), nodes.mass.end(), 0.0);
   std::fill(nodes.constrained.begin(), nodes.constrained.end(), 0);
   std::fill(nodes.prescribed_velocity.begin(), nodes.prescribed_velocity.end(), 0.0);
+  // One reference position per mesh node, shared by the nodes split from it.
+  std::vector<std::int32_t> reference_of_mesh_node(static_cast<std::size_t>(n_all_nodes), -1);
   for (LocalIndex n = 0; n < n_nodes; ++n) {
     const LocalIndex old = node_source[n];
-    const std::int32_t b = node_body[old];
-    for (int k = 0; k < 3; ++k)
-      nodes.x0[3 * n + k] = meshes[b].coords[3 * (old - node_offset[b]) + k];
+    std::int32_t& reference = reference_of_mesh_node[static_cast<std::size_t>(old)];
+    if (reference < 0) {
+      const std::int32_t b = node_body[old];
+      nodes.add_reference(n, meshes[b].coords.data() + 3 * (old - node_offset[b]));
+      reference = nodes.reference[n];
+    }
+    nodes.reference[n] = reference;
+    for (int k = 0; k < 3; ++k) nodes.x[3 * n + k] = nodes.x0(n)[k];
   }
-  nodes.x = nodes.x0;
+  nodes.reference_positions.shrink_to_fit();
+  release(node_source);
+  release(reference_of_mesh_node);
   for (LocalIndex n = 0; n < n_nodes; ++n) nodes.gid[n] = model.gid_offset + n;
 
   TetArrays& tets = model.tets;
@@ -276,7 +287,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     for (int c = 0; c < 4; ++c) {
       const LocalIndex n = tet_node[4 * t + c];
       tets.nodes[4 * t + c] = n;
-      X[c] = vec3_at(nodes.x0.data(), n);
+      X[c] = nodes.x0(n);
       nodes.piece[n] = r.piece;
     }
     const TetSetup setup = setup_tet(X, mat);
@@ -299,7 +310,14 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
   std::vector<std::vector<LocalIndex>> model_tet(meshes.size());
   for (std::size_t b = 0; b < meshes.size(); ++b) model_tet[b].resize(meshes[b].tets.size() / 4);
   for (LocalIndex t = 0; t < n_tets; ++t) model_tet[records[t].body][records[t].local] = t;
+  // The build's own tables go before the joints are placed (the start-up's peak is there).
+  release(records);
+  release(tet_node);
+  release(new_node);
+  release(node_body);
   place_joints(scene, meshes, model_tet, hi - lo, model);
+  resize_exact(nodes.v, 3 * static_cast<std::size_t>(n_nodes), 0.0);
+  resize_exact(nodes.f, 3 * static_cast<std::size_t>(n_nodes), 0.0);
 
   set_initial_velocities(scene, model);
 
@@ -330,7 +348,7 @@ void apply_constraints(const Scene& scene, Model& model) {
     for (LocalIndex n = 0; n < nodes.size(); ++n) {
       bool applies = false;
       if (load.region) {
-        const Vec3 X = vec3_at(nodes.x0.data(), n);
+        const Vec3 X = nodes.x0(n);
         applies = (X.array() >= load.region->min.array()).all() &&
                   (X.array() <= load.region->max.array()).all();
       } else {

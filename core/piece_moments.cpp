@@ -105,7 +105,7 @@ PieceMoments piece_moments(const NodeArrays& nodes, const OwnedPieces& owned, st
     for (int d = 0; d < 3; ++d) {
       s.position[d].add(m * nodes.x[3 * n + d]);
       s.momentum[d].add(m * nodes.v[3 * n + d]);
-      s.reference[d].add(m * nodes.x0[3 * n + d]);
+      s.reference[d].add(m * nodes.x0(n)[d]);
     }
   }
   return s;
@@ -117,7 +117,7 @@ PieceSpread piece_spread(const NodeArrays& nodes, const OwnedPieces& owned, std:
   for (std::int32_t k = owned.first[i]; k < owned.first[i + 1]; ++k) {
     const LocalIndex n = owned.nodes[static_cast<std::size_t>(k)];
     const Mat3 outer = nodes.mass[n] * (vec3_at(nodes.x.data(), n) - c.centroid) *
-                       (vec3_at(nodes.x0.data(), n) - c.reference).transpose();
+                       (nodes.x0(n) - c.reference).transpose();
     for (int j = 0; j < 9; ++j) s.covariance[j].add(outer.data()[j]);
   }
   return s;

@@ -1,7 +1,6 @@
 #include "core/state_hash.hpp"
 
 #include <cstring>
-#include <initializer_list>
 #include <vector>
 
 #include "core/error.hpp"
@@ -24,22 +23,6 @@ inline std::uint64_t finish(std::uint64_t h) {
   h ^= h >> 27;
   h *= 0x94d049bb133111ebULL;
   return h ^ (h >> 31);
-}
-// Σ over nodes [0, count) of mix(FNV-1a of (gid − gid_offset, the given 3-vectors)), mod 2^64.  A
-// sum of per-node fingerprints does not depend on the order the nodes are visited in nor on how
-// they are split among ranks (partial sums add up exactly), so no rank ever needs the whole state.
-std::uint64_t sum_of_node_hashes(const NodeArrays& nodes, LocalIndex count, GlobalId gid_offset,
-                                 std::initializer_list<const std::vector<double>*> fields) {
-  std::uint64_t sum = 0;
-  for (LocalIndex n = 0; n < count; ++n) {
-    std::uint64_t h = 0xcbf29ce484222325ULL;
-    const GlobalId index = nodes.gid[n] - gid_offset;
-    fnv_mix(h, &index, sizeof(GlobalId));
-    for (const std::vector<double>* field : fields)
-      fnv_mix(h, field->data() + 3 * static_cast<std::size_t>(n), 3 * sizeof(double));
-    sum += finish(h);
-  }
-  return sum;
 }
 }  // namespace
 
@@ -68,7 +51,17 @@ std::uint64_t state_hash(const NodeArrays& nodes, GlobalId gid_offset) {
 }
 
 std::uint64_t reference_hash(const NodeArrays& nodes, GlobalId gid_offset) {
-  return sum_of_node_hashes(nodes, nodes.n_owned, gid_offset, {&nodes.x0});
+  // Σ over owned nodes of mix(FNV-1a of (gid − gid_offset, x0)), mod 2^64: a sum of per-node
+  // fingerprints depends neither on the order of the nodes nor on how ranks split them.
+  std::uint64_t sum = 0;
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) {
+    std::uint64_t h = 0xcbf29ce484222325ULL;
+    const GlobalId index = nodes.gid[n] - gid_offset;
+    fnv_mix(h, &index, sizeof(GlobalId));
+    fnv_mix(h, nodes.x0(n).data(), 3 * sizeof(double));
+    sum += finish(h);
+  }
+  return sum;
 }
 
 std::uint64_t joint_strength_hash(const Model& model) {

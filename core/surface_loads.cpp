@@ -60,13 +60,12 @@ SurfaceFaces select_surface_faces(const Model& model, const LoadSpec& load) {
                                  {tri[i + 6], tri[i + 7], tri[i + 8]}));
   std::sort(wanted.begin(), wanted.end());
   const auto corner = [&](LocalIndex n) {
-    return Corner{nodes.x0[3 * static_cast<std::size_t>(n)],
-                  nodes.x0[3 * static_cast<std::size_t>(n) + 1],
-                  nodes.x0[3 * static_cast<std::size_t>(n) + 2]};
+    const Vec3 X = nodes.x0(n);
+    return Corner{X[0], X[1], X[2]};
   };
   std::vector<std::pair<LocalIndex, int>> chosen;  // (tet, corner)
   const auto inside = [&](LocalIndex n) {
-    const Vec3 X = vec3_at(nodes.x0.data(), n);
+    const Vec3 X = nodes.x0(n);
     return (X.array() >= load.region->min.array()).all() &&
            (X.array() <= load.region->max.array()).all();
   };
@@ -101,10 +100,9 @@ SurfaceFaces select_surface_faces(const Model& model, const LoadSpec& load) {
     std::array<LocalIndex, 3> f = {n[tet_face_corners[c][0]], n[tet_face_corners[c][1]],
                                    n[tet_face_corners[c][2]]};
     // Outward whatever the tet's corner order: away from the opposite corner at t = 0.
-    const Vec3 X0 = vec3_at(nodes.x0.data(), f[0]);
-    const Vec3 normal =
-        (vec3_at(nodes.x0.data(), f[1]) - X0).cross(vec3_at(nodes.x0.data(), f[2]) - X0);
-    if (normal.dot(X0 - vec3_at(nodes.x0.data(), n[c])) < 0.0) std::swap(f[1], f[2]);
+    const Vec3 X0 = nodes.x0(f[0]);
+    const Vec3 normal = (nodes.x0(f[1]) - X0).cross(nodes.x0(f[2]) - X0);
+    if (normal.dot(X0 - nodes.x0(n[c])) < 0.0) std::swap(f[1], f[2]);
     faces.nodes.insert(faces.nodes.end(), f.begin(), f.end());
     faces.tet.push_back(tets.gid[t]);
     faces.owned.push_back(tets.is_owned(t) ? 1 : 0);
@@ -116,12 +114,14 @@ SurfaceFaces select_surface_faces(const Model& model, const LoadSpec& load) {
 void add_surface_forces(const SurfaceLoadSpec& spec, double factor, SurfaceFaces& faces,
                         NodeArrays& nodes) {
   const bool current = spec.kind == SurfaceLoadSpec::Kind::pressure && spec.follower;
-  const double* x = current ? nodes.x.data() : nodes.x0.data();
+  const auto position = [&](LocalIndex n) -> Vec3 {
+    return current ? Vec3(vec3_at(nodes.x.data(), n)) : Vec3(nodes.x0(n));
+  };
   const double p = factor * spec.pressure;       // Pa
   const Vec3 traction = factor * spec.traction;  // Pa
   for (LocalIndex i = 0; i < faces.size(); ++i) {
     const LocalIndex* n = faces.nodes.data() + 3 * static_cast<std::size_t>(i);
-    const Vec3 a = vec3_at(x, n[0]), b = vec3_at(x, n[1]), c = vec3_at(x, n[2]);
+    const Vec3 a = position(n[0]), b = position(n[1]), c = position(n[2]);
     const Vec3 force = spec.kind == SurfaceLoadSpec::Kind::pressure
                            ? pressure_corner_force(a, b, c, p)
                            : traction_corner_force(a, b, c, traction);

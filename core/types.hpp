@@ -3,6 +3,7 @@
 
 #include <Eigen/Dense>
 #include <cstdint>
+#include <utility>
 
 namespace fdem {
 
@@ -25,6 +26,15 @@ inline Eigen::Map<Vec3> vec3_at(double* xyz, LocalIndex i) {
 }
 inline Eigen::Map<const Vec3> vec3_at(const double* xyz, LocalIndex i) {
   return Eigen::Map<const Vec3>(xyz + 3 * i);
+}
+
+// Empties a container (or a struct of them) and gives its memory back.  (`values = {}` does not:
+// for a std::vector it assigns an empty initializer list, which keeps the capacity.)
+template <class Container>
+void release(Container& container) {
+  Container empty{};
+  using std::swap;
+  swap(container, empty);
 }
 
 // ⌊a·b/c⌋ for 0 ≤ a, b and c > 0 without overflow of the product (block and directory ranks of

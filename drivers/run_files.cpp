@@ -115,11 +115,12 @@ void RunFiles::write_bodies_rows(double time, const Model& model, std::int32_t f
   shared_bodies_->append(bodies_rows(time, model, first_piece, motion));
 }
 
-std::vector<double> tet_damage(const Model& model) {
+std::vector<double> tet_damage(const Model& model, const JointStage* stage) {
   std::vector<double> damage(model.tets.size(), 0.0);
+  if (!stage) return damage;
   const JointArrays& joints = model.joints;
   for (LocalIndex j = 0; j < joints.size(); ++j) {
-    const double d = joints.broken[j] ? 1.0 : joints.damage[j];
+    const double d = joints.broken[j] ? 1.0 : stage->damage(j);
     for (int side = 0; side < 2; ++side) {
       double& slot = damage[joints.tets[2 * j + side]];
       slot = std::max(slot, d);
@@ -129,20 +130,20 @@ std::vector<double> tet_damage(const Model& model) {
 }
 
 void RunFiles::write_frame(double time, const Model& model, const std::vector<FrameField>& extra,
-                           bool cracks, const std::vector<std::int32_t>& node_owner) {
+                           const JointStage* joints, const std::vector<std::int32_t>& node_owner) {
   std::vector<FrameField> fields = extra;
   if (std::find(fields_.begin(), fields_.end(), "damage") != fields_.end())
-    fields.push_back({"damage", 1, true, tet_damage(model)});
+    fields.push_back({"damage", 1, true, tet_damage(model, joints)});
   if (xdmf_) {
     write_xdmf_tet_frame(time, model, fields, node_owner);
-    if (cracks) write_cracks(time, model);
+    if (joints) write_cracks(time, model, *joints);
     return;
   }
   const std::string stem = frames_.next_frame_path();
   write_parallel_tet_frame((std::filesystem::path(directory_) / stem).string(), model, fields_,
                            fields, rank_, ranks_);
   frames_.add_frame(time, frames_.frame_file(stem, "vtu"));
-  if (cracks) write_cracks(time, model);
+  if (joints) write_cracks(time, model, *joints);
 }
 
 void RunFiles::write_xdmf_tet_frame(double time, const Model& model,
@@ -167,7 +168,7 @@ void RunFiles::write_xdmf_tet_frame(double time, const Model& model,
   comm.run_collectively([&] { xdmf_series_->add_frame(written); });
 }
 
-void RunFiles::write_cracks(double time, const Model& model) {
+void RunFiles::write_cracks(double time, const Model& model, const JointStage& stage) {
   if (!cracks_) cracks_ = std::make_unique<SeriesWriter>(directory_, "cracks", rank_, ranks_);
   const JointArrays& joints = model.joints;
   const double* x = model.nodes.x.data();
@@ -184,7 +185,7 @@ void RunFiles::write_cracks(double time, const Model& model) {
       gap += (vec3_at(x, id[3 + i]) - vec3_at(x, id[i])).norm() / 3.0;
     }
     mode.push_back(joints.mode[j]);
-    failure_time.push_back(joints.failure_time[j]);
+    failure_time.push_back(stage.failure_time(j));
     opening.push_back(gap);
   }
   const std::string stem = cracks_->next_frame_path();

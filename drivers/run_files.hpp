@@ -13,6 +13,7 @@
 #include "core/dynamics.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
+#include "fracture/joint_stage.hpp"
 #include "io/vtk_output.hpp"
 #include "io/xdmf_series.hpp"
 #include "parallel/ordered_text_file.hpp"
@@ -47,14 +48,16 @@ class RunFiles {
                          const std::vector<PieceMotion>& motion, const Communicator& comm);
   // A frame of the tets; with `damage` in the fields, the per-tet damage; in a model with joints
   // also a frame of the "cracks" series (broken joint faces).
-  // `cracks`: the scene has joints (the same answer on every rank: each writes a piece).
+  // `joints`: the joint stage when the scene has joints (on every rank then: each writes a
+  // piece), else null.
   // `node_owner`: per local node its owning rank (Distribution::node_owners), read by xdmf frames
   // on N ranks for the ghost nodes of owned tets; empty on one rank.
   void write_frame(double time, const Model& model, const std::vector<FrameField>& extra = {},
-                   bool cracks = false, const std::vector<std::int32_t>& node_owner = {});
+                   const JointStage* joints = nullptr,
+                   const std::vector<std::int32_t>& node_owner = {});
   // Broken joint faces as triangles (face A's current position) with mode (FailureMode code),
   // failure_time (s) and opening (mean gap |b_i − a_i|, m), as the "cracks" series.
-  void write_cracks(double time, const Model& model);
+  void write_cracks(double time, const Model& model, const JointStage& joints);
   // Contact points with their normal and tangential forces, as the "contacts" series.
   void write_contacts(double time, const std::vector<ContactRecord>& records);
   void write_summary(const RunReport& report, const Model& model, const std::string& scene_name);
@@ -79,8 +82,9 @@ class RunFiles {
 std::string bodies_rows(double time, const Model& model, std::int32_t first_piece,
                         const std::vector<PieceMotion>& motion);
 
-// Per-tet damage: the largest damage of the tet's joints (0 for a tet without joints).
-std::vector<double> tet_damage(const Model& model);
+// Per-tet damage: the largest damage of the tet's joints (0 for a tet without joints; all 0
+// without a joint stage).
+std::vector<double> tet_damage(const Model& model, const JointStage* joints);
 
 // JSON text of the run summary (also used by `fdem check --json` and tests).
 std::string summary_json(const RunReport& report, const Model& model,

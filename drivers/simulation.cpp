@@ -160,7 +160,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
       contact_->set_bonds(model_.tets.size(), bonds);
       contact_->enclose(model_.tets.enclosed);
     }
-    model_.tets.enclosed = {};  // start-up only: the contact stage's joint state carries it
+    release(model_.tets.enclosed);  // start-up only: the contact stage's joint state carries it
   }
   if (!scene_.initial_stress.empty()) {
     plan_.initial_stress = true;
@@ -351,7 +351,7 @@ void Simulation::write_files(bool frame, bool energy_row, double energy_time) {
   const auto write = [&] {
     if (frame)
       files_->write_frame(
-          time_, model_, {}, plan_.joints,
+          time_, model_, {}, plan_.joints ? joints_.get() : nullptr,
           distribution_ ? distribution_->node_owners() : std::vector<std::int32_t>{});
     if (energy_row)
       files_->write_energy_row(energy_time, ledger_.current(), ledger_.balance_error());

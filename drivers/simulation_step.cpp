@@ -161,7 +161,7 @@ void Simulation::add_joint_forces(StepRecord& r) {
   for (LocalIndex b : joints_->newly_broken()) {
     const LocalIndex a = model_.joints.tets[2 * b], c = model_.joints.tets[2 * b + 1];
     own_breaks_.push_back({model_.joints.gid[b], model_.tets.gid[a], model_.tets.gid[c],
-                           model_.joints.failure_time[b], model_.joints.mode[b],
+                           joints_->failure_time(b), model_.joints.mode[b],
                            model_.pieces.body_of(model_.tets.piece[a]),
                            model_.pieces.body_of(model_.tets.piece[c])});
     if (contact_ && (!contact_->body_cracked(own_breaks_.back().body_a) ||

@@ -42,8 +42,8 @@ JointStage::JointStage(const Model& model) {
     if (joints.broken[j]) {
       JointHistory& h = live_[static_cast<std::size_t>(promote(j))];
       h.broken = true;
-      h.mode = static_cast<FailureMode>(joints.mode[j]);
-      h.failure_time = joints.failure_time[j];
+      h.mode = static_cast<FailureMode>(joints.mode[j]);  // failure time: from rebind's history
+      for (auto& p : h.point) p.damage = 1.0;
       ++broken_;
     }
   }
@@ -101,12 +101,10 @@ void JointStage::add_full_law(Model& model, LocalIndex j, double share, double t
   out.stored_energy += share * f.stored_energy;
   out.fracture_dissipated += share * f.fracture_energy;
   out.friction_dissipated += share * f.friction_energy;
-  joints.damage[j] = h.damage();
   if (!f.newly_broken) return;
   h.failure_time = time;
   joints.broken[j] = 1;
   joints.mode[j] = static_cast<std::uint8_t>(h.mode);
-  joints.failure_time[j] = time;
   newly_broken_.push_back(j);
 }
 
@@ -219,8 +217,6 @@ void JointStage::mark_broken(Model& model, LocalIndex j, double time, std::uint8
   for (auto& p : h.point) p.damage = 1.0;
   joints.broken[j] = 1;
   joints.mode[j] = mode;
-  joints.failure_time[j] = time;
-  joints.damage[j] = 1.0;
 }
 
 double JointStage::critical_time_step(const Model& model) const {

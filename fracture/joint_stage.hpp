@@ -68,6 +68,16 @@ class JointStage {
   const std::vector<CohesiveLaw>& laws() const { return laws_; }
   // Every local joint's history, in the model's joint order (pristine ones written out in full).
   std::vector<JointHistory> history() const;
+  // Joint j's damage (mean D of its three points; 0 while pristine) and the time it broke (s; −1
+  // while it holds).
+  double damage(LocalIndex j) const {
+    const std::int32_t slot = slot_[static_cast<std::size_t>(j)];
+    return slot < 0 ? 0.0 : live_[static_cast<std::size_t>(slot)].damage();
+  }
+  double failure_time(LocalIndex j) const {
+    const std::int32_t slot = slot_[static_cast<std::size_t>(j)];
+    return slot < 0 ? -1.0 : live_[static_cast<std::size_t>(slot)].failure_time;
+  }
   // Joints that hold a full history (the others are pristine).
   std::size_t live_histories() const { return live_.size(); }
 

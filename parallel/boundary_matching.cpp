@@ -109,7 +109,7 @@ std::vector<NodeMatch> match_boundary_points(const Scene& scene,
   // Directory: the partners of the nodes this rank answers for.
   std::vector<int> asker;
   std::vector<PosNode> seen = comm.exchange(outbox, &asker);
-  outbox = {};
+  release(outbox);
   std::vector<std::size_t> order(seen.size());
   std::iota(order.begin(), order.end(), 0);
   const auto same_node = [&](std::size_t a, std::size_t b) {
@@ -182,7 +182,7 @@ std::vector<NodeMatch> match_boundary_points(const Scene& scene,
     }
     i = j;
   }
-  seen = {};
+  release(seen);
   grid.clear();
   std::vector<NodeMatch> matches = comm.exchange(answers);
   std::sort(matches.begin(), matches.end(), match_order);

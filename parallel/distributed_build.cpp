@@ -435,19 +435,21 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
   const LocalIndex n_local = local_count(local_nodes.size(), "nodes");
   nodes.has_prescribed_velocity = scene.prescribes_velocities();
   nodes.resize(n_local);
+  nodes.reference_positions.clear();
   nodes.n_owned = 0;
   out.node_first_tet.resize(static_cast<std::size_t>(n_local));
   out.node_owner.resize(static_cast<std::size_t>(n_local));
   for (LocalIndex n = 0; n < n_local; ++n) {
     const LocalNode& l = local_nodes[n];
     nodes.gid[n] = l.gid;
-    for (int k = 0; k < 3; ++k) nodes.x0[3 * n + k] = l.x[k];
+    nodes.add_reference(n, l.x);
+    std::copy_n(l.x, 3, nodes.x.data() + 3 * static_cast<std::size_t>(n));
     nodes.piece[n] = l.piece;
     out.node_first_tet[n] = l.first_tet;
     out.node_owner[n] = block_owner(out.tet_block, l.first_tet);
     if (out.node_owner[n] == me) nodes.n_owned = n + 1;
   }
-  nodes.x = nodes.x0;
+  nodes.compact_references();
   std::fill(nodes.v.begin(), nodes.v.end(), 0.0);
   std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
   std::fill(nodes.mass.begin(), nodes.mass.end(), 0.0);
@@ -498,7 +500,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     for (int c = 0; c < 4; ++c) {
       const LocalIndex n = local_node(number_of(keys.key(r, c)).gid);
       tets.nodes[4 * t + c] = n;
-      X[c] = vec3_at(nodes.x0.data(), n);
+      X[c] = nodes.x0(n);
     }
     const TetSetup setup = setup_tet(X, model.materials[material]);
     Eigen::Map<Mat3>(tets.dm_inv.data() + 9 * static_cast<std::size_t>(t)) = setup.dm_inv;
@@ -556,7 +558,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     node_extent[static_cast<std::size_t>(n)] =
         std::max(node_extent[static_cast<std::size_t>(n)], p.extent);
   }
-  arrived = {};
+  release(arrived);
   // The other local nodes ask their owners for the mass and extent.
   std::vector<std::vector<GlobalId>> asks(static_cast<std::size_t>(ranks));
   for (LocalIndex n = nodes.n_owned; n < n_local; ++n)
@@ -584,7 +586,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
     joints = place_block_joints(scene, sources, model, tet_extent, face_tets, out.tet_block,
                                 matching_tolerance(hi - lo), comm);
   }
-  face_tets = {};
+  release(face_tets);
   out.joints = std::move(joints.joints);
   out.n_joints = joints.n_joints;
   model.joint_laws = std::move(joints.laws);

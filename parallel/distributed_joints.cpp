@@ -257,7 +257,6 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
     std::int64_t bin;
   };
   std::vector<Placed> placed;
-  const double* x0 = nodes.x0.data();
   const auto bonded = [&](GlobalId tet, double partner_extent) {
     const LocalIndex t = block_tet(tet);  // a joint reaches the owners of its tets
     out.bonded[static_cast<std::size_t>(t)] = 1;
@@ -288,8 +287,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
     FDEM_VERIFY(a[0] >= 0 && a[1] >= 0 && a[2] >= 0 && opposite >= 0,
                 "a joint's face nodes are three corners of its tet A");
     GlobalId b[3] = {d.b[0], d.b[1], d.b[2]};
-    if (joint_face_turned(vec3_at(x0, a[0]), vec3_at(x0, a[1]), vec3_at(x0, a[2]),
-                          vec3_at(x0, opposite))) {
+    if (joint_face_turned(nodes.x0(a[0]), nodes.x0(a[1]), nodes.x0(a[2]), nodes.x0(opposite))) {
       std::swap(a[1], a[2]);
       std::swap(b[1], b[2]);
     }
@@ -297,7 +295,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
       j.nodes[i] = nodes.gid[a[i]];
       j.nodes[3 + i] = b[i];
     }
-    j.area0 = joint_face_area(vec3_at(x0, a[0]), vec3_at(x0, a[1]), vec3_at(x0, a[2]));
+    j.area0 = joint_face_area(nodes.x0(a[0]), nodes.x0(a[1]), nodes.x0(a[2]));
     p.group = d.group;
     p.bin = joint_size_bin(tets.volume0[t], d.volume[1], j.area0);
     placed.push_back(p);
@@ -367,9 +365,9 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
   std::vector<std::vector<BoundaryNotice>> notices(static_cast<std::size_t>(ranks));
   {
     std::vector<FaceRecord> singles = comm.exchange(face_out);
-    face_out = {};
+    release(face_out);
     std::vector<FacePresence> presences = comm.exchange(presence_out);
-    presence_out = {};
+    release(presence_out);
     // Both kinds as (body, key, count, single or −1), grouped by face.
     struct Entry {
       std::int32_t body;
@@ -386,7 +384,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
                          static_cast<std::int64_t>(i)});
     for (const FacePresence& p : presences)
       entries.push_back({p.body, {p.key[0], p.key[1], p.key[2]}, p.count, -1});
-    presences = {};
+    release(presences);
     std::sort(entries.begin(), entries.end(), [&](const Entry& a, const Entry& b) {
       if (a.body != b.body) return a.body < b.body;
       if (a.key != b.key) return a.key < b.key;
@@ -445,13 +443,13 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
     for (int i = 0; i < 3; ++i) f.node[i] = node_at(*it, f.key[i]);
     owned_boundary.push_back(f);
   }
-  notices = {};
+  release(notices);
   {
     // Each boundary node once (a split body's copies of one mesh node: once).
     std::vector<BoundaryPoint> points;
     for (const OwnedBoundary& f : owned_boundary)
       for (int i = 0; i < 3; ++i) {
-        const Vec3 x = vec3_at(nodes.x0.data(), f.node[i]);
+        const Vec3 x = nodes.x0(f.node[i]);
         points.push_back({f.body, nodes.piece[f.node[i]], f.key[i], {x[0], x[1], x[2]}});
       }
     const auto by_node = [](const BoundaryPoint& a, const BoundaryPoint& b) {
@@ -521,7 +519,7 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
         ask(-1 - k, scene.interfaces[static_cast<std::size_t>(k)].body_b, n_materials + k,
             n_bodies + k);
     }
-    owned_boundary = {};
+    release(owned_boundary);
 
     // 5  Face directory: a partner triangle that is a boundary face makes a joint.
     std::vector<std::int64_t> counts(static_cast<std::size_t>(n_bodies) + scene.interfaces.size(),
@@ -562,9 +560,9 @@ BlockJoints place_block_joints(const Scene& scene, const std::vector<std::string
 
   // 6  Owners of tet A (joints) and of tet B (bonds) not reached yet.
   std::vector<DraftRecord> arrived = comm.exchange(drafts);
-  drafts = {};
+  release(drafts);
   for (const DraftRecord& d : arrived) (d.role == 0 ? place : bond)(d);
-  arrived = {};
+  release(arrived);
 
   // 7  Joint gids in ascending (gid A, gid B); laws in ascending key over all ranks.
   std::sort(placed.begin(), placed.end(), [](const Placed& p, const Placed& q) {

@@ -597,7 +597,7 @@ void Distribution::update_report(const Model& model, bool count_traffic) {
     report_.migration.dropped_tets += sum[3];
     report_.migration.sent_bytes += sum[4];
   }
-  cycle_traffic_ = {};
+  release(cycle_traffic_);
 }
 
 std::uint64_t global_state_hash(const Model& model, const Communicator& comm) {

@@ -74,7 +74,7 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
   std::vector<char> send, own;
   std::vector<std::size_t> send_counts;
-  cycle_traffic_ = {};
+  release(cycle_traffic_);
   cycle_traffic_.sent_tets = pack_rows(model, state, lists, send, send_counts, &own, start_joints);
   move_rows(model, state, send, send_counts, own, out, out_state);
 }
@@ -87,7 +87,7 @@ void Distribution::move_rows(Model& source, TravellingState& source_state, std::
   source.nodes = NodeArrays{};
   source.tets = TetArrays{};
   source.joints = JointArrays{};
-  source.tet_force_order = {};
+  release(source.tet_force_order);
   source_state = TravellingState{};
   std::vector<char> receive = exchange_rows(send, send_counts);
   assemble({&receive, &own}, out, out_state);
@@ -135,7 +135,7 @@ void Distribution::migrate_incremental(Model& model, TravellingState& state) {
   // A new copy carries every joint of its tet: the receiver may hold the other side already.
   std::vector<char> send, own;
   std::vector<std::size_t> send_counts;
-  cycle_traffic_ = {};
+  release(cycle_traffic_);
   cycle_traffic_.dropped_tets = static_cast<long>(dropped.size());
   cycle_traffic_.sent_tets = pack_rows(model, state, sends, send, send_counts, &own, nullptr, true);
   move_rows(model, state, send, send_counts, own, model, state);
@@ -175,6 +175,7 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   NodeArrays& nodes = model.nodes;
   const LocalIndex n_nodes = local_count(node_rows.size(), "nodes");
   nodes.resize(n_nodes);
+  nodes.reference_positions.clear();  // every node is stored anew from its row
   nodes.n_owned = 0;
   node_owner_.resize(static_cast<std::size_t>(n_nodes));
   node_first_tet_.resize(static_cast<std::size_t>(n_nodes));
@@ -187,6 +188,7 @@ void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, M
   }
   node_rows = std::vector<NodeRow>{};
   parsed.node_values = std::vector<unsigned char>{};
+  nodes.compact_references();
   TetArrays& tets = model.tets;
   const LocalIndex n_tets = local_count(tet_rows.size(), "tetrahedra");
   tets.contact_group.resize(n_tets);  // every arriving tet has its group

@@ -60,7 +60,8 @@ inline std::size_t padded(std::size_t bytes) {
 // Bytes of the migrating field values of one node, tet or joint.
 inline std::size_t node_value_bytes() {
   static const std::size_t bytes = field_bytes(node_fields, FieldUse::migrates) +
-                                   field_bytes(travelling_node_fields, FieldUse::migrates);
+                                   field_bytes(travelling_node_fields, FieldUse::migrates) +
+                                   3 * sizeof(double);  // the reference position
   return bytes;
 }
 inline std::size_t tet_value_bytes() {
@@ -197,7 +198,8 @@ class RowPacker {
       append(out, row);
       unsigned char* p = open_values(out, node_value_bytes());
       p = pack_fields(node_fields, FieldUse::migrates, nodes, n, p);
-      pack_fields(travelling_node_fields, FieldUse::migrates, state_, n, p);
+      p = pack_fields(travelling_node_fields, FieldUse::migrates, state_, n, p);
+      std::memcpy(p, nodes.x0(n).data(), 3 * sizeof(double));
     }
     for (LocalIndex j : joint_list) {
       JointRow row{};
@@ -272,7 +274,8 @@ struct ParsedRows {
 };
 
 // Writes node row `r` into entry n of the arrays and of the state's node fields (the fields that
-// do not migrate, such as the force, are reset).
+// do not migrate, such as the force, are reset).  Its reference position is appended to the
+// table: the caller compacts it once the rows are in (NodeArrays::compact_references).
 inline void store_node_row(const ParsedRows& rows, const NodeRow& r, std::size_t n,
                            NodeArrays& nodes, std::vector<std::int32_t>& node_owner,
                            std::vector<GlobalId>& node_first_tet, TravellingState& state) {
@@ -281,7 +284,10 @@ inline void store_node_row(const ParsedRows& rows, const NodeRow& r, std::size_t
   node_first_tet[n] = r.first_tet;
   const unsigned char* p =
       unpack_fields(node_fields, FieldUse::migrates, nodes, n, rows.values_of(r));
-  unpack_fields(travelling_node_fields, FieldUse::migrates, state, n, p);
+  p = unpack_fields(travelling_node_fields, FieldUse::migrates, state, n, p);
+  double reference[3];
+  std::memcpy(reference, p, sizeof reference);
+  nodes.add_reference(static_cast<LocalIndex>(n), reference);
 }
 
 // Writes tet row `r` into entry t of the arrays and of the state's tet fields, its nodes found by

@@ -110,6 +110,7 @@ void Distribution::append_halo(Model& model, TravellingState& state,
   }
   rows.nodes = std::vector<NodeRow>{};
   rows.node_values = std::vector<unsigned char>{};
+  nodes.compact_references();
   std::vector<std::size_t> order(n_all - n_owned);
   std::iota(order.begin(), order.end(), n_owned);
   std::sort(order.begin(), order.end(),

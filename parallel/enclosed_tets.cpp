@@ -37,7 +37,7 @@ std::vector<std::uint8_t> enclosed_face_tets(std::vector<BoundaryMeshNode> bound
     std::vector<std::vector<BoundaryMeshNode>> outbox(static_cast<std::size_t>(ranks));
     for (const BoundaryMeshNode& n : boundary)
       outbox[static_cast<std::size_t>(node_rank(n, ranks))].push_back(n);
-    boundary = {};
+    release(boundary);
     directory = comm.exchange(outbox);
     sort_unique(directory);
   }

@@ -118,9 +118,9 @@ BodyChunks file_mesh_chunks(const std::string& path, const std::string& physical
                         nodes.begin() + 4 * std::ptrdiff_t(t) + 4);
       kept_tags.push_back(tags[t]);
     }
-  nodes = {};
-  tags = {};
-  entity = {};
+  release(nodes);
+  release(tags);
+  release(entity);
   const std::vector<std::int64_t> kept =
       comm.allgather(static_cast<std::int64_t>(kept_tags.size()));
   const std::int64_t kept_first = std::accumulate(kept.begin(), kept.begin() + me, std::int64_t{0});

@@ -80,7 +80,7 @@ std::vector<PieceInfo> chain_piece_sums(const Model& model, const std::vector<st
   const TetArrays& tets = model.tets;
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     Vec3 X[4];
-    for (int c = 0; c < 4; ++c) X[c] = vec3_at(model.nodes.x0.data(), tets.nodes[4 * t + c]);
+    for (int c = 0; c < 4; ++c) X[c] = model.nodes.x0(tets.nodes[4 * t + c]);
     add_to_piece(running[slot_of(local, tets.piece[t])],
                  model.materials[tets.material[t]].density * tets.volume0[t], X);
   }
@@ -271,7 +271,7 @@ BlockMotions directory_piece_motions(const Model& model, const Communicator& com
       });
   FDEM_VERIFY(merged_pieces == block.end - block.begin, "every piece of the block has nodes");
   const std::vector<CentreRow> rows = comm.exchange(answers);
-  answers = {};
+  release(answers);
   FDEM_VERIFY(rows.size() == owned.ids.size(), "the centres of every owned piece come back");
   std::vector<PieceCentres> centres(owned.ids.size());
   for (const CentreRow& r : rows) {

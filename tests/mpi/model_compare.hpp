@@ -64,7 +64,7 @@ inline void check_block_is_serial_model(const DistributedModel& block, const Mod
                 same_bits(local.nodes.mass[n], serial.nodes.mass[g]) &&
                 local.nodes.constrained[n] == serial.nodes.constrained[g];
     for (int k = 0; k < 3; ++k)
-      same = same && same_bits(local.nodes.x0[3 * n + k], serial.nodes.x0[3 * g + k]) &&
+      same = same && same_bits(local.nodes.x0(n)[k], serial.nodes.x0(g)[k]) &&
              same_bits(local.nodes.x[3 * n + k], serial.nodes.x[3 * g + k]) &&
              same_bits(local.nodes.v[3 * n + k], serial.nodes.v[3 * g + k]) &&
              same_bits(local.nodes.prescribed_velocity_at(3 * n + k),

@@ -253,9 +253,8 @@ void reseal(const std::string& path) {
   std::vector<FileRegion> regions;
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   for (const char* group : {"/nodes", "/joints", "/friction"})
-    for (const char* name :
-         {"gid", "x", "v", "x_at_detection", "prescribed_velocity", "broken", "mode",
-          "failure_time", "damage", "history", "a", "b", "spring", "stiffness"}) {
+    for (const char* name : {"gid", "x", "v", "x_at_detection", "prescribed_velocity", "broken",
+                             "mode", "history", "a", "b", "spring", "stiffness"}) {
       const std::string full = std::string(group) + "/" + name;
       if (H5Lexists(file, group, H5P_DEFAULT) <= 0 ||
           H5Lexists(file, full.c_str(), H5P_DEFAULT) <= 0)
@@ -302,7 +301,7 @@ TEST_CASE("checkpoint: interleaved rows of every rank round-trip bit-exactly",
   CHECK(back.second.field_list() ==
         "nodes/x:float64[3] nodes/v:float64[3] nodes/prescribed_velocity:float64[3] "
         "nodes/x_at_detection:float64[3] joints/broken:uint8[1] joints/mode:uint8[1] "
-        "joints/failure_time:float64[1] joints/damage:float64[1] joints/history:uint8[12] "
+        "joints/history:uint8[12] "
         "friction/spring:float64[3] friction/stiffness:float64[1] friction/anchor_a:float64[4] "
         "friction/anchor_b:float64[4]");
 }
@@ -498,9 +497,9 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
   }
   SECTION("a missing dataset") {
     const std::string path = good_copy("no_damage.h5");
-    alter(path, [](hid_t file) { CHECK(H5Ldelete(file, "/joints/damage", H5P_DEFAULT) >= 0); });
+    alter(path, [](hid_t file) { CHECK(H5Ldelete(file, "/joints/mode", H5P_DEFAULT) >= 0); });
     const std::string message = read_error(path);
-    CHECK(message.find("/joints/damage") != std::string::npos);
+    CHECK(message.find("/joints/mode") != std::string::npos);
   }
   SECTION("another format version") {
     const std::string path = good_copy("version2.h5");
@@ -544,7 +543,7 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
     comm.barrier();
   };
   SECTION("one flipped bit in a dataset: checkpoint corrupt, naming the dataset") {
-    for (const char* dataset : {"/nodes/x", "/nodes/v", "/joints/damage", "/joints/history"}) {
+    for (const char* dataset : {"/nodes/x", "/nodes/v", "/joints/mode", "/joints/history"}) {
       const std::string path = good_copy("flipped.h5");
       haddr_t offset = HADDR_UNDEF;  // the dataset's bytes in the file (contiguous layout)
       hsize_t size = 0;

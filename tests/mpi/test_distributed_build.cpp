@@ -285,10 +285,10 @@ TEST_CASE("distributed start-up: joints, contact groups and joint states are the
   std::vector<double> extent(static_cast<std::size_t>(serial.tets.size()));
   std::vector<double> node_extent(static_cast<std::size_t>(serial.nodes.size()), 0.0);
   for (LocalIndex t = 0; t < serial.tets.size(); ++t) {
-    Vec3 lo = vec3_at(serial.nodes.x0.data(), serial.tets.nodes[4 * t]), hi = lo;
+    Vec3 lo = serial.nodes.x0(serial.tets.nodes[4 * t]), hi = lo;
     for (int c = 1; c < 4; ++c) {
-      lo = lo.cwiseMin(vec3_at(serial.nodes.x0.data(), serial.tets.nodes[4 * t + c]));
-      hi = hi.cwiseMax(vec3_at(serial.nodes.x0.data(), serial.tets.nodes[4 * t + c]));
+      lo = lo.cwiseMin(serial.nodes.x0(serial.tets.nodes[4 * t + c]));
+      hi = hi.cwiseMax(serial.nodes.x0(serial.tets.nodes[4 * t + c]));
     }
     extent[t] = (hi - lo).maxCoeff();
     for (int c = 0; c < 4; ++c)

@@ -43,7 +43,7 @@ void move(Model& model, double shift) {
   NodeArrays& n = model.nodes;
   for (LocalIndex i = 0; i < n.size(); ++i) {
     const double g = static_cast<double>(n.gid[i]);
-    if (n.x0[3 * i + 2] > 0.205) n.x[3 * i] += shift;
+    if (n.x0(i)[2] > 0.205) n.x[3 * i] += shift;
     for (int k = 0; k < 3; ++k) n.x[3 * i + k] += 1e-4 * std::cos(0.3 * g + k);
   }
 }

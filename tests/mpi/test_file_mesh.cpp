@@ -140,8 +140,9 @@ TEST_CASE("distributed start-up from a Gmsh model file is the serial builder's m
     const Model serial_h5 = build_model(from_h5, load_body_meshes(from_h5));
     CHECK(serial_h5.tets.size() == serial.tets.size());
     long differences = 0;
-    for (std::size_t i = 0; i < serial.nodes.x0.size() && i < serial_h5.nodes.x0.size(); ++i)
-      differences += !testing::same_bits(serial.nodes.x0[i], serial_h5.nodes.x0[i]);
+    for (LocalIndex n = 0; n < serial.nodes.size() && n < serial_h5.nodes.size(); ++n)
+      for (int k = 0; k < 3; ++k)
+        differences += !testing::same_bits(serial.nodes.x0(n)[k], serial_h5.nodes.x0(n)[k]);
     for (std::size_t i = 0; i < serial.tets.nodes.size() && i < serial_h5.tets.nodes.size(); ++i)
       differences += serial.tets.nodes[i] != serial_h5.tets.nodes[i];
     CHECK(differences == 0);

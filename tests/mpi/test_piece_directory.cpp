@@ -59,7 +59,7 @@ Model moved_model() {
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
     const double g = static_cast<double>(nodes.gid[n]);
     const double turn = 0.01 * (model.nodes.piece[n] % 5);
-    const Vec3 x0 = vec3_at(nodes.x0.data(), n);
+    const Vec3 x0 = nodes.x0(n);
     vec3_at(nodes.x.data(), n) =
         x0 + Vec3(-turn * x0.y(), turn * x0.x(), 1e-4 * std::sin(g)) + Vec3(0.01, 0, 0.02);
     vec3_at(nodes.v.data(), n) += Vec3(1e-3 * std::cos(g), 0, 0);
@@ -84,9 +84,9 @@ Model dealt_model(const Model& whole, const Communicator& comm) {
     nodes.gid[j] = whole.nodes.gid[n];
     nodes.mass[j] = whole.nodes.mass[n];
     nodes.piece[j] = whole.nodes.piece[n];
+    nodes.add_reference(j, whole.nodes.x0(n).data());
     for (int k = 0; k < 3; ++k) {
       nodes.x[3 * j + k] = whole.nodes.x[3 * n + k];
-      nodes.x0[3 * j + k] = whole.nodes.x0[3 * n + k];
       nodes.v[3 * j + k] = whole.nodes.v[3 * n + k];
     }
   }

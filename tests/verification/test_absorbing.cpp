@@ -44,7 +44,7 @@ PulseResult run_pulse(int axis, bool absorbing) {
   Model& model = sim->model();
   const double pi = std::acos(-1.0);
   for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
-    const double z = model.nodes.x0[3 * n + 2], s = (z - z0) / w;
+    const double z = model.nodes.x0(n)[2], s = (z - z0) / w;
     if (std::abs(s) >= 0.5) continue;
     const double phase = pi * s + pi / 2;  // 0 .. π over the pulse
     const double u = a * std::sin(phase) * std::sin(phase);

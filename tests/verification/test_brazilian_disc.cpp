@@ -73,8 +73,7 @@ Mat3 cauchy_stress(const Model& model, LocalIndex t) {
 
 Vec3 tet_centroid0(const Model& model, LocalIndex t) {
   Vec3 c = Vec3::Zero();
-  for (int k = 0; k < 4; ++k)
-    c += 0.25 * vec3_at(model.nodes.x0.data(), model.tets.nodes[4 * t + k]);
+  for (int k = 0; k < 4; ++k) c += 0.25 * model.nodes.x0(model.tets.nodes[4 * t + k]);
   return c;
 }
 
@@ -148,7 +147,7 @@ DiscResult run_brazilian_disc(const DiscSettings& s) {
     if (!nodes.constrained[n])
       free_nodes.push_back(n);
     else
-      (nodes.x0[3 * n + 1] > 0 ? top_nodes : bottom_nodes).push_back(n);
+      (nodes.x0(n)[1] > 0 ? top_nodes : bottom_nodes).push_back(n);
   }
   REQUIRE(top_nodes.size() > 4);
   REQUIRE(bottom_nodes.size() > 4);
@@ -238,7 +237,7 @@ DiscResult run_brazilian_disc(const DiscSettings& s) {
   for (LocalIndex j = 0; j < model.joints.size(); ++j) {
     if (!model.joints.broken[j]) continue;
     Vec3 c = Vec3::Zero();
-    for (int k = 0; k < 3; ++k) c += vec3_at(nodes.x0.data(), model.joints.nodes[6 * j + k]) / 3;
+    for (int k = 0; k < 3; ++k) c += nodes.x0(model.joints.nodes[6 * j + k]) / 3;
     r.mean_abs_x += std::abs(c.x());
     in_band += std::abs(c.x()) < 5e-3;
   }

@@ -34,11 +34,11 @@ TEST_CASE(
   std::vector<LocalIndex> probe, free_end;
   for (LocalIndex t = 0; t < model.tets.size(); ++t) {
     double cx = 0;
-    for (int c = 0; c < 4; ++c) cx += 0.25 * model.nodes.x0[3 * model.tets.nodes[4 * t + c]];
+    for (int c = 0; c < 4; ++c) cx += 0.25 * model.nodes.x0(model.tets.nodes[4 * t + c])[0];
     if (std::abs(cx - L / 2) < L / 160) probe.push_back(t);
   }
   for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if (model.nodes.x0[3 * n] == L) free_end.push_back(n);
+    if (model.nodes.x0(n)[0] == L) free_end.push_back(n);
   REQUIRE(!probe.empty());
   auto probe_stress =
       [&]() {  // mean axial Cauchy stress (Pa): tension, the bar pulls away from the stop
@@ -108,7 +108,7 @@ TEST_CASE(
   double inertia = 0;
   const NodeArrays& nodes = sim->model().nodes;
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    const Vec3 r = vec3_at(nodes.x0.data(), n);
+    const Vec3 r = nodes.x0(n);
     inertia += nodes.mass[n] * (r - r.dot(axis) * axis).squaredNorm();
   }
   CHECK(L0.dot(axis) == Approx(inertia * 10.0).epsilon(1e-4));
@@ -141,17 +141,17 @@ TEST_CASE("free-free axial frequency of a beam within 1 % (docs/references.md 5)
   // First axial mode shape u = a·cos(πX/L): start from that velocity field.
   NodeArrays& nodes = sim->model().nodes;
   for (LocalIndex n = 0; n < nodes.size(); ++n)
-    nodes.v[3 * n] = 0.01 * std::cos(M_PI * nodes.x0[3 * n] / L);
+    nodes.v[3 * n] = 0.01 * std::cos(M_PI * nodes.x0(n)[0] / L);
   // Record end displacement zero crossings (u(L) − u(0) changes sign every half period).
   std::vector<LocalIndex> left, right;
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    if (nodes.x0[3 * n] == 0) left.push_back(n);
-    if (nodes.x0[3 * n] == L) right.push_back(n);
+    if (nodes.x0(n)[0] == 0) left.push_back(n);
+    if (nodes.x0(n)[0] == L) right.push_back(n);
   }
   auto elongation = [&]() {
     double e = 0;
-    for (LocalIndex n : right) e += nodes.x[3 * n] - nodes.x0[3 * n];
-    for (LocalIndex n : left) e -= nodes.x[3 * n] - nodes.x0[3 * n];
+    for (LocalIndex n : right) e += nodes.x[3 * n] - nodes.x0(n)[0];
+    for (LocalIndex n : left) e -= nodes.x[3 * n] - nodes.x0(n)[0];
     return e;
   };
   std::vector<double> crossings;
@@ -181,7 +181,7 @@ TEST_CASE("energy balance within 0.1 % for an undamped vibrating block over 1e4 
   // A smooth initial velocity field: stretching, bending and twisting modes together.
   NodeArrays& nodes = sim->model().nodes;
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    const Vec3 X = vec3_at(nodes.x0.data(), n);
+    const Vec3 X = nodes.x0(n);
     vec3_at(nodes.v.data(), n) = 0.05 * Vec3(std::cos(M_PI * X.x()), std::sin(M_PI * X.x()) * X.y(),
                                              X.y() - 0.25 + std::cos(M_PI * X.x()) * X.z());
   }

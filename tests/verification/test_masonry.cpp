@@ -145,7 +145,7 @@ RockResult rock_at(double level) {
   // The heel's bottom corner nodes (x = +b/2, z = 0 at t = 0) and their lowest point at rest.
   std::vector<LocalIndex> heel, bottom;
   for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
-    const Vec3 X = vec3_at(model.nodes.x0.data(), n);
+    const Vec3 X = model.nodes.x0(n);
     if (model.nodes.piece[n] != 1 || std::abs(X.z()) > 1e-9) continue;
     bottom.push_back(n);
     if (X.x() > 0.5 * b - 1e-9) heel.push_back(n);

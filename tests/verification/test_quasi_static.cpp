@@ -105,11 +105,11 @@ WallHold hold_wall(const Scene& scene, double window_start) {
   const NodeArrays& nodes = sim->model().nodes;
   LocalIndex corner = 0;
   for (LocalIndex n = 1; n < nodes.size(); ++n) {
-    const Vec3 x = vec3_at(nodes.x0.data(), n), best = vec3_at(nodes.x0.data(), corner);
+    const Vec3 x = nodes.x0(n), best = nodes.x0(corner);
     if (x.z() - x.x() > best.z() - best.x()) corner = n;
   }
   const auto displacement = [&] {
-    return Vec3(vec3_at(nodes.x.data(), corner) - vec3_at(nodes.x0.data(), corner));
+    return Vec3(vec3_at(nodes.x.data(), corner) - nodes.x0(corner));
   };
   WallHold r;
   const auto clock = std::chrono::steady_clock::now();

@@ -75,7 +75,7 @@ TEST_CASE(
   double mass = 0, inertia = 0;
   for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
     if (model.nodes.piece[n] != 1) continue;
-    const Vec3 r = vec3_at(model.nodes.x0.data(), n) - Vec3(0.5 * b, 0, 0);
+    const Vec3 r = model.nodes.x0(n) - Vec3(0.5 * b, 0, 0);
     mass += model.nodes.mass[n];
     inertia += model.nodes.mass[n] * (r.x() * r.x() + r.z() * r.z());
   }

@@ -118,7 +118,7 @@ TEST_CASE("a stable run at 0.95 of the critical step is not stopped", "[verifica
   std::mt19937 rng(3);
   std::normal_distribution<double> g(0.0, 1e-3);
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    nodes.v[3 * n] = 0.01 * std::cos(M_PI * nodes.x0[3 * n] / 2.0);
+    nodes.v[3 * n] = 0.01 * std::cos(M_PI * nodes.x0(n)[0] / 2.0);
     for (int k = 0; k < 3; ++k) nodes.v[3 * n + k] += g(rng);  // every mode, the highest included
   }
   double worst = 0;

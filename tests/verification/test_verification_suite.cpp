@@ -34,7 +34,7 @@ double face_position(const Model& model, int body, int k, double at) {
   int n = 0;
   for (LocalIndex i = 0; i < model.nodes.size(); ++i)
     if (model.pieces[model.nodes.piece[i]].body == body &&
-        std::abs(model.nodes.x0[3 * i + k] - at) < 1e-9) {
+        std::abs(model.nodes.x0(i)[k] - at) < 1e-9) {
       sum += model.nodes.x[3 * i + k];
       ++n;
     }
@@ -112,7 +112,7 @@ double bending_frequency(int nx, int n, double periods, double exact) {
   const double bl = beta * L;
   const double s = (std::cosh(bl) - std::cos(bl)) / (std::sinh(bl) - std::sin(bl));
   for (LocalIndex i = 0; i < model.nodes.size(); ++i) {
-    const double x = beta * model.nodes.x0[3 * i];
+    const double x = beta * model.nodes.x0(i)[0];
     model.nodes.v[3 * i + 2] =
         1e-3 * (std::cosh(x) + std::cos(x) - s * (std::sinh(x) + std::sin(x)));
   }
@@ -123,8 +123,8 @@ double bending_frequency(int nx, int n, double periods, double exact) {
     double mid = 0, ends = 0;
     int n_mid = 0, n_ends = 0;
     for (LocalIndex i = 0; i < model.nodes.size(); ++i) {
-      const double X = model.nodes.x0[3 * i];
-      const double w = model.nodes.x[3 * i + 2] - model.nodes.x0[3 * i + 2];
+      const double X = model.nodes.x0(i)[0];
+      const double w = model.nodes.x[3 * i + 2] - model.nodes.x0(i)[2];
       if (std::abs(X - L / 2) < 1e-9) mid += w, ++n_mid;
       if (X == 0 || X == L) ends += w, ++n_ends;
     }

@@ -48,7 +48,7 @@ TEST_CASE("build_model marks the jointed tets with no corner on the mesh boundar
     bool inside = true;  // by geometry: no corner on a face of the cube
     for (int c = 0; c < 4; ++c)
       for (int d = 0; d < 3; ++d) {
-        const double x = model.nodes.x0[3 * model.tets.nodes[4 * t + c] + d];
+        const double x = model.nodes.x0(model.tets.nodes[4 * t + c])[d];
         inside = inside && x > 1e-9 && x < n * h - 1e-9;
       }
     CHECK(model.tets.enclosed[t] == (inside ? 1 : 0));

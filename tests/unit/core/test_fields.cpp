@@ -72,7 +72,10 @@ TEST_CASE(
     round_trip(node_fields, from, to);
     // The force is summed anew every step: it does not travel.
     CHECK(to.f[0] == 0.0);
-    CHECK(field_bytes(node_fields, FieldUse::migrates) == (4 * 3 + 1) * 8 + 4 + 1);
+    // x, v, prescribed velocity, mass, piece, constrained; the reference position travels as
+    // three doubles beside them (parallel/distribution_rows.hpp), its local index not at all.
+    CHECK(to.reference[0] == -1);
+    CHECK(field_bytes(node_fields, FieldUse::migrates) == (3 * 3 + 1) * 8 + 4 + 1);
   }
   SECTION("tets") {
     TetArrays from, to;
@@ -97,8 +100,10 @@ TEST_CASE(
     "[core][fields]") {
   JointArrays joints;
   joints.resize(2);
-  CHECK(joints.failure_time == std::vector<double>{-1.0, -1.0});
   CHECK(joints.broken == std::vector<std::uint8_t>{0, 0});
+  NodeArrays nodes;
+  nodes.resize(2);
+  CHECK(nodes.reference == std::vector<std::int32_t>{-1, -1});
 
   TetArrays tets;  // contact_group absent: a tet's group is its piece
   tets.resize(2);
@@ -130,10 +135,11 @@ TEST_CASE(
   nodes.n_owned = 3;
   for (LocalIndex n = 0; n < 4; ++n) {
     nodes.gid[n] = 100 + 2 * n;
+    const double reference[3] = {99.0, 99.0, 99.0};  // not hashed
+    nodes.add_reference(n, reference);
     for (int k = 0; k < 3; ++k) {
       nodes.x[3 * n + k] = 0.1 * n - 0.3 * k;
       nodes.v[3 * n + k] = -2.0 * n + 0.7 * k;
-      nodes.x0[3 * n + k] = 99.0;  // not hashed
     }
   }
   const GlobalId offset = 100;

@@ -22,6 +22,8 @@ NodeArrays random_nodes(LocalIndex n, std::uint64_t seed) {
       nodes.x[3 * i + k] = uniform(random);
       nodes.v[3 * i + k] = uniform(random);
     }
+    const double reference[3] = {uniform(random), uniform(random), uniform(random)};
+    nodes.add_reference(i, reference);
   }
   return nodes;
 }

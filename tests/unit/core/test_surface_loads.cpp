@@ -82,9 +82,7 @@ TEST_CASE("surface loads: boundary faces, outward, without shared or joint faces
       const Vec3 force = vec3_at(faces.corner_force.data(), i);
       const LocalIndex* n = faces.nodes.data() + 3 * i;
       const Vec3 centre =
-          (vec3_at(model.nodes.x0.data(), n[0]) + vec3_at(model.nodes.x0.data(), n[1]) +
-           vec3_at(model.nodes.x0.data(), n[2])) /
-          3.0;
+          (model.nodes.x0(n[0]) + model.nodes.x0(n[1]) + model.nodes.x0(n[2])) / 3.0;
       const Vec3 piece_centre = centre.x() < 3 ? Vec3(0.25, 0.25, 0.25) : Vec3(5.5, 0.5, 0.5);
       CHECK(force.dot(piece_centre - centre) > 0.0);
       area += 3.0 * force.norm() / p;
@@ -93,11 +91,9 @@ TEST_CASE("surface loads: boundary faces, outward, without shared or joint faces
     double pair_area = 0;
     for (LocalIndex i = 0; i < faces.size(); ++i) {
       const LocalIndex* n = faces.nodes.data() + 3 * i;
-      const Vec3 x0 = vec3_at(model.nodes.x0.data(), n[0]);
+      const Vec3 x0 = model.nodes.x0(n[0]);
       if (x0.x() < 3) continue;
-      pair_area += 0.5 * (vec3_at(model.nodes.x0.data(), n[1]) - x0)
-                             .cross(vec3_at(model.nodes.x0.data(), n[2]) - x0)
-                             .norm();
+      pair_area += 0.5 * (model.nodes.x0(n[1]) - x0).cross(model.nodes.x0(n[2]) - x0).norm();
     }
     CHECK(area == Approx(1.5 + std::sqrt(3.0) / 2 + pair_area).epsilon(1e-12));
     // Every node's force is the sum of its faces' corner forces: Σ f = 0 as well.
@@ -124,7 +120,7 @@ TEST_CASE("surface loads: a region keeps faces with three corners inside, power 
   // A fixed-direction pressure and a traction act on the reference shape: moving x changes
   // neither; a follower pressure turns with the face.
   for (LocalIndex n = 0; n < model.nodes.size(); ++n) {  // turn everything 90° about x
-    const Vec3 X = vec3_at(model.nodes.x0.data(), n);
+    const Vec3 X = model.nodes.x0(n);
     vec3_at(model.nodes.x.data(), n) = Vec3(X.x(), -X.z(), X.y());
   }
   add_surface_forces(load.surface, 0.5, faces, model.nodes);

@@ -54,7 +54,7 @@ double run(Model model, double dt, const Eigen::VectorXd& v0, int steps, int fro
     integrate_central_difference(dt, model.nodes);
     if (s < from) continue;
     for (int i = 0; i < 12; ++i)
-      largest = std::max(largest, std::abs(model.nodes.x[i] - model.nodes.x0[i]));
+      largest = std::max(largest, std::abs(model.nodes.x[i] - model.nodes.x0(i / 3)[i % 3]));
   }
   return largest;
 }

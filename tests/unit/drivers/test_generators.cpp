@@ -78,8 +78,8 @@ LocalIndex interface_joints(const MeshSpec& mesh) {
     REQUIRE(model.tets.piece[model.joints.tets[2 * j]] !=
             model.tets.piece[model.joints.tets[2 * j + 1]]);
     for (int i = 0; i < 3; ++i)
-      REQUIRE((vec3_at(model.nodes.x0.data(), model.joints.nodes[6 * j + i]) -
-               vec3_at(model.nodes.x0.data(), model.joints.nodes[6 * j + 3 + i]))
+      REQUIRE((model.nodes.x0(model.joints.nodes[6 * j + i]) -
+               model.nodes.x0(model.joints.nodes[6 * j + 3 + i]))
                   .norm() < 1e-12);
   }
   return model.joints.size();

@@ -85,7 +85,7 @@ TEST_CASE("histories: the reaction of a statically stretched bar is E·A·ε",
   const double strain = 1e-4;
   NodeArrays& nodes = sim->model().nodes;
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    nodes.x[3 * n] = (1 + strain) * nodes.x0[3 * n];
+    nodes.x[3 * n] = (1 + strain) * nodes.x0(n)[0];
     for (int k = 0; k < 3; ++k) nodes.v[3 * n + k] = 0.0;
   }
   REQUIRE(sim->run().status == "completed");
@@ -127,7 +127,7 @@ TEST_CASE(
   C << 1.0, 2.0, -3.0, 0.5, -0.25, 4.0, -2.0, 1.5, 0.75;
   const Vec3 b(0.1, -0.2, 0.3), d(-5, 6, 7);
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    const Vec3 X = vec3_at(nodes.x0.data(), n);
+    const Vec3 X = nodes.x0(n);
     vec3_at(nodes.x.data(), n) = X + A * X + b;
     vec3_at(nodes.v.data(), n) = C * X + d;
   }
@@ -144,7 +144,7 @@ TEST_CASE(
   // A uniform stretch F = diag(λ1, λ2, λ3): neo-Hookean σ = μ/J (F·Fᵀ − I) + λ_L ln J / J · I.
   const Vec3 stretch(1.02, 0.99, 1.005);
   for (LocalIndex n = 0; n < nodes.size(); ++n)
-    vec3_at(nodes.x.data(), n) = stretch.cwiseProduct(vec3_at(nodes.x0.data(), n));
+    vec3_at(nodes.x.data(), n) = stretch.cwiseProduct(nodes.x0(n));
   const double E = 3.0e9, nu = 0.3, mu = E / (2 * (1 + nu)),
                lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
   const double J = stretch.prod();

@@ -288,13 +288,13 @@ TEST_CASE("a prescribed velocity follows its time history, a later constant load
   const NodeArrays& nodes = sim->model().nodes;
   int top_nodes = 0;
   for (LocalIndex n = 0; n < nodes.size(); ++n)  // at rest at t = 0: h(0) = 0
-    if (nodes.x0[3 * n + 2] > 0.19) CHECK(nodes.v[3 * n + 2] == 0.0);
+    if (nodes.x0(n)[2] > 0.19) CHECK(nodes.v[3 * n + 2] == 0.0);
   while (sim->time() < end - 0.5 * dt) sim->step();
   const double expected = v * (T / 2 + end - T);  // m
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    if (nodes.x0[3 * n + 2] < 0.19) continue;
-    const double uz = nodes.x[3 * n + 2] - nodes.x0[3 * n + 2];
-    if (nodes.x0[3 * n] < 0.01 && nodes.x0[3 * n + 1] < 0.01) {
+    if (nodes.x0(n)[2] < 0.19) continue;
+    const double uz = nodes.x[3 * n + 2] - nodes.x0(n)[2];
+    if (nodes.x0(n)[0] < 0.01 && nodes.x0(n)[1] < 0.01) {
       CHECK(uz == 0.0);  // the corner load comes later in the scene
       continue;
     }

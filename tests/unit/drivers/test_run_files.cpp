@@ -267,10 +267,10 @@ TEST_CASE("RunFiles writes energy and body rows as they come, and frames", "[cli
   // 0.5), and give every node the velocity (1, 2, 3) m/s.
   const double angle = 0.05, c = std::cos(angle), s = std::sin(angle);
   for (int n = 0; n < model.nodes.size(); ++n) {
-    const double x = model.nodes.x0[3 * n] - 1.0, y = model.nodes.x0[3 * n + 1] - 0.5;
+    const double x = model.nodes.x0(n)[0] - 1.0, y = model.nodes.x0(n)[1] - 0.5;
     model.nodes.x[3 * n] = 1.0 + c * x - s * y + 0.1;
     model.nodes.x[3 * n + 1] = 0.5 + s * x + c * y - 0.2;
-    model.nodes.x[3 * n + 2] = model.nodes.x0[3 * n + 2] + 0.3;
+    model.nodes.x[3 * n + 2] = model.nodes.x0(n)[2] + 0.3;
     for (int k = 0; k < 3; ++k) model.nodes.v[3 * n + k] = k + 1.0;
   }
   files.write_bodies_rows(0.5, model, fdem::piece_motions(model));
@@ -313,7 +313,7 @@ TEST_CASE("RunFiles writes energy and body rows as they come, and frames", "[cli
   REQUIRE(v);
   for (vtkIdType n = 0; n < 12; ++n) {
     for (int k = 0; k < 3; ++k) {
-      CHECK(u->GetComponent(n, k) == Approx(model.nodes.x[3 * n + k] - model.nodes.x0[3 * n + k]));
+      CHECK(u->GetComponent(n, k) == Approx(model.nodes.x[3 * n + k] - model.nodes.x0(n)[k]));
       CHECK(v->GetComponent(n, k) == k + 1.0);
     }
   }

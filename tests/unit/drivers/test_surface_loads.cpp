@@ -60,7 +60,7 @@ TEST_CASE("surface loads: a bar under end pressure shortens by p·L/E, the suppo
   double tip = 0, reaction = 0;  // m (mean ux at x = L), N (Σ −f at x = 0)
   int tip_nodes = 0;
   for (LocalIndex n = 0; n < model.nodes.size(); ++n) {
-    const double X = model.nodes.x0[3 * n];
+    const double X = model.nodes.x0(n)[0];
     if (X > length - 1e-9) {
       tip += model.nodes.x[3 * n] - X;
       ++tip_nodes;

@@ -81,8 +81,7 @@ void set_lift_velocity(Model& m) {
 
 bool upper(const Model& m, LocalIndex t) {
   double z = 0.0;
-  for (int c = 0; c < 4; ++c)
-    z += m.nodes.x0[3 * static_cast<std::size_t>(m.tets.nodes[4 * t + c]) + 2];
+  for (int c = 0; c < 4; ++c) z += m.nodes.x0(static_cast<std::size_t>(m.tets.nodes[4 * t + c]))[2];
   return z > 4.0;
 }
 
@@ -122,7 +121,8 @@ TEST_CASE(
         upper(model, model.joints.tets[2 * j]) != upper(model, model.joints.tets[2 * j + 1]);
     across += spans;
     CHECK(static_cast<bool>(model.joints.broken[j]) == spans);
-    if (spans) CHECK((model.joints.failure_time[j] > 0.0 && model.joints.failure_time[j] <= 0.4));
+    if (spans) CHECK((stage.failure_time(j) > 0.0 && stage.failure_time(j) <= 0.4));
+    if (spans) CHECK(stage.damage(j) == 1.0);
   }
   REQUIRE(across > 0);
   CHECK(newly == across);
@@ -142,7 +142,8 @@ TEST_CASE(
   for (auto [m, st] : {std::pair<Model*, JointStage*>{&model, &stage}, {&copy, &rebound}}) {
     st->mark_broken(*m, intact, 0.75, 1);
     CHECK(m->joints.broken[intact] == 1);
-    CHECK(m->joints.failure_time[intact] == 0.75);
+    CHECK(st->failure_time(intact) == 0.75);
+    CHECK(st->damage(intact) == 1.0);
     for (double& x : m->nodes.x) x *= 1.0 + 1e-6;  // a small stretch of everything
     std::fill(m->nodes.f.begin(), m->nodes.f.end(), 0.0);
   }

@@ -103,8 +103,8 @@ Model two_block_model() {
         const double dx[3] = {1e-3 * X[0] + 2e-3 * X[1] * X[1], -5e-4 * X[1] + 1e-3 * X[2] * X[0],
                               3e-4 * X[0] * X[1] + 2e-4 * X[2]};
         m.nodes.gid[n] = (GlobalId{1} << 32) + 500 + 7 * n;
+        m.nodes.add_reference(n, X);
         for (int c = 0; c < 3; ++c) {
-          m.nodes.x0[3 * n + c] = X[c];
           m.nodes.x[3 * n + c] = X[c] + dx[c];
           m.nodes.v[3 * n + c] = 0.1 * (n + 1) * (c + 1) * (c == 1 ? -1.0 : 1.0);
         }
@@ -121,7 +121,7 @@ Model two_block_model() {
         m.tets.nodes[4 * t + s + 1] = node(corner[0], corner[1], corner[2]);
       }
       fdem::Vec3 X[4];
-      for (int c = 0; c < 4; ++c) X[c] = fdem::vec3_at(m.nodes.x0.data(), m.tets.nodes[4 * t + c]);
+      for (int c = 0; c < 4; ++c) X[c] = m.nodes.x0(m.tets.nodes[4 * t + c]);
       const fdem::Mat3 dm_inv = fdem::edge_matrix(X).inverse();
       std::copy(dm_inv.data(), dm_inv.data() + 9, m.tets.dm_inv.begin() + 9 * t);
       m.tets.volume0[t] = 1.0 / 6.0;
@@ -244,7 +244,7 @@ void check_frame_against_model(vtkUnstructuredGrid* grid, const Model& m,
       grid->GetPoint(p, x);
       for (int k = 0; k < 3; ++k) {
         CHECK(x[k] == m.nodes.x[3 * n + k]);
-        CHECK(u->GetComponent(p, k) == m.nodes.x[3 * n + k] - m.nodes.x0[3 * n + k]);
+        CHECK(u->GetComponent(p, k) == m.nodes.x[3 * n + k] - m.nodes.x0(n)[k]);
         CHECK(v->GetComponent(p, k) == m.nodes.v[3 * n + k]);
       }
       CHECK(node_gid->GetComponent(p, 0) == m.nodes.gid[n]);
@@ -307,9 +307,9 @@ TEST_CASE("a uniform stretch gives the analytic Cauchy stress in every piece", "
   Model m = two_block_model();
   const double e = 2e-3;
   for (LocalIndex n = 0; n < m.nodes.size(); ++n) {
-    m.nodes.x[3 * n] = (1.0 + e) * m.nodes.x0[3 * n];
-    m.nodes.x[3 * n + 1] = m.nodes.x0[3 * n + 1];
-    m.nodes.x[3 * n + 2] = m.nodes.x0[3 * n + 2];
+    m.nodes.x[3 * n] = (1.0 + e) * m.nodes.x0(n)[0];
+    m.nodes.x[3 * n + 1] = m.nodes.x0(n)[1];
+    m.nodes.x[3 * n + 2] = m.nodes.x0(n)[2];
   }
   std::fill(m.tets.material.begin(), m.tets.material.end(), 1);
   const fdem::LameParameters lame = m.materials[1].lame;
@@ -410,9 +410,9 @@ TEST_CASE("a rank model with ghost nodes writes its owned tets with global ids",
   for (std::size_t i = 0; i < whole_node.size(); ++i) {
     const LocalIndex n = whole_node[i];
     local.nodes.gid[i] = whole.nodes.gid[n];
+    local.nodes.add_reference(static_cast<LocalIndex>(i), whole.nodes.x0(n).data());
     for (int k = 0; k < 3; ++k) {
       local.nodes.x[3 * i + k] = whole.nodes.x[3 * n + k];
-      local.nodes.x0[3 * i + k] = whole.nodes.x0[3 * n + k];
       local.nodes.v[3 * i + k] = whole.nodes.v[3 * n + k];
     }
   }
