@@ -122,6 +122,9 @@ class Distribution {
                                     std::size_t record_bytes) const;
 
  private:
+  // Tets per buffer of this rank's own rows in a migration (~1 kB of rows per tet of a jointed
+  // body, a few per other tet): the buffers are freed one by one as they are parsed.
+  static constexpr std::size_t own_chunk_tets = 4096;
   struct Neighbour {
     int rank = 0;
     std::vector<LocalIndex> send, receive;  // local node indices
@@ -139,12 +142,14 @@ class Distribution {
   // kept): no second copy of the model is ever made.
   void append_halo(Model& model, TravellingState& state, const std::vector<double>* start_reach);
   // Packs lists[p] for the other ranks into `send` (counts in 8-byte words) and lists[me] into
-  // `own` when given; exchange_rows sends them (freeing `send`) and returns what arrived.
+  // `own` when given, as buffers of at most own_chunk_tets tets each (parse_rows frees each once
+  // read, so this rank's own rows and their parsed copy are not held whole at once);
+  // exchange_rows sends them (freeing `send`) and returns what arrived.
   // Returns the tet copies packed for other ranks.  `both_sides`: each tet carries every joint
   // of which it is a side (RowPacker).
   long pack_rows(const Model& model, const TravellingState& state,
                  const std::vector<std::vector<LocalIndex>>& lists, std::vector<char>& send,
-                 std::vector<std::size_t>& send_counts, std::vector<char>* own,
+                 std::vector<std::size_t>& send_counts, std::vector<std::vector<char>>* own,
                  const std::vector<StartJoint>* start_joints = nullptr,
                  bool both_sides = false) const;
   std::vector<char> exchange_rows(std::vector<char>& send,
@@ -158,13 +163,13 @@ class Distribution {
   // Frees `source`'s mesh arrays and `source_state` (the rows hold what travels), sends the rows,
   // and builds `out` (which may be `source`) from what arrived and this rank's `own` rows.
   void move_rows(Model& source, TravellingState& source_state, std::vector<char>& send,
-                 const std::vector<std::size_t>& send_counts, std::vector<char>& own, Model& out,
-                 TravellingState& out_state);
+                 const std::vector<std::size_t>& send_counts, std::vector<std::vector<char>>& own,
+                 Model& out, TravellingState& out_state);
   // After a full migration: every rank tells the owners of the tets it holds (not owned) that it
   // holds them, so that the next incremental cycle knows where copies are.
   void record_holders(const Model& model);
   // Builds `model` from packed rows; empties each buffer once parsed.
-  void assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
+  void assemble(const std::vector<std::vector<char>*>& buffers, Model& model,
                 TravellingState& state);
   void build_exchange(const Model& model);
   void start_exchange(std::vector<Neighbour>& plan, const NodeArrays& nodes);

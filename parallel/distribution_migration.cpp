@@ -31,8 +31,8 @@ const std::vector<double>* detection_positions(const Model& model, const Travell
 long Distribution::pack_rows(const Model& model, const TravellingState& state,
                              const std::vector<std::vector<LocalIndex>>& lists,
                              std::vector<char>& send, std::vector<std::size_t>& send_counts,
-                             std::vector<char>* own, const std::vector<StartJoint>* start_joints,
-                             bool both_sides) const {
+                             std::vector<std::vector<char>>* own,
+                             const std::vector<StartJoint>* start_joints, bool both_sides) const {
   const int ranks = comm_.size(), me = comm_.rank();
   send_counts.assign(static_cast<std::size_t>(ranks), 0);
   RowPacker packer(model, state, tet_owner_, node_owner_, node_first_tet_, start_joints,
@@ -41,7 +41,17 @@ long Distribution::pack_rows(const Model& model, const TravellingState& state,
   for (int p = 0; p < ranks; ++p) {
     if (lists[p].empty()) continue;
     if (p == me) {
-      if (own) packer.pack(lists[p], *own);
+      if (!own) continue;
+      // A tet's nodes (and joints) go with it into its chunk: a node shared by two chunks comes
+      // twice and is stored once (assemble keeps one row per gid).
+      const std::vector<LocalIndex>& mine = lists[p];
+      for (std::size_t first = 0; first < mine.size(); first += own_chunk_tets) {
+        const std::size_t last = std::min(mine.size(), first + own_chunk_tets);
+        own->emplace_back();
+        packer.pack(std::vector<LocalIndex>(mine.begin() + static_cast<std::ptrdiff_t>(first),
+                                            mine.begin() + static_cast<std::ptrdiff_t>(last)),
+                    own->back());
+      }
       continue;
     }
     const std::size_t before = send.size();
@@ -72,7 +82,8 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
   const std::vector<std::vector<LocalIndex>> lists =
       destinations(model, false, start_reach, detection_positions(model, state));
   // Rows for the other ranks travel; this rank's own rows stay in `own` (no copy through MPI).
-  std::vector<char> send, own;
+  std::vector<char> send;
+  std::vector<std::vector<char>> own;
   std::vector<std::size_t> send_counts;
   release(cycle_traffic_);
   cycle_traffic_.sent_tets = pack_rows(model, state, lists, send, send_counts, &own, start_joints);
@@ -80,8 +91,9 @@ void Distribution::migrate(Model& model, TravellingState& state, Model& out,
 }
 
 void Distribution::move_rows(Model& source, TravellingState& source_state, std::vector<char>& send,
-                             const std::vector<std::size_t>& send_counts, std::vector<char>& own,
-                             Model& out, TravellingState& out_state) {
+                             const std::vector<std::size_t>& send_counts,
+                             std::vector<std::vector<char>>& own, Model& out,
+                             TravellingState& out_state) {
   cycle_traffic_.sent_bytes = static_cast<long>(send.size());
   // The rows hold everything that travels: the source arrays can go before the new ones come.
   source.nodes = NodeArrays{};
@@ -90,7 +102,9 @@ void Distribution::move_rows(Model& source, TravellingState& source_state, std::
   release(source.tet_force_order);
   source_state = TravellingState{};
   std::vector<char> receive = exchange_rows(send, send_counts);
-  assemble({&receive, &own}, out, out_state);
+  std::vector<std::vector<char>*> buffers = {&receive};
+  for (std::vector<char>& chunk : own) buffers.push_back(&chunk);
+  assemble(buffers, out, out_state);
   build_exchange(out);
 }
 
@@ -133,7 +147,8 @@ void Distribution::migrate_incremental(Model& model, TravellingState& state) {
   }
   FDEM_VERIFY(found == dropped.size(), "a rank drops only copies it holds");
   // A new copy carries every joint of its tet: the receiver may hold the other side already.
-  std::vector<char> send, own;
+  std::vector<char> send;
+  std::vector<std::vector<char>> own;
   std::vector<std::size_t> send_counts;
   release(cycle_traffic_);
   cycle_traffic_.dropped_tets = static_cast<long>(dropped.size());
@@ -154,7 +169,7 @@ void Distribution::record_holders(const Model& model) {
   std::sort(held_by_.begin(), held_by_.end());
 }
 
-void Distribution::assemble(std::initializer_list<std::vector<char>*> buffers, Model& model,
+void Distribution::assemble(const std::vector<std::vector<char>*>& buffers, Model& model,
                             TravellingState& state) {
   const int me = comm_.rank();
   ParsedRows parsed = parse_rows(buffers);

@@ -317,7 +317,7 @@ inline const unsigned char* store_joint_values(const ParsedRows& rows, const Joi
   return unpack_fields(joint_fields, FieldUse::migrates, joints, j, rows.values_of(r));
 }
 
-inline ParsedRows parse_rows(std::initializer_list<std::vector<char>*> buffers) {
+inline ParsedRows parse_rows(const std::vector<std::vector<char>*>& buffers) {
   ParsedRows parsed;
   std::int64_t counts[5] = {0, 0, 0, 0, 0};
   const std::size_t tet_bytes = tet_value_bytes(), node_bytes = node_value_bytes();
