@@ -74,20 +74,18 @@ void NbsDetector::release_workspace() {
 
 void NbsDetector::detect(const double* lo, const double* hi, LocalIndex n, double buffer,
                          std::vector<CandidatePair>& out, PairFilter keep) {
-  std::vector<double> boxes = std::move(boxes_);  // the workspace's capacity, reused
-  boxes.resize(6 * static_cast<std::size_t>(std::max<LocalIndex>(n, 0)));
-  for (LocalIndex i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      boxes[6 * static_cast<std::size_t>(i) + k] = lo[3 * i + k];
-      boxes[6 * static_cast<std::size_t>(i) + 3 + k] = hi[3 * i + k];
-    }
-  detect(std::move(boxes), n, buffer, out, keep);
+  inflate_boxes(lo, hi, n, buffer, boxes_);
+  detect_inflated(n, out, keep);
 }
 
 void NbsDetector::detect(std::vector<double>&& boxes, LocalIndex n, double buffer,
                          std::vector<CandidatePair>& out, PairFilter keep) {
   boxes_ = std::move(boxes);
   inflate_boxes_in_place(boxes_, n, buffer);
+  detect_inflated(n, out, keep);
+}
+
+void NbsDetector::detect_inflated(LocalIndex n, std::vector<CandidatePair>& out, PairFilter keep) {
   out.clear();
   stats_ = NbsStats{};
   stats_.elements = n;

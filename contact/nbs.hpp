@@ -80,6 +80,8 @@ class NbsDetector {
   void release_workspace();
 
  private:
+  // The search over boxes_ (inflated, 6 doubles per element).
+  void detect_inflated(LocalIndex n, std::vector<CandidatePair>& out, PairFilter keep);
   struct Level {
     std::vector<LocalIndex> ids;     // global element index of each local element
     std::vector<std::int32_t> cell;  // 3 per local element: x, y, z cell index (1-based)

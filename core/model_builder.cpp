@@ -258,13 +258,14 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
   std::vector<std::int32_t> reference_of_mesh_node(static_cast<std::size_t>(n_all_nodes), -1);
   for (LocalIndex n = 0; n < n_nodes; ++n) {
     const LocalIndex old = node_source[n];
-    std::int32_t& reference = reference_of_mesh_node[static_cast<std::size_t>(old)];
-    if (reference < 0) {
+    std::int32_t& shared = reference_of_mesh_node[static_cast<std::size_t>(old)];
+    if (shared < 0) {
       const std::int32_t b = node_body[old];
       nodes.add_reference(n, meshes[b].coords.data() + 3 * (old - node_offset[b]));
-      reference = nodes.reference[n];
+      shared = nodes.reference[n];
+    } else {
+      nodes.reference[n] = shared;
     }
-    nodes.reference[n] = reference;
     for (int k = 0; k < 3; ++k) nodes.x[3 * n + k] = nodes.x0(n)[k];
   }
   nodes.reference_positions.shrink_to_fit();

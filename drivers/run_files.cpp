@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "drivers/run_report.hpp"
 #include "fracture/joint_kernels.hpp"
+#include "fracture/joint_stage.hpp"
 
 namespace fdem {
 

@@ -13,13 +13,14 @@
 #include "core/dynamics.hpp"
 #include "core/energy.hpp"
 #include "core/model.hpp"
-#include "fracture/joint_stage.hpp"
 #include "io/vtk_output.hpp"
 #include "io/xdmf_series.hpp"
 #include "parallel/ordered_text_file.hpp"
 #include "parallel/xdmf_output.hpp"
 
 namespace fdem {
+
+class JointStage;
 
 struct RunReport;
 struct StagePlan;
