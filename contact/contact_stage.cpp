@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "contact/dashpot_kernels.hpp"
 #include "contact/detection.hpp"
 #include "contact/potential_contact_kernels.hpp"
 #include "core/error.hpp"
@@ -37,6 +38,7 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   // slides).  docs/verification.md, "Static friction on an incline".
   FDEM_VERIFY(settings.friction_anchor_lag > 0.0, "friction anchor lag > 0");
   friction_anchor_lag_ = settings.friction_anchor_lag;
+  body_dashpot_ = settings.body_dashpot;
   body_cracked_.assign(static_cast<std::size_t>(std::max(model.pieces.bodies(), 0)), 0);
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
@@ -332,17 +334,32 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         1e-12 * std::min(std::abs(tets.volume0[pair.a]), std::abs(tets.volume0[pair.b]));
     if (xi > 0.0 && r.energy > 0.0 && r.normal_force > 0.0 && r.overlap_volume > sliver) {
       // Normal dashpot c = 2ξ√(k m): k = F²/(2U) is the pair's secant stiffness (exact for U ∝ d²),
-      // m the reduced mass of the two tets (a fixed partner has infinite mass).  The dashpot never
-      // pulls harder than the elastic push, so it cannot make the contact sticky.
+      // m the reduced mass of the two pieces (contact.dashpot: bodies) or of the two tets (tets);
+      // a fixed partner has infinite mass.  The dashpot never pulls harder than the elastic push,
+      // so it cannot make the contact sticky.
       const double k = r.normal_force * r.normal_force / (2.0 * r.energy);
       const double m_a = model.materials[ma].density * std::abs(tets.volume0[pair.a]);
       const double m_b = model.materials[mb].density * std::abs(tets.volume0[pair.b]);
       const bool a_fixed = piece_fixed(model, tets.piece[pair.a]),
                  b_fixed = piece_fixed(model, tets.piece[pair.b]);
-      const double m = a_fixed ? m_b : b_fixed ? m_a : m_a * m_b / (m_a + m_b);
+      double c = 0.0;
+      if (body_dashpot_) {  // dashpot_kernels.hpp: sized by the pieces, implicit on the pair
+        const auto piece_mass = [&](LocalIndex t, double tet_mass) {
+          return tets.dashpot_mass[t] > 0.0 ? tets.dashpot_mass[t] : tet_mass;
+        };
+        double inverse_a[4], inverse_b[4];
+        for (int q = 0; q < 4; ++q) {
+          inverse_a[q] = a_fixed ? 0.0 : 1.0 / nodes.mass[tets.nodes[4 * pair.a + q]];
+          inverse_b[q] = b_fixed ? 0.0 : 1.0 / nodes.mass[tets.nodes[4 * pair.b + q]];
+        }
+        c = dashpot_coefficient(
+            xi, k, reduced_mass(piece_mass(pair.a, m_a), a_fixed, piece_mass(pair.b, m_b), b_fixed),
+            centroid_point_mass(r, inverse_a, inverse_b), dt);
+      } else {
+        c = dashpot_coefficient(xi, k, reduced_mass(m_a, a_fixed, m_b, b_fixed), 0.0, dt);
+      }
       const double v_n = relative_velocity_at_centroid(r, va, vb).dot(r.normal);
-      const double f_n = std::max(-2.0 * xi * std::sqrt(k * m) * v_n,
-                                  -r.normal_force);  // on the contactor, along n
+      const double f_n = std::max(-c * v_n, -r.normal_force);  // on the contactor, along n
       double* damping_force = writable(damping_force_, damping_written_);
       for (int c = 0; c < 4; ++c) {
         const Vec3 on_a = r.centroid_weights_contactor[c] * f_n * r.normal;

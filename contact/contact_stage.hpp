@@ -28,6 +28,10 @@ struct ContactSettings {
   // Time (s) with which a stick spring's anchors follow the overlap centroid (scene key
   // contact.friction_anchor_lag; friction_kernels.hpp, docs/verification.md).
   double friction_anchor_lag = 0.05;
+  // Size the normal dashpot by the masses of the two pieces in contact (scene key
+  // contact.dashpot: bodies), or by the two tets' (tets: the previous formulation, for
+  // comparison); docs/verification.md, "Free rocking".
+  bool body_dashpot = true;
 };
 
 // Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with
@@ -233,6 +237,7 @@ class ContactStage {
   bool skip_enclosed_ = true;
   bool exact_narrowing_ = true;
   double friction_anchor_lag_ = 0.05;       // s
+  bool body_dashpot_ = true;                // ContactSettings::body_dashpot
   std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;

@@ -137,12 +137,13 @@ inline const std::array<Field<NodeArrays>, 8> node_fields = {{
 
 // Tets (besides gid, nodes, n_owned and the roles owned / active, which the distribution sets,
 // and `enclosed`, read once at start-up and carried by the contact stage's joint state).
-inline const std::array<Field<TetArrays>, 6> tet_fields = {{
+inline const std::array<Field<TetArrays>, 7> tet_fields = {{
     {"dm_inv", &TetArrays::dm_inv, 9, FieldUse::migrates},
     {"volume0", &TetArrays::volume0, 1, FieldUse::migrates},
     {"material", &TetArrays::material, 1, FieldUse::migrates},
     {"piece", &TetArrays::piece, 1, FieldUse::migrates},
     {"viscosity", &TetArrays::viscosity, 1, FieldUse::migrates},
+    {"dashpot_mass", &TetArrays::dashpot_mass, 1, FieldUse::migrates},
     {"contact_group", &TetArrays::contact_group, 1, FieldUse::migrates, 0.0, true,
      &TetArrays::piece},
 }};

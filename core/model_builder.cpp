@@ -307,6 +307,10 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     tets.contact_group[t] = scene.bodies[records[t].body].joints == JointPlacement::all
                                 ? next_group++
                                 : records[t].piece;
+  for (LocalIndex t = 0; t < n_tets; ++t)
+    tets.dashpot_mass[t] = tets.contact_group[t] == tets.piece[t]
+                               ? model.pieces[tets.piece[t]].mass
+                               : model.materials[tets.material[t]].density * tets.volume0[t];
 
   std::vector<std::vector<LocalIndex>> model_tet(meshes.size());
   for (std::size_t b = 0; b < meshes.size(); ++b) model_tet[b].resize(meshes[b].tets.size() / 4);

@@ -323,6 +323,7 @@ struct Scene {
   bool contact_skip_enclosed = true;    // contact.skip_enclosed (ContactSettings::skip_enclosed)
   bool contact_exact_narrowing = true;  // contact.narrowing (ContactSettings::exact_narrowing)
   double contact_friction_anchor_lag = 0.05;  // s, contact.friction_anchor_lag
+  bool contact_body_dashpot = true;           // contact.dashpot (ContactSettings::body_dashpot)
   ParallelSpec parallel;
   LimitsSpec limits;
 

@@ -712,7 +712,10 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
 
   if (const YAML::Node contact = root["contact"]) {
     r.check_keys(contact, "contact",
-                 {"buffer", "skip_enclosed", "narrowing", "friction_anchor_lag"});
+                 {"buffer", "skip_enclosed", "narrowing", "friction_anchor_lag", "dashpot"});
+    if (contact["dashpot"])
+      scene.contact_body_dashpot =
+          r.choice(contact["dashpot"], "contact.dashpot", {"bodies", "tets"}) == "bodies";
     if (contact["friction_anchor_lag"])
       scene.contact_friction_anchor_lag =
           r.positive(contact["friction_anchor_lag"], "contact.friction_anchor_lag",
