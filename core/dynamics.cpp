@@ -170,10 +170,17 @@ void build_internal_force_split(const Model& model, InternalForceSplit& split) {
 }
 
 InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& split,
-                                             const std::function<void()>& complete_halo) {
+                                             const std::function<void()>& complete_halo,
+                                             const Vec3* gravity) {
   const TetArrays& tets = model.tets;
   NodeArrays& nodes = model.nodes;
-  std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
+  if (gravity) {
+    const double g[3] = {gravity->x(), gravity->y(), gravity->z()};
+    for (LocalIndex n = 0; n < nodes.size(); ++n)
+      for (int k = 0; k < 3; ++k) nodes.f[3 * n + k] = nodes.mass[n] * g[k];
+  } else {
+    std::fill(nodes.f.begin(), nodes.f.end(), 0.0);
+  }
   InternalForceSummary sum;
   double* f = nodes.f.data();
   double* corner = split.corner_force.data();

@@ -56,11 +56,11 @@ void Simulation::step() {
   if (migration_due(detect))            // 4b before a detection cycle: re-balance, migrate,
     redistribute(detect);               //    rebuild the halo
   apply_loads();                        // 0  gravity (tilt, ramp) and base velocities at t_n
-  add_internal_forces(r);               // 1  F = Ds·Dm⁻¹, stress, nodal forces in tet gid order
+  add_internal_forces(r);               // 1  m·g + F = Ds·Dm⁻¹, stress: tet gid order
   add_joint_forces(r);                  // 2  cohesive joints in joint gid order; 3 they break
   if (detect) detect_contacts();        // 4  NBS: the pairs within the buffer
   add_contact_forces(r);                // 5  potential tet–tet contact with Coulomb friction
-  add_external_forces(r);               // 6  gravity, dashpots, surface loads at t_n
+  add_external_forces(r);               // 6  absorbing dashpots, surface loads at t_n
   record_histories();                   // 6b histories.csv at t_n: reactions, positions x_n
   integrate(r);                         // 7  central difference with prescribed velocities
   start_halo_exchange();                // 8  ghost positions travel while step n+1 begins
@@ -144,7 +144,9 @@ void Simulation::add_internal_forces(StepRecord& r) {
   {
     Timed timed(clocks_[internal]);
     // Split phase: interior tets while the ghost positions of step 8 arrive (bit-identical sums).
-    r.forces = compute_internal_forces(model_, split_, [&] { finish_halo_exchange(); });
+    r.forces = compute_internal_forces(
+        model_, split_, [&] { finish_halo_exchange(); },
+        plan_.gravity ? &model_.gravity : nullptr);  // + m·g (6)
   }
   clocks_[internal].seconds -= clocks_[halo].seconds - halo_before;  // waiting is halo time
   if (plan_.initial_stress) {  // after every tet's own force: tets in gid order again
@@ -183,9 +185,9 @@ void Simulation::add_contact_forces(StepRecord& r) {
 }
 
 void Simulation::add_external_forces(StepRecord& r) {
-  if (!plan_.gravity && !absorbing_ && !plan_.surface_loads) return;
+  if (!absorbing_ && !plan_.surface_loads) return;
   Timed timed(clocks_[external]);
-  if (plan_.gravity) add_gravity(model_.gravity, model_.nodes);
+  // Gravity's m·g is already in: the internal forces start from it (1).
   if (absorbing_) r.boundary_before = absorbing_->add_forces(dt_, model_);
   if (plan_.surface_loads) {  // pressure and traction on boundary faces, at t_n
     loads_->add_surface_forces(time_, model_);
