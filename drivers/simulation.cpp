@@ -67,7 +67,8 @@ std::vector<std::string> StagePlan::describe() const {
   s.push_back(joints ? "joint forces + fracture" : "joint forces: skipped (no joints)");
   s.push_back(contact ? "contact detection + contact forces"
                       : "contact: skipped (no contact partners)");
-  s.push_back(std::string("external forces: ") + (gravity ? "gravity" : "none") +
+  s.push_back(std::string("external forces: ") +
+              (gravity ? "gravity (its weights start the internal forces' sums)" : "none") +
               (kinematic_loads ? " + prescribed velocities" : "") +
               (surface_loads ? " + surface loads" : "") +
               (absorbing ? " + absorbing boundaries (dashpots)" : ""));

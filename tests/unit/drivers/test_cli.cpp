@@ -233,7 +233,8 @@ TEST_CASE("fdem check prints the scene contents and stages without stepping", "[
   CHECK_THAT(o.out, Contains("mesh: 27 nodes, 48 tetrahedra, 1 discrete elements"));
   CHECK_THAT(o.out, Contains("stages:\n    internal forces (tetrahedra)\n"));
   CHECK_THAT(o.out, Contains("joint forces: skipped (no joints)"));
-  CHECK_THAT(o.out, Contains("external forces: gravity\n"));
+  CHECK_THAT(o.out, Contains("external forces: gravity (its weights start the internal forces' "
+                             "sums)\n"));
   CHECK_THAT(o.out, Contains("integrate (central difference)"));
   // Automatic step = default safety 0.7 × the critical step.
   const double critical = critical_step_from_check(o.out);
