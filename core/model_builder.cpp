@@ -131,6 +131,14 @@ void finish_piece(PieceInfo& piece) {
   if (piece.mass > 0.0) piece.centroid0 /= piece.mass;
 }
 
+void set_dashpot_masses(Model& model) {
+  TetArrays& tets = model.tets;
+  for (LocalIndex t = 0; t < tets.size(); ++t)
+    tets.dashpot_mass[t] = tets.group_of(t) == tets.piece[t]
+                               ? model.pieces[tets.piece[t]].mass
+                               : model.materials[tets.material[t]].density * tets.volume0[t];
+}
+
 void set_initial_velocities(const Scene& scene, Model& model) {
   NodeArrays& nodes = model.nodes;
   for (LocalIndex n = 0; n < nodes.size(); ++n) {
@@ -307,10 +315,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
     tets.contact_group[t] = scene.bodies[records[t].body].joints == JointPlacement::all
                                 ? next_group++
                                 : records[t].piece;
-  for (LocalIndex t = 0; t < n_tets; ++t)
-    tets.dashpot_mass[t] = tets.contact_group[t] == tets.piece[t]
-                               ? model.pieces[tets.piece[t]].mass
-                               : model.materials[tets.material[t]].density * tets.volume0[t];
+  set_dashpot_masses(model);
 
   std::vector<std::vector<LocalIndex>> model_tet(meshes.size());
   for (std::size_t b = 0; b < meshes.size(); ++b) model_tet[b].resize(meshes[b].tets.size() / 4);

@@ -602,10 +602,7 @@ DistributedModel build_distributed_model(const Scene& scene, const std::vector<B
 
   // Pieces (kept at their directory ranks), velocities, constraints, force order.
   sum_pieces_by_directory(model, comm);
-  for (LocalIndex t = 0; t < n_tets; ++t)  // as the serial builder: a split tet is its own
-    tets.dashpot_mass[t] = tets.contact_group[t] == tets.piece[t]
-                               ? model.pieces[tets.piece[t]].mass
-                               : model.materials[tets.material[t]].density * tets.volume0[t];
+  set_dashpot_masses(model);
   set_initial_velocities(scene, model);
   keep_directory_block(model.pieces, comm);
   build_tet_force_order(tets, model.tet_force_order);
