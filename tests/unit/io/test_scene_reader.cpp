@@ -204,6 +204,7 @@ TEST_CASE("omitted optional keys take the documented defaults", "[io]") {
   CHECK(s.contact_buffer < 0.0);  // automatic
   CHECK(s.contact_exact_narrowing);
   CHECK(s.contact_friction_anchor_lag == 0.05);
+  CHECK(s.contact_body_dashpot);  // contact.dashpot: bodies
   CHECK(s.parallel.rebalance_threshold == 1.10);
   CHECK(s.parallel.redistribute_every == 0);
 
@@ -221,6 +222,18 @@ TEST_CASE("omitted optional keys take the documented defaults", "[io]") {
     CHECK(b.materials[0].contact.auto_penalty);
     CHECK(b.materials[0].contact.friction == 0.3);
   }
+}
+
+TEST_CASE("contact.dashpot: bodies or tets and nothing else", "[io]") {
+  CHECK(fdem::parse_scene(minimal_plus("contact: {dashpot: bodies}\n"), "scene.yaml")
+            .contact_body_dashpot);
+  CHECK_FALSE(fdem::parse_scene(minimal_plus("contact: {dashpot: tets}\n"), "scene.yaml")
+                  .contact_body_dashpot);
+  const std::string msg = input_error(minimal_plus("contact: {dashpot: pieces}\n"));
+  CHECK_THAT(msg, StartsWith("scene.yaml:10:"));
+  CHECK_THAT(msg, Contains("contact.dashpot"));
+  CHECK_THAT(msg, Contains("bodies"));
+  CHECK_THAT(msg, Contains("tets"));
 }
 
 TEST_CASE("unknown keys are reported with file, line, path and the nearest valid key", "[io]") {
