@@ -37,8 +37,8 @@ struct InternalForceSplit {
 };
 // Call after every change of the local model (distribution).
 void build_internal_force_split(const Model& model, InternalForceSplit& split);
-// `gravity` (m/s², optional): the forces start from each node's weight m·g instead of 0, the
-// same sums as add_gravity after, in one pass over the forces instead of two.
+// `gravity` (m/s², optional): the forces start from each node's weight m·g instead of 0 — the
+// terms of add_gravity, added first instead of last, in one pass over the forces instead of two.
 InternalForceSummary compute_internal_forces(Model& model, InternalForceSplit& split,
                                              const std::function<void()>& complete_halo,
                                              const Vec3* gravity = nullptr);

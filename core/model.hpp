@@ -80,9 +80,9 @@ struct TetArrays {
   std::vector<std::int32_t> material;
   std::vector<std::int32_t> piece;
   std::vector<double> viscosity;  // Pa·s (0: undamped)
-  // Mass (kg) the contact dashpot sizes itself by: the tet's piece (a block moves as one), or
-  // the tet itself in a `joints: all` body (its fragments are not known before they break).  0:
-  // not set (models assembled by hand), the tet's own mass.
+  // Mass (kg) the contact dashpot sizes itself by: the tet's piece (a block moves as one).  0:
+  // the tet's own mass — a tet of a `joints: all` body (its fragments are not known before they
+  // break), or a model assembled by hand.
   std::vector<double> dashpot_mass;
   // Contact group: tets of one group never contact each other.  A body without joints is one
   // group per piece; in a body with `joints: all` every tet is its own group (its neighbours are

@@ -134,9 +134,8 @@ void finish_piece(PieceInfo& piece) {
 void set_dashpot_masses(Model& model) {
   TetArrays& tets = model.tets;
   for (LocalIndex t = 0; t < tets.size(); ++t)
-    tets.dashpot_mass[t] = tets.group_of(t) == tets.piece[t]
-                               ? model.pieces[tets.piece[t]].mass
-                               : model.materials[tets.material[t]].density * tets.volume0[t];
+    tets.dashpot_mass[t] =
+        tets.group_of(t) == tets.piece[t] ? model.pieces[tets.piece[t]].mass : 0.0;
 }
 
 void set_initial_velocities(const Scene& scene, Model& model) {

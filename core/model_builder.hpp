@@ -76,7 +76,7 @@ TetSetup setup_tet(const Vec3 (&X)[4], const MaterialProperties& material);
 void add_to_piece(PieceInfo& piece, double element_mass, const Vec3 (&X)[4]);
 void finish_piece(PieceInfo& piece);
 
-// Each tet's dashpot mass (TetArrays::dashpot_mass): its piece's mass, or its own in a
+// Each tet's dashpot mass (TetArrays::dashpot_mass): its piece's mass, or 0 (the tet's own) in a
 // `joints: all` body (its contact group is not its piece).  The pieces of the tets must be kept.
 void set_dashpot_masses(Model& model);
 
