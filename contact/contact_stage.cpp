@@ -39,6 +39,8 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   FDEM_VERIFY(settings.friction_anchor_lag > 0.0, "friction anchor lag > 0");
   friction_anchor_lag_ = settings.friction_anchor_lag;
   body_dashpot_ = settings.body_dashpot;
+  FDEM_VERIFY(settings.sliver_tolerance >= 0.0, "sliver tolerance >= 0");
+  sliver_tolerance_ = settings.sliver_tolerance;
   body_cracked_.assign(static_cast<std::size_t>(std::max(model.pieces.bodies(), 0)), 0);
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
@@ -301,7 +303,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     const int ma = tets.material[pair.a], mb = tets.material[pair.b];
     const double penalty = std::min(penalty_[ma], penalty_[mb]);
     const double mu = std::min(friction_coefficient_[ma], friction_coefficient_[mb]);
-    const ContactPairResult r = potential_contact(a, b, penalty);
+    const ContactPairResult r = potential_contact(a, b, penalty, sliver_tolerance_);
     const PairId key{tets.gid[pair.a], tets.gid[pair.b]};
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
@@ -342,8 +344,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       const double m_b = model.materials[mb].density * std::abs(tets.volume0[pair.b]);
       const bool a_fixed = piece_fixed(model, tets.piece[pair.a]),
                  b_fixed = piece_fixed(model, tets.piece[pair.b]);
-      double c = 0.0;
-      if (body_dashpot_) {  // dashpot_kernels.hpp: sized by the pieces, implicit on the pair
+      double coefficient = 0.0;  // N·s/m
+      if (body_dashpot_) {       // dashpot_kernels.hpp: sized by the pieces, implicit on the pair
         const auto piece_mass = [&](LocalIndex t, double tet_mass) {
           return tets.dashpot_mass[t] > 0.0 ? tets.dashpot_mass[t] : tet_mass;
         };
@@ -352,14 +354,15 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
           inverse_a[q] = a_fixed ? 0.0 : 1.0 / nodes.mass[tets.nodes[4 * pair.a + q]];
           inverse_b[q] = b_fixed ? 0.0 : 1.0 / nodes.mass[tets.nodes[4 * pair.b + q]];
         }
-        c = dashpot_coefficient(
+        coefficient = dashpot_coefficient(
             xi, k, reduced_mass(piece_mass(pair.a, m_a), a_fixed, piece_mass(pair.b, m_b), b_fixed),
             centroid_point_mass(r, inverse_a, inverse_b), dt);
       } else {
-        c = dashpot_coefficient(xi, k, reduced_mass(m_a, a_fixed, m_b, b_fixed), 0.0, dt);
+        coefficient = dashpot_coefficient(xi, k, reduced_mass(m_a, a_fixed, m_b, b_fixed), 0.0, dt);
       }
       const double v_n = relative_velocity_at_centroid(r, va, vb).dot(r.normal);
-      const double f_n = std::max(-c * v_n, -r.normal_force);  // on the contactor, along n
+      const double f_n =
+          std::max(-coefficient * v_n, -r.normal_force);  // on the contactor, along n
       double* damping_force = writable(damping_force_, damping_written_);
       for (int c = 0; c < 4; ++c) {
         const Vec3 on_a = r.centroid_weights_contactor[c] * f_n * r.normal;

@@ -1,6 +1,7 @@
 // Exact potential contact between two tets; see potential_contact_kernels.hpp for the formulas.
 #include <cmath>
 
+#include "contact/pair_force_bound.hpp"
 #include "contact/piece_clipper.hpp"
 #include "contact/potential_contact_kernels.hpp"
 
@@ -220,9 +221,10 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
 }  // namespace
 
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,
-                                    double penalty) {
+                                    double penalty, double sliver_tolerance) {
   TetPairFrame frame;
   if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
+  if (sliver_tolerance > 0.0 && contact_negligible(frame, sliver_tolerance)) return zero_result();
   return assemble(frame, penalty);
 }
 

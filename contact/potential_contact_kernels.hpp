@@ -43,9 +43,12 @@ struct ContactPairResult {
   double centroid_weights_target[4] = {0, 0, 0, 0};     // barycentric coords of centroid in t
 };
 
-// Cheap rejection (boxes, face planes), then the exact integration.  penalty in Pa.
+// Cheap rejection (boxes, face planes), then the exact integration.  penalty in Pa.  With
+// sliver_tolerance > 0, a pair whose nodal forces are proven below sliver_tolerance · p · ℓ²
+// (pair_force_bound.hpp; ℓ the shorter tet's longest edge) is returned as not overlapping: the
+// slivers next to a pressed pair across an interface, which carry O(depth/size) of its force.
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,
-                                    double penalty);
+                                    double penalty, double sliver_tolerance = 0.0);
 
 // The exact integration alone, with only the degenerate-tet check (no box or face-plane
 // rejection).  Same results as potential_contact for every pair that passes the rejection;

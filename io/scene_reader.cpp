@@ -712,7 +712,16 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
 
   if (const YAML::Node contact = root["contact"]) {
     r.check_keys(contact, "contact",
-                 {"buffer", "skip_enclosed", "narrowing", "friction_anchor_lag", "dashpot"});
+                 {"buffer", "skip_enclosed", "narrowing", "friction_anchor_lag", "dashpot",
+                  "sliver_tolerance"});
+    if (contact["sliver_tolerance"]) {
+      const double tolerance = r.number(contact["sliver_tolerance"], "contact.sliver_tolerance");
+      if (!(tolerance >= 0.0 && tolerance <= 1e-6))
+        r.fail(contact["sliver_tolerance"], "contact.sliver_tolerance",
+               "must be between 0 (integrate every pair) and 1e-6: the largest nodal force a "
+               "skipped pair may carry, as a fraction of p·ℓ² (default 1e-9)");
+      scene.contact_sliver_tolerance = tolerance;
+    }
     if (contact["dashpot"])
       scene.contact_body_dashpot =
           r.choice(contact["dashpot"], "contact.dashpot", {"bodies", "tets"}) == "bodies";

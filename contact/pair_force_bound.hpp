@@ -1,0 +1,127 @@
+// A cheap, rigorous upper bound of what one potential-contact pair can contribute, from the
+// quantities the face-plane rejection already computed.  Used to skip pairs whose overlap is a
+// sliver thin in two directions (the tets next to a pressed pair across an interface, sharing
+// only an edge or a corner of its footprint): their forces are O(depth/size) of the pressed
+// pair's and they cost a full clip each.
+//
+// The overlap Omega = c ∩ t lies in a slab per face a of either tet T:
+//     0 <= lambda_a^T <= mu_a^T,   mu_a^T = max over the other tet's corners of lambda_a^T,
+// because Omega ⊂ T and Omega ⊂ the other tet (a convex hull, on which a linear function peaks at
+// a corner).  Two slabs A, B with non-parallel gradients g_A, g_B meet in a prism along
+// g_A × g_B whose cross-section is a parallelogram of area mu_A mu_B / |g_A × g_B| and perimeter
+// 2 (mu_A |g_B| + mu_B |g_A|) / |g_A × g_B|; along the prism Omega is no longer than the shorter
+// tet's longest edge W.  That bounds Omega's volume V and (a convex set inside a convex set has
+// the smaller surface) the area S of its boundary.  On Omega the potentials are bounded too:
+// phi_T = 4 min_a lambda_a^T <= 4 min_a mu_a^T =: Phi_T.
+//
+// With the force formulas of potential_contact_kernels.hpp, every nodal force of tet T obeys
+//     |f_T,b| <= p (4 G_T V + Phi_other S),   G_T = max_a |grad lambda_a^T|,
+// and the energy U = p ∫ (phi_c + phi_t) dV <= p V (Phi_c + Phi_t).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "contact/tet_overlap.hpp"
+
+namespace fdem {
+
+struct PairForceBound {
+  double nodal_force = 0.0;  // N: no nodal force of either tet exceeds it
+  double energy = 0.0;       // J
+  double volume = 0.0;       // m^3: the overlap's volume is below it
+  double length = 0.0;       // m: the shorter of the two tets' longest edges
+  double thinnest = 1.0;     // the thinnest slab mu (barycentric): ~ depth / size when pressed
+};
+
+inline double longest_edge_squared(const Vec3 (&x)[4]) {
+  double longest = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (x[a] - x[b]).squaredNorm());
+  return longest;
+}
+
+// Prisms are formed from slabs thinner than this (barycentric units) only: a thicker slab's prism
+// is rarely the smallest, and each costs a cross product and a square root.
+constexpr double kPrismSlab = 1e-2;
+
+// `frame` as filled by prepare_tet_pair (the pair passed the face-plane test); penalty in Pa.
+inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty) {
+  // Slabs: index 4T + a for face a of tet T (0 contactor, 1 target).
+  double mu[8];
+  const Vec3* gradient[8];
+  double potential_bound[2], gradient_max[2], volume[2], thinnest = 1.0;
+  int thin[8], thin_count = 0;  // slabs thin enough for their prisms to matter
+  for (int T = 0; T < 2; ++T) {
+    const double(&at_other_corners)[4][4] = frame.lambda_other[1 - T];
+    double smallest_mu = 1.0, largest_gradient_squared = 0.0;
+    for (int a = 0; a < 4; ++a) {
+      const int k = 4 * T + a;
+      const double peak = std::max(std::max(at_other_corners[0][a], at_other_corners[1][a]),
+                                   std::max(at_other_corners[2][a], at_other_corners[3][a]));
+      mu[k] = std::clamp(peak, 0.0, 1.0);
+      smallest_mu = std::min(smallest_mu, mu[k]);
+      gradient[k] = &frame.map[T].gradient[a];
+      largest_gradient_squared = std::max(largest_gradient_squared, gradient[k]->squaredNorm());
+      if (mu[k] < kPrismSlab) thin[thin_count++] = k;
+    }
+    potential_bound[T] = 4.0 * smallest_mu;
+    thinnest = std::min(thinnest, smallest_mu);
+    gradient_max[T] = std::sqrt(largest_gradient_squared);
+    volume[T] = std::abs(frame.map[T].edge_det) / 6.0;
+  }
+  const double length = std::sqrt(
+      std::min(longest_edge_squared(frame.local[0]), longest_edge_squared(frame.local[1])));
+
+  // Whole tets: face a's area is 3V |grad lambda_a| <= 3V G_T.
+  double volume_bound = std::min(volume[0], volume[1]);
+  double surface_bound = 12.0 * std::min(volume[0] * gradient_max[0], volume[1] * gradient_max[1]);
+  // One slab alone: the part of T within lambda_a <= mu is at most 3 mu of T's volume.
+  for (int k = 0; k < 8; ++k) volume_bound = std::min(volume_bound, 3.0 * mu[k] * volume[k / 4]);
+  for (int i = 0; i < thin_count; ++i)
+    for (int j = i + 1; j < thin_count; ++j) {
+      const int k = thin[i], l = thin[j];
+      const double cross = gradient[k]->cross(*gradient[l]).norm();
+      if (!(cross > 0.0)) continue;
+      const double section = mu[k] * mu[l] / cross;
+      const double perimeter =
+          2.0 * (mu[k] * gradient[l]->norm() + mu[l] * gradient[k]->norm()) / cross;
+      volume_bound = std::min(volume_bound, section * length);
+      surface_bound = std::min(surface_bound, 2.0 * section + perimeter * length);
+    }
+  PairForceBound bound;
+  bound.volume = volume_bound;
+  bound.length = length;
+  bound.thinnest = thinnest;
+  bound.nodal_force =
+      penalty * std::max(4.0 * gradient_max[0] * volume_bound + potential_bound[1] * surface_bound,
+                         4.0 * gradient_max[1] * volume_bound + potential_bound[0] * surface_bound);
+  bound.energy = penalty * volume_bound *
+                 (std::min(1.0, potential_bound[0]) + std::min(1.0, potential_bound[1]));
+  return bound;
+}
+
+// True when the pair is proven to exert no nodal force above tolerance · p · ℓ² (ℓ the shorter
+// tet's longest edge; p ℓ² is about the force of a full overlap), nor above kPressedFaceShare of
+// mu · p · ℓ², about what a face pressed as deep (mu the thinnest slab) carries.  The second
+// condition keeps every pressed face in contact from its first touch, so no face contact starts
+// with a jump of its energy: only the pairs whose forces grow faster than their depth (slivers
+// beside a pressed face, edges and corners) wait until they matter.  Only a pair with a slab
+// thinner than kThinSlab can pass, so the bound is computed only there: a deep overlap pays one
+// scan of its 32 corner coordinates.
+constexpr double kPressedFaceShare = 1e-3;
+
+inline bool contact_negligible(const TetPairFrame& frame, double tolerance) {
+  constexpr double kThinSlab = 1e-3;
+  bool thin = false;
+  for (int s = 0; s < 2 && !thin; ++s)
+    for (int a = 0; a < 4 && !thin; ++a)
+      thin = frame.lambda_other[s][0][a] < kThinSlab && frame.lambda_other[s][1][a] < kThinSlab &&
+             frame.lambda_other[s][2][a] < kThinSlab && frame.lambda_other[s][3][a] < kThinSlab;
+  if (!thin) return false;
+  const PairForceBound bound = pair_force_bound(frame, 1.0);
+  const double full = bound.length * bound.length;  // p ℓ² / p
+  return bound.nodal_force <= std::min(tolerance, kPressedFaceShare * bound.thinnest) * full;
+}
+
+}  // namespace fdem
