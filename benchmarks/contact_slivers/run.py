@@ -11,7 +11,7 @@ algorithm), alternating in one invocation, one core each.
 Cases (each `fdem run` to a fixed time; the pieces' centroids at the end are compared between
 tolerances):
   wall_tilt  the tilting-table wall of docs/verification.md at 0.9 of its collapse tilt, 0.05 s
-             (5 courses of 4 touching units, 160 tets, quasi-static mode)
+             (5 courses of 4 touching units, 240 tets, quasi-static mode)
   arch       the 20-voussoir arch (t/R 0.15) under 0.13 g horizontal, 0.02 s (516 tets)
   tower      the default example (tower and projectile), first 0.1 s: the projectile hits at 14 ms
   dry_wall   examples/dry-stone-wall-seismic.yaml, first 0.2 s (2 mm mortar gaps: the stones land)
