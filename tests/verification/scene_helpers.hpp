@@ -11,6 +11,21 @@
 namespace fdem::testing {
 using namespace fdem::builders;
 
+// A running-bond wall of `courses` courses of `units` units (running bond: n − 1 full and two
+// half units in every other course), exactly touching (no mortar gap), 2 × 1 × 1 cells per unit.
+inline BodySpec running_bond_wall(const Vec3& unit, int courses, int units, int material = 0) {
+  BodySpec wall;
+  wall.name = "wall";
+  wall.material = material;
+  wall.mesh.kind = MeshSpec::Kind::wall;
+  WallMeshSpec& w = wall.mesh.wall;
+  w.bond = WallMeshSpec::Bond::running;
+  w.unit = unit;
+  w.courses = courses;
+  w.units_per_course = units;
+  return wall;
+}
+
 // A block b (x) × 0.2 (y) × h (z) generated as a one-block tower on a fixed base.
 // Contact penalty p = 4E.  A penalty contact is a compliant foundation: near the tipping point
 // the contact zone shrinks towards the edge and the pivot sits inside it, so the block tips early

@@ -315,19 +315,7 @@ TEST_CASE("dry running-bond wall with exactly touching units (mortar gap 0) stan
   scene.gravity = Vec3(0, 0, -9.81);
   scene.bodies.push_back(box_body("table", Vec3(-0.2, -0.2, -0.1), Vec3(1.4, 0.35, 0), 8, 2, 1));
   scene.bodies[0].fixed = true;
-  BodySpec wall;
-  wall.name = "wall";
-  wall.material = 0;
-  wall.mesh.kind = MeshSpec::Kind::wall;
-  wall.mesh.wall.unit = Vec3(0.3, 0.15, 0.1);
-  wall.mesh.wall.courses = 6;
-  wall.mesh.wall.units_per_course = 4;
-  wall.mesh.wall.bond = WallMeshSpec::Bond::running;
-  wall.mesh.wall.mortar_gap = 0.0;
-  wall.mesh.wall.cells[0] = 2;
-  wall.mesh.wall.cells[1] = 1;
-  wall.mesh.wall.cells[2] = 1;
-  scene.bodies.push_back(wall);
+  scene.bodies.push_back(running_bond_wall(Vec3(0.3, 0.15, 0.1), 6, 4));
   auto sim = quiet_simulation(scene);
   const Model& model = sim->model();
   REQUIRE(model.pieces.size() == 28);  // the table, 3 courses of 4 stones, 3 of 3 + 2 halves

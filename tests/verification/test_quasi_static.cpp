@@ -65,16 +65,7 @@ Scene tilted_wall(double angle, double end, int courses, int units, double young
   scene.materials.push_back(elastic_material(2000, young, 0.2));
   scene.materials[0].contact.friction = mu;
   scene.gravity = g * Vec3(-std::sin(angle), 0, -std::cos(angle));
-  BodySpec wall;
-  wall.name = "wall";
-  wall.material = 0;
-  wall.mesh.kind = MeshSpec::Kind::wall;
-  WallMeshSpec& w = wall.mesh.wall;
-  w.bond = WallMeshSpec::Bond::running;
-  w.unit = Vec3(0.2, 0.1, 0.1);
-  w.courses = courses;
-  w.units_per_course = units;
-  scene.bodies.push_back(wall);
+  scene.bodies.push_back(running_bond_wall(Vec3(0.2, 0.1, 0.1), courses, units));
   scene.loads.push_back(
       load_on_region(Vec3(-1, -1, -0.001), Vec3(2, 1, 0.001), Vec3::Zero()));  // lowest course
   return scene;
