@@ -148,3 +148,30 @@ TEST_CASE("meshes shifted across a pressed interface have no slivers to skip", "
   CHECK(overlapping > 40);
   CHECK(skipped == 0);
 }
+
+TEST_CASE("a pressed face is never skipped, from round-off depth to deep, at the largest tolerance",
+          "[contact]") {
+  // The second condition of contact_negligible (below 1/1000 of what a face pressed as deep
+  // carries): without it a face contact starting from touching would be skipped until its force
+  // reached the tolerance, then enter with its energy at once.
+  const double h = 1.0, penalty = 1.0;
+  const auto lower = cube_layer(2, h, Vec3(0, 0, -h));
+  for (const double depth : {1e-14, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2}) {
+    const auto upper = cube_layer(2, h, Vec3(0, 0, -depth * h));
+    double largest = 0.0;
+    for (const TetCorners& c : upper)
+      for (const TetCorners& t : lower)
+        largest = std::max(largest, largest_nodal_force(potential_contact(c, t, penalty)));
+    int pressed = 0, kept = 0;
+    for (const TetCorners& c : upper)
+      for (const TetCorners& t : lower) {
+        const ContactPairResult exact = potential_contact(c, t, penalty);
+        if (largest_nodal_force(exact) <= 1e-3 * largest) continue;
+        ++pressed;
+        kept += potential_contact(c, t, penalty, 1e-6).overlapping;
+      }
+    INFO("depth " << depth);
+    CHECK(pressed >= 8);  // the 8 pressed faces (1e-2 deep, the slivers carry more than 1e-3)
+    CHECK(kept == pressed);
+  }
+}
