@@ -45,28 +45,39 @@ inline double longest_edge_squared(const Vec3 (&x)[4]) {
 // is rarely the smallest, and each costs a cross product and a square root.
 constexpr double kPrismSlab = 1e-2;
 
-// `frame` as filled by prepare_tet_pair (the pair passed the face-plane test); penalty in Pa.
-inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty) {
-  // Slabs: index 4T + a for face a of tet T (0 contactor, 1 target).
-  double mu[8];
-  const Vec3* gradient[8];
-  double potential_bound[2], gradient_max[2], volume[2], thinnest = 1.0;
-  int thin[8], thin_count = 0;  // slabs thin enough for their prisms to matter
+// The slab depths mu[4T + a] (face a of tet T: 0 contactor, 1 target), clamped to [0, 1], of a
+// pair that passed the face-plane test (`frame` as filled by prepare_tet_pair); returns the
+// smallest.
+inline double slab_depths(const TetPairFrame& frame, double (&mu)[8]) {
+  double thinnest = 1.0;
   for (int T = 0; T < 2; ++T) {
     const double(&at_other_corners)[4][4] = frame.lambda_other[1 - T];
+    for (int a = 0; a < 4; ++a) {
+      const double peak = std::max(std::max(at_other_corners[0][a], at_other_corners[1][a]),
+                                   std::max(at_other_corners[2][a], at_other_corners[3][a]));
+      mu[4 * T + a] = std::clamp(peak, 0.0, 1.0);
+      thinnest = std::min(thinnest, mu[4 * T + a]);
+    }
+  }
+  return thinnest;
+}
+
+// The bound from the slab depths of slab_depths; penalty in Pa.
+inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (&mu)[8],
+                                       double penalty) {
+  const Vec3* gradient[8];
+  double potential_bound[2], gradient_max[2], volume[2];
+  int thin[8], thin_count = 0;  // slabs thin enough for their prisms to matter
+  for (int T = 0; T < 2; ++T) {
     double smallest_mu = 1.0, largest_gradient_squared = 0.0;
     for (int a = 0; a < 4; ++a) {
       const int k = 4 * T + a;
-      const double peak = std::max(std::max(at_other_corners[0][a], at_other_corners[1][a]),
-                                   std::max(at_other_corners[2][a], at_other_corners[3][a]));
-      mu[k] = std::clamp(peak, 0.0, 1.0);
       smallest_mu = std::min(smallest_mu, mu[k]);
       gradient[k] = &frame.map[T].gradient[a];
       largest_gradient_squared = std::max(largest_gradient_squared, gradient[k]->squaredNorm());
       if (mu[k] < kPrismSlab) thin[thin_count++] = k;
     }
     potential_bound[T] = 4.0 * smallest_mu;
-    thinnest = std::min(thinnest, smallest_mu);
     gradient_max[T] = std::sqrt(largest_gradient_squared);
     volume[T] = std::abs(frame.map[T].edge_det) / 6.0;
   }
@@ -92,13 +103,20 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty
   PairForceBound bound;
   bound.volume = volume_bound;
   bound.length = length;
-  bound.thinnest = thinnest;
+  bound.thinnest = *std::min_element(mu, mu + 8);
   bound.nodal_force =
       penalty * std::max(4.0 * gradient_max[0] * volume_bound + potential_bound[1] * surface_bound,
                          4.0 * gradient_max[1] * volume_bound + potential_bound[0] * surface_bound);
   bound.energy = penalty * volume_bound *
                  (std::min(1.0, potential_bound[0]) + std::min(1.0, potential_bound[1]));
   return bound;
+}
+
+// `frame` as filled by prepare_tet_pair (the pair passed the face-plane test); penalty in Pa.
+inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty) {
+  double mu[8];
+  slab_depths(frame, mu);
+  return pair_force_bound(frame, mu, penalty);
 }
 
 // True when the pair is proven to exert no nodal force above tolerance · p · ℓ² (ℓ the shorter
@@ -108,18 +126,14 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty
 // with a jump of its energy: only the pairs whose forces grow faster than their depth (slivers
 // beside a pressed face, edges and corners) wait until they matter.  Only a pair with a slab
 // thinner than kThinSlab can pass, so the bound is computed only there: a deep overlap pays one
-// scan of its 32 corner coordinates.
+// scan of its 32 corner coordinates (slab_depths).
 constexpr double kPressedFaceShare = 1e-3;
 
 inline bool contact_negligible(const TetPairFrame& frame, double tolerance) {
   constexpr double kThinSlab = 1e-3;
-  bool thin = false;
-  for (int s = 0; s < 2 && !thin; ++s)
-    for (int a = 0; a < 4 && !thin; ++a)
-      thin = frame.lambda_other[s][0][a] < kThinSlab && frame.lambda_other[s][1][a] < kThinSlab &&
-             frame.lambda_other[s][2][a] < kThinSlab && frame.lambda_other[s][3][a] < kThinSlab;
-  if (!thin) return false;
-  const PairForceBound bound = pair_force_bound(frame, 1.0);
+  double mu[8];
+  if (!(slab_depths(frame, mu) < kThinSlab)) return false;
+  const PairForceBound bound = pair_force_bound(frame, mu, 1.0);
   const double full = bound.length * bound.length;  // p ℓ² / p
   return bound.nodal_force <= std::min(tolerance, kPressedFaceShare * bound.thinnest) * full;
 }

@@ -718,8 +718,10 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
       const double tolerance = r.number(contact["sliver_tolerance"], "contact.sliver_tolerance");
       if (!(tolerance >= 0.0 && tolerance <= 1e-6))
         r.fail(contact["sliver_tolerance"], "contact.sliver_tolerance",
-               "must be between 0 (integrate every pair) and 1e-6: the largest nodal force a "
-               "skipped pair may carry, as a fraction of p·ℓ² (default 1e-9)");
+               Reader::format(tolerance) +
+                   " is impossible: the largest nodal force a skipped pair may carry, as a "
+                   "fraction of p·ℓ², must be between 0 (integrate every pair) and 1e-6 "
+                   "(default 1e-9)");
       scene.contact_sliver_tolerance = tolerance;
     }
     if (contact["dashpot"])

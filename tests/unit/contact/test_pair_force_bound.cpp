@@ -35,10 +35,6 @@ std::vector<TetCorners> cube_layer(int n, double h, const Vec3& origin) {
   return tets;
 }
 
-double largest_nodal_force(const ContactPairResult& r) {
-  return max_force(r);
-}
-
 struct PairCheck {
   int pairs = 0, violations = 0;
 };
@@ -52,10 +48,9 @@ void check_bound(const TetCorners& c, const TetCorners& t, double penalty, PairC
   const ContactPairResult exact = potential_contact(c, t, penalty);
   const double l = bound.length;
   ++check.pairs;
-  const bool holds =
-      largest_nodal_force(exact) <= bound.nodal_force * (1 + 1e-9) + 1e-14 * penalty * l * l &&
-      exact.energy <= bound.energy * (1 + 1e-9) + 1e-14 * penalty * l * l * l &&
-      exact.overlap_volume <= bound.volume * (1 + 1e-9) + 1e-14 * l * l * l;
+  const bool holds = max_force(exact) <= bound.nodal_force * (1 + 1e-9) + 1e-14 * penalty * l * l &&
+                     exact.energy <= bound.energy * (1 + 1e-9) + 1e-14 * penalty * l * l * l &&
+                     exact.overlap_volume <= bound.volume * (1 + 1e-9) + 1e-14 * l * l * l;
   if (!holds) ++check.violations;
 }
 
@@ -101,14 +96,14 @@ TEST_CASE("matched interface pressed 1e-6 deep: the slivers are skipped and no p
   double largest = 0.0;
   for (const TetCorners& c : upper)
     for (const TetCorners& t : lower)
-      largest = std::max(largest, largest_nodal_force(potential_contact(c, t, penalty)));
+      largest = std::max(largest, max_force(potential_contact(c, t, penalty)));
   int pressed = 0, slivers = 0, slivers_skipped = 0, pressed_skipped = 0, differ = 0;
   double loosest = 0.0;  // bound / exact force over the slivers
   for (const TetCorners& c : upper)
     for (const TetCorners& t : lower) {
       const ContactPairResult exact = potential_contact(c, t, penalty);
       const ContactPairResult skipping = potential_contact(c, t, penalty, tolerance);
-      const double force = largest_nodal_force(exact);
+      const double force = max_force(exact);
       const bool skipped = exact.overlapping && !skipping.overlapping;
       if (!skipped)  // an evaluated pair is the exact kernel's, bit for bit
         for (int v = 0; v < 4; ++v)
@@ -161,12 +156,12 @@ TEST_CASE("a pressed face is never skipped, from round-off depth to deep, at the
     double largest = 0.0;
     for (const TetCorners& c : upper)
       for (const TetCorners& t : lower)
-        largest = std::max(largest, largest_nodal_force(potential_contact(c, t, penalty)));
+        largest = std::max(largest, max_force(potential_contact(c, t, penalty)));
     int pressed = 0, kept = 0;
     for (const TetCorners& c : upper)
       for (const TetCorners& t : lower) {
         const ContactPairResult exact = potential_contact(c, t, penalty);
-        if (largest_nodal_force(exact) <= 1e-3 * largest) continue;
+        if (max_force(exact) <= 1e-3 * largest) continue;
         ++pressed;
         kept += potential_contact(c, t, penalty, 1e-6).overlapping;
       }
