@@ -293,17 +293,25 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   };
   clear(friction_force_, friction_written_);
   clear(damping_force_, damping_written_);
+  // Pairs come in contactor order: each contactor is prepared once for all its pairs.
+  PreparedContactor contactor;
+  LocalIndex prepared = -1;
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
     const CandidatePair& pair = pairs_[index];
-    TetCorners a, b;
-    for (int c = 0; c < 4; ++c) {
-      a.x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * pair.a + c]);
-      b.x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * pair.b + c]);
+    if (pair.a != prepared) {
+      TetCorners corners;
+      for (int c = 0; c < 4; ++c)
+        corners.x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * pair.a + c]);
+      prepare_contactor(corners, contactor);
+      prepared = pair.a;
     }
+    const TetCorners& a = contactor.corners;
+    TetCorners b;
+    for (int c = 0; c < 4; ++c) b.x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * pair.b + c]);
     const int ma = tets.material[pair.a], mb = tets.material[pair.b];
     const double penalty = std::min(penalty_[ma], penalty_[mb]);
     const double mu = std::min(friction_coefficient_[ma], friction_coefficient_[mb]);
-    const ContactPairResult r = potential_contact(a, b, penalty, sliver_tolerance_);
+    const ContactPairResult r = potential_contact(contactor, b, penalty, sliver_tolerance_);
     const PairId key{tets.gid[pair.a], tets.gid[pair.b]};
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;

@@ -27,8 +27,9 @@ struct BarycentricMap {
   double value(int a, const Vec3& y) const { return gradient[a].dot(y) + offset[a]; }
 };
 
-// Builds the map; false for a degenerate (flat or non-finite) tet, which has no interior.
-inline bool make_barycentric_map(const TetCorners& tet, const Vec3& origin, BarycentricMap& map) {
+// The origin-free part of the map: gradients and edge determinant; false for a degenerate (flat
+// or non-finite) tet, which has no interior.
+inline bool barycentric_gradients(const TetCorners& tet, Vec3 (&gradient)[4], double& edge_det) {
   const Vec3 e1 = tet.x[1] - tet.x[0];
   const Vec3 e2 = tet.x[2] - tet.x[0];
   const Vec3 e3 = tet.x[3] - tet.x[0];
@@ -38,33 +39,57 @@ inline bool make_barycentric_map(const TetCorners& tet, const Vec3& origin, Bary
   const double det = e1.dot(c1);
   if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return false;
   const double inv = 1.0 / det;
-  map.gradient[1] = c1 * inv;
-  map.gradient[2] = c2 * inv;
-  map.gradient[3] = c3 * inv;
-  map.gradient[0] = -(map.gradient[1] + map.gradient[2] + map.gradient[3]);
-  const Vec3 y0 = tet.x[0] - origin;
+  gradient[1] = c1 * inv;
+  gradient[2] = c2 * inv;
+  gradient[3] = c3 * inv;
+  gradient[0] = -(gradient[1] + gradient[2] + gradient[3]);
+  edge_det = det;
+  return true;
+}
+
+// The offsets for the local origin `origin`, from corner 0 (`corner0`); false when not finite.
+inline bool barycentric_offsets(const Vec3& corner0, const Vec3& origin, BarycentricMap& map) {
+  const Vec3 y0 = corner0 - origin;
   map.offset[1] = -map.gradient[1].dot(y0);
   map.offset[2] = -map.gradient[2].dot(y0);
   map.offset[3] = -map.gradient[3].dot(y0);
   map.offset[0] = 1.0 - map.offset[1] - map.offset[2] - map.offset[3];
-  map.edge_det = det;
   return std::isfinite(map.offset[0]);
+}
+
+// Builds the map; false for a degenerate (flat or non-finite) tet, which has no interior.
+inline bool make_barycentric_map(const TetCorners& tet, const Vec3& origin, BarycentricMap& map) {
+  return barycentric_gradients(tet, map.gradient, map.edge_det) &&
+         barycentric_offsets(tet.x[0], origin, map);
 }
 
 inline Vec3 tet_centroid(const TetCorners& tet) {
   return 0.25 * (tet.x[0] + tet.x[1] + tet.x[2] + tet.x[3]);
 }
 
-// True when the axis-aligned bounding boxes intersect (touching counts as intersecting).
-inline bool tet_boxes_intersect(const TetCorners& a, const TetCorners& b) {
+// Axis-aligned box of a tet's corners (m).
+struct TetBox {
+  double lo[3], hi[3];
+};
+
+inline TetBox tet_box(const TetCorners& t) {
+  TetBox box;
   for (int k = 0; k < 3; ++k) {
-    const double amin = std::min(std::min(a.x[0][k], a.x[1][k]), std::min(a.x[2][k], a.x[3][k]));
-    const double amax = std::max(std::max(a.x[0][k], a.x[1][k]), std::max(a.x[2][k], a.x[3][k]));
-    const double bmin = std::min(std::min(b.x[0][k], b.x[1][k]), std::min(b.x[2][k], b.x[3][k]));
-    const double bmax = std::max(std::max(b.x[0][k], b.x[1][k]), std::max(b.x[2][k], b.x[3][k]));
-    if (amax < bmin || bmax < amin) return false;
+    box.lo[k] = std::min(std::min(t.x[0][k], t.x[1][k]), std::min(t.x[2][k], t.x[3][k]));
+    box.hi[k] = std::max(std::max(t.x[0][k], t.x[1][k]), std::max(t.x[2][k], t.x[3][k]));
   }
+  return box;
+}
+
+// True when the boxes intersect (touching counts as intersecting).
+inline bool boxes_intersect(const TetBox& a, const TetBox& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
   return true;
+}
+
+inline bool tet_boxes_intersect(const TetCorners& a, const TetCorners& b) {
+  return boxes_intersect(tet_box(a), tet_box(b));
 }
 
 // lambda[v][a]: barycentric coordinate a of `map`'s tet at corner v of `other` (local coords).
@@ -126,23 +151,52 @@ struct TetPairFrame {
   double lambda_other[2][4][4];  // [s][v][a]: lambda of tet 1-s, component a, at corner v of s
 };
 
+// A contactor's share of its pairs' frames, prepared once for all its pairs (the contact stage
+// visits the pairs in contactor order): its corners, box, centroid (the frames' origin) and
+// barycentric map about it.  A frame built with it is the one built from the corners, bit for bit.
+struct PreparedContactor {
+  TetCorners corners;
+  TetBox box;
+  Vec3 origin;    // the centroid (m)
+  Vec3 local[4];  // corners - origin (m)
+  BarycentricMap map{};
+  bool valid = false;  // false: degenerate, overlaps nothing
+};
+
+inline void prepare_contactor(const TetCorners& contactor, PreparedContactor& out) {
+  out.corners = contactor;
+  out.box = tet_box(contactor);
+  out.origin = tet_centroid(contactor);
+  for (int v = 0; v < 4; ++v) out.local[v] = contactor.x[v] - out.origin;
+  out.valid = make_barycentric_map(contactor, out.origin, out.map);
+}
+
 // Bounding boxes, then the 4+4 face planes.  False when the pair certainly does not overlap
 // (or a tet is degenerate); true means "may overlap" and fills `frame`.
-inline bool prepare_tet_pair(const TetCorners& contactor, const TetCorners& target,
+inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetCorners& target,
                              TetPairFrame& frame) {
-  if (!tet_boxes_intersect(contactor, target)) return false;
-  frame.origin = tet_centroid(contactor);
+  if (!boxes_intersect(contactor.box, tet_box(target))) return false;
+  if (!contactor.valid) return false;
+  frame.origin = contactor.origin;
   for (int v = 0; v < 4; ++v) {
-    frame.local[0][v] = contactor.x[v] - frame.origin;
+    frame.local[0][v] = contactor.local[v];
     frame.local[1][v] = target.x[v] - frame.origin;
   }
-  if (!make_barycentric_map(contactor, frame.origin, frame.map[0])) return false;
+  frame.map[0] = contactor.map;
   if (!make_barycentric_map(target, frame.origin, frame.map[1])) return false;
   barycentric_at_corners(frame.map[1], frame.local[0], frame.lambda_other[0]);
   if (separated_by_face_plane(frame.lambda_other[0])) return false;
   barycentric_at_corners(frame.map[0], frame.local[1], frame.lambda_other[1]);
   if (separated_by_face_plane(frame.lambda_other[1])) return false;
   return true;
+}
+
+inline bool prepare_tet_pair(const TetCorners& contactor, const TetCorners& target,
+                             TetPairFrame& frame) {
+  if (!tet_boxes_intersect(contactor, target)) return false;
+  PreparedContactor prepared;
+  prepare_contactor(contactor, prepared);
+  return prepare_tet_pair(prepared, target, frame);
 }
 
 // Cheap conservative rejection: false only when the tets certainly do not overlap (boxes
