@@ -6,7 +6,10 @@ algorithm), alternating in one invocation, one core each.
 
   benchmarks/contact_slivers/run.py [--fdem build/drivers/fdem] [--repeats 3]
       [--tolerances 0,1e-9] [--cases wall_tilt,arch,tower,dry_wall]
-      [--csv docs/data/bench_contact_slivers.csv]
+      [--baseline OLD_FDEM] [--csv docs/data/bench_contact_slivers.csv]
+
+With --baseline, a third variant runs that binary (an older build) at the last tolerance, in the
+same alternation: the ratio of the current code's skipping against the older one's.
 
 Cases (each `fdem run` to a fixed time; the pieces' centroids at the end are compared between
 tolerances):
@@ -74,30 +77,35 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--tolerances", default="0,1e-9")
     ap.add_argument("--cases", default="wall_tilt,arch,tower,dry_wall")
+    ap.add_argument("--baseline", help="an older fdem binary, run at the last tolerance")
     ap.add_argument("--csv", default=os.path.join(root, "docs", "data",
                                                   "bench_contact_slivers.csv"))
     a = ap.parse_args()
     tolerances = a.tolerances.split(",")
+    # (label, binary, tolerance); the first is the reference of the speed-ups
+    variants = [(f"tolerance {t}", a.fdem, t) for t in tolerances]
+    if a.baseline:
+        variants.append((f"baseline {tolerances[-1]}", a.baseline, tolerances[-1]))
     rows = []
     with tempfile.TemporaryDirectory() as workdir:
         for name in a.cases.split(","):
             scene, overrides = case_scene(name, workdir)
             best = {}
             for repeat in range(a.repeats):
-                for tol in tolerances:  # alternating, so drift of the machine hits both
-                    r = run_once(a.fdem, scene, overrides, tol,
-                                 os.path.join(workdir, f"{name}_{tol}"))
-                    if tol not in best or r["cpu"] < best[tol]["cpu"]:
-                        best[tol] = r
-            reference = best[tolerances[0]]
-            for tol in tolerances:
-                r = best[tol]
+                for label, fdem, tol in variants:  # alternating: drift hits every variant
+                    r = run_once(fdem, scene, overrides, tol,
+                                 os.path.join(workdir, f"{name}_{len(best)}"))
+                    if label not in best or r["cpu"] < best[label]["cpu"]:
+                        best[label] = r
+            reference = best[variants[0][0]]
+            for label, fdem, tol in variants:
+                r = best[label]
                 moved = max(
                     (sum((p - q) ** 2 for p, q in zip(r["centroids"][k],
                                                        reference["centroids"][k])) ** 0.5
                      for k in reference["centroids"]), default=0.0)
-                row = {"case": name, "sliver_tolerance": tol, "steps": r["steps"],
-                       "cpu_seconds": round(r["cpu"], 3),
+                row = {"case": name, "variant": label, "sliver_tolerance": tol,
+                       "steps": r["steps"], "cpu_seconds": round(r["cpu"], 3),
                        "contact_seconds": round(r["contact"], 3),
                        "speedup": round(reference["cpu"] / r["cpu"], 3),
                        "balance_error": f"{r['balance']:.3e}",
