@@ -384,11 +384,12 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     Vec3 tangential = Vec3::Zero();
     if (mu > 0.0) {
       // Stick spring k_t = p·s (N/m) with s the pair's size: as stiff as the normal contact.
-      const double size =
-          std::cbrt(std::abs(tets.volume0[pair.a]) + std::abs(tets.volume0[pair.b]));
-      const FrictionLaw law{mu, penalty * size};
+      // (set once per contact: the pair's reference volumes do not change)
       PairFriction& pair_friction = friction_[key];
-      pair_friction.stiffness = law.tangential_stiffness;
+      if (!(pair_friction.stiffness > 0.0))
+        pair_friction.stiffness =
+            penalty * std::cbrt(std::abs(tets.volume0[pair.a]) + std::abs(tets.volume0[pair.b]));
+      const FrictionLaw law{mu, pair_friction.stiffness};
       pair_friction.owned = share > 0.0;
       FrictionHistory& history = pair_friction.history;
       // The spring joins two material points, anchored at the first real overlap's centroid (a
@@ -401,10 +402,16 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
           history.follow(r, -std::expm1(-dt / friction_anchor_lag_));
       }
       FrictionPoint point = centroid_point(r);
-      if (history.attached()) spring_point(history, a, b, point);
+      // The kernel found both tets sound; the contactor's gradients are those it used.
+      PairGradients gradients;
+      std::copy_n(contactor.map.gradient, 4, gradients.contactor);
+      for (Vec3& g : gradients.target) g.setZero();  // (written below unless degenerate)
+      double det = 0.0;
+      const bool sound = barycentric_gradients(b, gradients.target, det);
+      if (history.attached() && sound) spring_point(history, a, b, gradients, point);
       const FrictionResult f =
           coulomb_friction(law, r, point, relative_velocity_at(point, va, vb), dt, history);
-      if (f.slipping && history.attached()) slide_anchors(history, a, b, f.slip);
+      if (f.slipping && history.attached() && sound) slide_anchors(history, gradients, f.slip);
       double* friction_force = writable(friction_force_, friction_written_);
       for (int c = 0; c < 4; ++c) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];

@@ -101,10 +101,24 @@ inline FrictionPoint centroid_point(const ContactPairResult& pair) {
   return p;
 }
 
+// Barycentric gradients of a pair's two tets (1/m).  They do not depend on the origin of the
+// map, so one computation serves every point a step looks at; false for a degenerate tet.
+struct PairGradients {
+  Vec3 contactor[4], target[4];
+};
+
+inline bool pair_gradients(const TetCorners& contactor, const TetCorners& target,
+                           PairGradients& out) {
+  double det = 0.0;
+  return barycentric_gradients(contactor, out.contactor, det) &&
+         barycentric_gradients(target, out.target, det);
+}
+
 // The point of an attached spring: midway between its anchors at the tets' current positions.
 // False (and `point` untouched) for a degenerate tet, which has no barycentric coordinates.
 inline bool spring_point(const FrictionHistory& history, const TetCorners& contactor,
-                         const TetCorners& target, FrictionPoint& point) {
+                         const TetCorners& target, const PairGradients& gradients,
+                         FrictionPoint& point) {
   Vec3 anchor_c = Vec3::Zero(), anchor_t = Vec3::Zero();
   for (int a = 0; a < 4; ++a) {
     anchor_c += history.anchor_contactor[a] * contactor.x[a];
@@ -112,8 +126,12 @@ inline bool spring_point(const FrictionHistory& history, const TetCorners& conta
   }
   const Vec3 middle = 0.5 * (anchor_c + anchor_t);
   BarycentricMap map_c, map_t;
-  if (!make_barycentric_map(contactor, middle, map_c) ||
-      !make_barycentric_map(target, middle, map_t))
+  for (int a = 0; a < 4; ++a) {
+    map_c.gradient[a] = gradients.contactor[a];
+    map_t.gradient[a] = gradients.target[a];
+  }
+  if (!barycentric_offsets(contactor.x[0], middle, map_c) ||
+      !barycentric_offsets(target.x[0], middle, map_t))
     return false;
   for (int a = 0; a < 4; ++a) {  // at y = middle - origin = 0 the map's value is its offset
     point.contactor[a] = map_c.offset[a];
@@ -122,18 +140,21 @@ inline bool spring_point(const FrictionHistory& history, const TetCorners& conta
   return true;
 }
 
+inline bool spring_point(const FrictionHistory& history, const TetCorners& contactor,
+                         const TetCorners& target, FrictionPoint& point) {
+  PairGradients gradients;
+  return pair_gradients(contactor, target, gradients) &&
+         spring_point(history, contactor, target, gradients, point);
+}
+
 // A slipping spring's anchors follow the slip: the contactor's moves back by half the relative
 // displacement `slip` (m) that the spring did not take up, the target's forward by half, so that
-// they stay as far apart as the spring is long.  Unchanged for a degenerate tet.
-inline void slide_anchors(FrictionHistory& history, const TetCorners& contactor,
-                          const TetCorners& target, const Vec3& slip) {
-  BarycentricMap map_c, map_t;
-  if (!make_barycentric_map(contactor, contactor.x[0], map_c) ||
-      !make_barycentric_map(target, target.x[0], map_t))
-    return;
+// they stay as far apart as the spring is long.
+inline void slide_anchors(FrictionHistory& history, const PairGradients& gradients,
+                          const Vec3& slip) {
   for (int a = 0; a < 4; ++a) {  // barycentric coordinates are affine: shift = gradient · move
-    history.anchor_contactor[a] -= 0.5 * map_c.gradient[a].dot(slip);
-    history.anchor_target[a] += 0.5 * map_t.gradient[a].dot(slip);
+    history.anchor_contactor[a] -= 0.5 * gradients.contactor[a].dot(slip);
+    history.anchor_target[a] += 0.5 * gradients.target[a].dot(slip);
   }
 }
 
