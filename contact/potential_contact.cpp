@@ -110,8 +110,7 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
 }
 
 // Integrates the four pieces (sub-tet i of `own`) ∩ other.
-void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned skipped,
-                    SideIntegrals& out) {
+void integrate_side(const TetPairFrame& frame, int own, int moments, SideIntegrals& out) {
   const BarycentricMap& own_map = frame.map[own];
   const BarycentricMap& other_map = frame.map[1 - own];
   const double(&other_at_corner)[4][4] = frame.lambda_other[own];
@@ -150,7 +149,7 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned sk
               own_at_other_corner[1][i] > own_at_other_corner[1][k] &&
               own_at_other_corner[2][i] > own_at_other_corner[2][k] &&
               own_at_other_corner[3][i] > own_at_other_corner[3][k];
-    if (empty || (skipped >> (4 * own + i)) & 1u) continue;
+    if (empty) continue;
     piece.count = 4;
     for (int s = 0; s < 4; ++s) {
       PieceVertex& v = piece.v[s];
@@ -171,13 +170,12 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned sk
   }
 }
 
-ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned skipped = 0) {
+ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   ContactPairResult r = zero_result();
 
   SideIntegrals side[2];
-  integrate_side(frame, 0, 8, skipped,
-                 side[0]);  // the other tet's moments give the centroid's weights
-  integrate_side(frame, 1, 4, skipped, side[1]);
+  integrate_side(frame, 0, 8, side[0]);  // the other tet's moments give the centroid's weights
+  integrate_side(frame, 1, 4, side[1]);
 
   // Physical volume integrals: ∫_{piece i} lam_c dV = |det| * moment / 24 (moment includes the
   // apex term vol6 * lam_c(apex)).
@@ -226,9 +224,8 @@ ContactPairResult potential_contact(const PreparedContactor& contactor, const Te
                                     double penalty, double sliver_tolerance) {
   TetPairFrame frame;
   if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
-  const unsigned skipped = sliver_tolerance > 0.0 ? negligible_parts(frame, sliver_tolerance) : 0u;
-  if (skipped == kEveryPiece) return zero_result();
-  return assemble(frame, penalty, skipped);
+  if (sliver_tolerance > 0.0 && contact_negligible(frame, sliver_tolerance)) return zero_result();
+  return assemble(frame, penalty);
 }
 
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,
@@ -237,13 +234,6 @@ ContactPairResult potential_contact(const TetCorners& contactor, const TetCorner
   PreparedContactor prepared;
   prepare_contactor(contactor, prepared);
   return potential_contact(prepared, target, penalty, sliver_tolerance);
-}
-
-ContactPairResult potential_contact_without(const TetCorners& contactor, const TetCorners& target,
-                                            double penalty, unsigned left_out) {
-  TetPairFrame frame;
-  if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
-  return assemble(frame, penalty, left_out);
 }
 
 ContactPairResult potential_contact_unculled(const TetCorners& contactor, const TetCorners& target,

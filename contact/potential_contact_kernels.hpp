@@ -47,20 +47,12 @@ struct ContactPairResult {
 // sliver_tolerance > 0, a pair whose nodal forces are proven below sliver_tolerance · p · ℓ²
 // (pair_force_bound.hpp; ℓ the shorter tet's longest edge) is returned as not overlapping: the
 // slivers next to a pressed pair across an interface, which carry O(depth/size) of its force.
-// Of the other pairs, the pieces proven below the same limit are left out: the sub-tets beside a
-// pressed face, whose overlap is a sliver along the face's edges.
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,
                                     double penalty, double sliver_tolerance = 0.0);
 
 // The same with the contactor prepared once for all its pairs (tet_overlap.hpp): bit for bit.
 ContactPairResult potential_contact(const PreparedContactor& contactor, const TetCorners& target,
                                     double penalty, double sliver_tolerance = 0.0);
-
-// potential_contact without the sliver skip and with the pieces in `left_out` (bit 4T + i: sub-tet
-// i of tet T, 0 contactor, 1 target, clipped by the other tet) left out; for the tests of the
-// piece bound.
-ContactPairResult potential_contact_without(const TetCorners& contactor, const TetCorners& target,
-                                            double penalty, unsigned left_out);
 
 // The exact integration alone, with only the degenerate-tet check (no box or face-plane
 // rejection).  Same results as potential_contact for every pair that passes the rejection;
