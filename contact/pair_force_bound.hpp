@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "contact/tet_overlap.hpp"
 
@@ -30,6 +31,7 @@ struct PairForceBound {
   double nodal_force = 0.0;  // N: no nodal force of either tet exceeds it
   double energy = 0.0;       // J
   double volume = 0.0;       // m^3: the overlap's volume is below it
+  double surface = 0.0;      // m^2: the area of the overlap's boundary is below it
   double length = 0.0;       // m: the shorter of the two tets' longest edges
   double thinnest = 1.0;     // the thinnest slab mu (barycentric): ~ depth / size when pressed
 };
@@ -102,6 +104,7 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
     }
   PairForceBound bound;
   bound.volume = volume_bound;
+  bound.surface = surface_bound;
   bound.length = length;
   bound.thinnest = *std::min_element(mu, mu + 8);
   bound.nodal_force =
@@ -119,23 +122,79 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty
   return pair_force_bound(frame, mu, penalty);
 }
 
-// True when the pair is proven to exert no nodal force above tolerance · p · ℓ² (ℓ the shorter
-// tet's longest edge; p ℓ² is about the force of a full overlap), nor above kPressedFaceShare of
-// mu · p · ℓ², about what a face pressed as deep (mu the thinnest slab) carries.  The second
-// condition keeps every pressed face in contact from its first touch, so no face contact starts
-// with a jump of its energy: only the pairs whose forces grow faster than their depth (slivers
-// beside a pressed face, edges and corners) wait until they matter.  Only a pair with a slab
-// thinner than kThinSlab can pass, so the bound is computed only there: a deep overlap pays one
-// scan of its 32 corner coordinates (slab_depths).
-constexpr double kPressedFaceShare = 1e-3;
+// Per piece of a pair (sub-tet i of tet T clipped by the other tet: index 4T + i), an upper bound
+// (N / Pa) of what it contributes to any nodal force.  On piece (T, i) the own coordinate
+// lambda_i^T is the smallest of tet T's, so it is below every mu_a^T: the piece lies in the slab
+// of face i thinned to m_T = min_a mu_a^T besides the pair's slabs, and beside a pressed face F
+// the pieces of the sub-tets next to F lie in the prism of the slabs i and F, both m_T thin.
+// The piece's terms: its volume term on T's nodes (<= 4 G_T V) and its surface terms on the other
+// tet's nodes (<= Phi_T S, Phi_T = 4 m_T).  Leaving it out also leaves out its share of the flux
+// through the sub-tet boundaries, which the pieces' sum cancels: the remaining forces are the
+// gradient of the remaining energy to within the same bound.  A tet whose every piece is sure to
+// exceed `above` (or that has no slab thinner than kPrismSlab) gets infinity, uncomputed.
+inline void piece_force_bounds(const TetPairFrame& frame, const double (&mu)[8],
+                               const PairForceBound& pair, double above, double (&bound)[8]) {
+  for (int T = 0; T < 2; ++T) {
+    for (int i = 0; i < 4; ++i) bound[4 * T + i] = std::numeric_limits<double>::infinity();
+    const double* own = mu + 4 * T;
+    const double thinnest_own = std::min(std::min(own[0], own[1]), std::min(own[2], own[3]));
+    if (!(thinnest_own < kPrismSlab)) continue;
+    const Vec3* gradient = frame.map[T].gradient;
+    double norm[4], largest = 0.0;
+    for (int a = 0; a < 4; ++a) largest = std::max(largest, norm[a] = gradient[a].norm());
+    // Every section below is at least m_T² / G_T² (|g_a × g_b| <= G_T²).
+    const double least_volume =
+        std::min(pair.volume, thinnest_own * thinnest_own * pair.length / (largest * largest));
+    if (!(4.0 * largest * least_volume <= above)) continue;
+    double cross[4][4];
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) cross[a][b] = gradient[a].cross(gradient[b]).norm();
+    for (int i = 0; i < 4; ++i) {
+      double nu[4];
+      for (int a = 0; a < 4; ++a) nu[a] = a == i ? thinnest_own : own[a];
+      double volume = pair.volume, surface = pair.surface;
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+          if (!(cross[a][b] > 0.0)) continue;
+          const double section = nu[a] * nu[b] / cross[a][b];
+          const double perimeter = 2.0 * (nu[a] * norm[b] + nu[b] * norm[a]) / cross[a][b];
+          volume = std::min(volume, section * pair.length);
+          surface = std::min(surface, 2.0 * section + perimeter * pair.length);
+        }
+      bound[4 * T + i] = 4.0 * largest * volume + 4.0 * thinnest_own * surface;
+    }
+  }
+}
 
-inline bool contact_negligible(const TetPairFrame& frame, double tolerance) {
+// Which parts of a pair may be left out: every piece (kEveryPiece) when the whole pair is proven
+// to exert no nodal force above tolerance · p · ℓ² (ℓ the shorter tet's longest edge; p ℓ² is
+// about the force of a full overlap), nor above kPressedFaceShare of mu · p · ℓ², about what a
+// face pressed as deep (mu the thinnest slab) carries; otherwise the pieces proven below the same
+// limit (piece_force_bounds).  The second condition keeps every pressed face in contact from its
+// first touch, so no face contact starts with a jump of its energy: only the pairs and pieces
+// whose forces grow faster than their depth (slivers beside a pressed face, edges and corners)
+// wait until they matter.  Only a pair with a slab thinner than kThinSlab can pass, so the bound
+// is computed only there: a deep overlap pays one scan of its 32 corner coordinates.
+constexpr double kPressedFaceShare = 1e-3;
+constexpr unsigned kEveryPiece = 0xFFu;
+
+inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   constexpr double kThinSlab = 1e-3;
   double mu[8];
-  if (!(slab_depths(frame, mu) < kThinSlab)) return false;
+  if (!(slab_depths(frame, mu) < kThinSlab)) return 0;
   const PairForceBound bound = pair_force_bound(frame, mu, 1.0);
-  const double full = bound.length * bound.length;  // p ℓ² / p
-  return bound.nodal_force <= std::min(tolerance, kPressedFaceShare * bound.thinnest) * full;
+  const double limit =
+      std::min(tolerance, kPressedFaceShare * bound.thinnest) * bound.length * bound.length;
+  if (bound.nodal_force <= limit) return kEveryPiece;
+  double piece[8];
+  piece_force_bounds(frame, mu, bound, limit, piece);
+  unsigned skipped = 0;
+  for (int k = 0; k < 8; ++k) skipped |= piece[k] <= limit ? 1u << k : 0u;
+  return skipped;
+}
+
+inline bool contact_negligible(const TetPairFrame& frame, double tolerance) {
+  return negligible_parts(frame, tolerance) == kEveryPiece;
 }
 
 }  // namespace fdem

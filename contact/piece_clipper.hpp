@@ -119,6 +119,10 @@ struct SideIntegrals {
   double moment[4][8] = {};       // per sub-tet i: sum vol6_tet * (sum of its 4 vertex values)
   double surface[4][4] = {};  // [other face j][other node b]: ∫ 4 lambda_i^own lambda_b^other dS
                               // * 24 (physical area), over the pieces' faces on face j
+  unsigned nonempty = 0;      // bit i: piece i was clipped to a non-empty polyhedron
+  // [sub-tet k][slot s][own node a]: ∫ 4 lambda_k lambda_a dS * 24 (physical area) over piece k's
+  // face on the plane it shares with sub-tet s (lambda_k = lambda_s), for left-out pieces s only
+  double flux[4][4][4];
 };
 
 inline ContactPairResult zero_result() {

@@ -19,12 +19,15 @@ using namespace piece_clip;
 // area_weight[j]: maps a barycentric-space doubled area vector to the doubled physical area
 // projected on face j's outward unit normal.
 void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight)[4][3],
-                     int moments, SideIntegrals& out) {
+                     const double (&side_weight)[4][3], unsigned flux_slots, int moments,
+                     SideIntegrals& out) {
   const int n = piece.count;
   bool used[kMaxVertices][3];
   double volume_weight[kMaxVertices];      // Σ vol6 of the cones having the vertex on their base
   double surface_weight[4][kMaxVertices];  // per other face: Σ area × (f_k + Σf) of its triangles
   bool on_face[4] = {false, false, false, false};
+  double flux_weight[4][kMaxVertices];  // per side slot s in flux_slots: as surface_weight
+  bool on_side[4] = {false, false, false, false};
   for (int v = 0; v < n; ++v) {
     used[v][0] = used[v][1] = used[v][2] = false;
     volume_weight[v] = 0.0;
@@ -60,6 +63,14 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
           for (int v = 0; v < n; ++v) surface_weight[other_face][v] = 0.0;
         }
       }
+      int side_slot = -1;  // a face on the plane shared with a left-out piece's sub-tet
+      if (const unsigned side = (face_planes >> 1) & flux_slots & 0xFu) {
+        side_slot = (side & 1u) ? 0 : (side & 2u) ? 1 : (side & 4u) ? 2 : 3;
+        if (!on_side[side_slot]) {
+          on_side[side_slot] = true;
+          for (int v = 0; v < n; ++v) flux_weight[side_slot][v] = 0.0;
+        }
+      }
       // Fan from the face's first vertex.
       const double* x0 = piece.v[face[0]].lam;
       const double h0[3] = {x0[1] - apex[1], x0[2] - apex[2], x0[3] - apex[3]};
@@ -87,6 +98,16 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
           sw[face[k]] += area_phys2 * (f1 + fsum);
           sw[face[k + 1]] += area_phys2 * (f2 + fsum);
         }
+        if (side_slot >= 0) {  // the same rule with the side plane's area
+          const double* aw = side_weight[side_slot];
+          const double area_phys2 = area2[0] * aw[0] + area2[1] * aw[1] + area2[2] * aw[2];
+          const double f0 = 4.0 * x0[own_sub], f1 = 4.0 * x1[own_sub], f2 = 4.0 * x2[own_sub];
+          const double fsum = f0 + f1 + f2;
+          double* fw = flux_weight[side_slot];
+          fw[face[0]] += area_phys2 * (f0 + fsum);
+          fw[face[k]] += area_phys2 * (f1 + fsum);
+          fw[face[k + 1]] += area_phys2 * (f2 + fsum);
+        }
       }
     }
   }
@@ -97,6 +118,14 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
     const double wv = volume_weight[v];
     const double* lam = piece.v[v].lam;
     for (int c = 0; c < moments; ++c) moment[c] += wv * lam[c];
+  }
+  for (int slot = 0; slot < 4; ++slot) {
+    double* flux = out.flux[own_sub][slot];
+    if ((flux_slots >> slot) & 1u)
+      for (int a = 0; a < 4; ++a) flux[a] = 0.0;
+    if (!on_side[slot]) continue;
+    for (int v = 0; v < n; ++v)
+      for (int a = 0; a < 4; ++a) flux[a] += flux_weight[slot][v] * piece.v[v].lam[a];
   }
   for (int j = 0; j < 4; ++j) {
     if (!on_face[j]) continue;
@@ -110,7 +139,8 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
 }
 
 // Integrates the four pieces (sub-tet i of `own`) ∩ other.
-void integrate_side(const TetPairFrame& frame, int own, int moments, SideIntegrals& out) {
+void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned left_out,
+                    SideIntegrals& out) {
   const BarycentricMap& own_map = frame.map[own];
   const BarycentricMap& other_map = frame.map[1 - own];
   const double(&other_at_corner)[4][4] = frame.lambda_other[own];
@@ -130,6 +160,10 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, SideIntegra
     for (int k = 0; k < 3; ++k)
       area_weight[j][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
   }
+  // This side's left-out pieces: each kept piece i also integrates its face on the plane
+  // lambda_i = lambda_s it shares with a left-out sub-tet s (SideIntegrals::flux); side_weight[s]
+  // maps the fan's area to that plane's, whose unit normal points out of sub-tet i.
+  const unsigned flux_slots = (left_out >> (4 * own)) & 0xFu;
   Piece piece;
   for (int i = 0; i < 4; ++i) {
     // Sub-tet i = own corners k != i plus the centroid in slot i.  In lambda_1..3 coordinates
@@ -149,7 +183,7 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, SideIntegra
               own_at_other_corner[1][i] > own_at_other_corner[1][k] &&
               own_at_other_corner[2][i] > own_at_other_corner[2][k] &&
               own_at_other_corner[3][i] > own_at_other_corner[3][k];
-    if (empty) continue;
+    if (empty || (left_out >> (4 * own + i)) & 1u) continue;
     piece.count = 4;
     for (int s = 0; s < 4; ++s) {
       PieceVertex& v = piece.v[s];
@@ -166,16 +200,28 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, SideIntegra
     bool alive = true;
     for (int b = 0; b < 4 && alive; ++b)
       alive = clip_piece(piece, 4 + b, 1u << (kOtherFaceShift + b));
-    if (alive) integrate_piece(piece, i, area_weight, moments, out);
+    if (alive) {
+      out.nonempty |= 1u << i;
+      double side_weight[4][3] = {};
+      const unsigned slots = flux_slots & ~(1u << i);
+      for (int slot = 0; slot < 4; ++slot) {
+        if (!((slots >> slot) & 1u)) continue;
+        const Vec3 normal = (own_map.gradient[i] - own_map.gradient[slot]).normalized();
+        for (int k = 0; k < 3; ++k)
+          side_weight[slot][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
+      }
+      integrate_piece(piece, i, area_weight, side_weight, slots, moments, out);
+    }
   }
 }
 
-ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
+ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned left_out = 0) {
   ContactPairResult r = zero_result();
 
   SideIntegrals side[2];
-  integrate_side(frame, 0, 8, side[0]);  // the other tet's moments give the centroid's weights
-  integrate_side(frame, 1, 4, side[1]);
+  // (side 0 carries the other tet's moments too: they give the centroid's weights)
+  integrate_side(frame, 0, 8, left_out, side[0]);
+  integrate_side(frame, 1, 4, left_out, side[1]);
 
   // Physical volume integrals: ∫_{piece i} lam_c dV = |det| * moment / 24 (moment includes the
   // apex term vol6 * lam_c(apex)).
@@ -208,6 +254,19 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
       }
       force[s][a] = penalty * f;
     }
+    // The pieces' forces sum to the gradient of the energy because the boundary term
+    // -p ∫ phi lambda_a n dS on the face two sub-tets share cancels between their pieces.  A
+    // left-out piece i leaves it to each kept neighbour k, over k's face on their plane (normal
+    // out of k, phi = 4 lambda_k there): the forces stay the exact gradient of the kept energy.
+    for (int i = 0; i < 4; ++i) {
+      if (!((left_out >> (4 * s + i)) & 1u)) continue;
+      for (int k = 0; k < 4; ++k) {
+        if (k == i || !((side[s].nonempty >> k) & 1u)) continue;  // an empty piece shares nothing
+        const Vec3 normal = (own.gradient[k] - own.gradient[i]).normalized();
+        for (int a = 0; a < 4; ++a)
+          force[s][a] -= (penalty * side[s].flux[k][i][a] * (1.0 / 24.0)) * normal;
+      }
+    }
   }
   energy *= 4.0 * penalty;
 
@@ -224,8 +283,9 @@ ContactPairResult potential_contact(const PreparedContactor& contactor, const Te
                                     double penalty, double sliver_tolerance) {
   TetPairFrame frame;
   if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
-  if (sliver_tolerance > 0.0 && contact_negligible(frame, sliver_tolerance)) return zero_result();
-  return assemble(frame, penalty);
+  const unsigned left_out = sliver_tolerance > 0.0 ? negligible_parts(frame, sliver_tolerance) : 0u;
+  if (left_out == kEveryPiece) return zero_result();
+  return assemble(frame, penalty, left_out);
 }
 
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,
@@ -234,6 +294,13 @@ ContactPairResult potential_contact(const TetCorners& contactor, const TetCorner
   PreparedContactor prepared;
   prepare_contactor(contactor, prepared);
   return potential_contact(prepared, target, penalty, sliver_tolerance);
+}
+
+ContactPairResult potential_contact_without(const TetCorners& contactor, const TetCorners& target,
+                                            double penalty, unsigned left_out) {
+  TetPairFrame frame;
+  if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
+  return assemble(frame, penalty, left_out);
 }
 
 ContactPairResult potential_contact_unculled(const TetCorners& contactor, const TetCorners& target,

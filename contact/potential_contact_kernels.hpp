@@ -47,8 +47,18 @@ struct ContactPairResult {
 // sliver_tolerance > 0, a pair whose nodal forces are proven below sliver_tolerance · p · ℓ²
 // (pair_force_bound.hpp; ℓ the shorter tet's longest edge) is returned as not overlapping: the
 // slivers next to a pressed pair across an interface, which carry O(depth/size) of its force.
+// Of the other pairs, the pieces proven below the same limit are left out (the sub-tets beside a
+// pressed face, whose overlap is a sliver along the face's edges), each with the flux it leaves
+// uncancelled: the forces stay the exact gradient of the energy.
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,
                                     double penalty, double sliver_tolerance = 0.0);
+
+// potential_contact without the sliver skip and with the pieces in `left_out` left out (bit
+// 4T + i: sub-tet i of tet T, 0 contactor, 1 target, clipped by the other tet), each with the flux
+// it leaves uncancelled, so that the forces are the exact gradient of the kept pieces' energy;
+// for the tests of the piece bound.
+ContactPairResult potential_contact_without(const TetCorners& contactor, const TetCorners& target,
+                                            double penalty, unsigned left_out);
 
 // The same with the contactor prepared once for all its pairs (tet_overlap.hpp): bit for bit.
 ContactPairResult potential_contact(const PreparedContactor& contactor, const TetCorners& target,
