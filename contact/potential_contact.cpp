@@ -86,28 +86,22 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
         volume_weight[face[0]] += vol6;
         volume_weight[face[k]] += vol6;
         volume_weight[face[k + 1]] += vol6;
-        if (other_face >= 0) {
-          // ∫_tri f g dS = A/12 (sum f_k g_k + (sum f)(sum g)), f = 4 lambda_own, g =
-          // lambda_other_b: vertex k carries A (f_k + sum f).
-          const double* aw = area_weight[other_face];
-          const double area_phys2 = area2[0] * aw[0] + area2[1] * aw[1] + area2[2] * aw[2];
+        // ∫_tri f g dS = A/12 (sum f_k g_k + (sum f)(sum g)), f = 4 lambda_own, g any carried
+        // value: vertex k carries A (f_k + sum f), A the triangle's area on the plane that
+        // `weight` projects onto.
+        const auto add_quadratic = [&](const double* weight, double* vertex_weight) {
+          const double area_phys2 =
+              area2[0] * weight[0] + area2[1] * weight[1] + area2[2] * weight[2];
           const double f0 = 4.0 * x0[own_sub], f1 = 4.0 * x1[own_sub], f2 = 4.0 * x2[own_sub];
           const double fsum = f0 + f1 + f2;
-          double* sw = surface_weight[other_face];
-          sw[face[0]] += area_phys2 * (f0 + fsum);
-          sw[face[k]] += area_phys2 * (f1 + fsum);
-          sw[face[k + 1]] += area_phys2 * (f2 + fsum);
-        }
-        if (side_slot >= 0) {  // the same rule with the side plane's area
-          const double* aw = side_weight[side_slot];
-          const double area_phys2 = area2[0] * aw[0] + area2[1] * aw[1] + area2[2] * aw[2];
-          const double f0 = 4.0 * x0[own_sub], f1 = 4.0 * x1[own_sub], f2 = 4.0 * x2[own_sub];
-          const double fsum = f0 + f1 + f2;
-          double* fw = flux_weight[side_slot];
-          fw[face[0]] += area_phys2 * (f0 + fsum);
-          fw[face[k]] += area_phys2 * (f1 + fsum);
-          fw[face[k + 1]] += area_phys2 * (f2 + fsum);
-        }
+          vertex_weight[face[0]] += area_phys2 * (f0 + fsum);
+          vertex_weight[face[k]] += area_phys2 * (f1 + fsum);
+          vertex_weight[face[k + 1]] += area_phys2 * (f2 + fsum);
+        };
+        if (other_face >= 0)  // the other tet's face: g = lambda_other_b
+          add_quadratic(area_weight[other_face], surface_weight[other_face]);
+        if (side_slot >= 0)  // the plane shared with a left-out sub-tet: g = lambda_own_a
+          add_quadratic(side_weight[side_slot], flux_weight[side_slot]);
       }
     }
   }

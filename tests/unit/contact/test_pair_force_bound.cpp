@@ -44,6 +44,18 @@ double max_force_difference(const ContactPairResult& a, const ContactPairResult&
   return largest;
 }
 
+// Two layers of 3 × 3 cubes of 0.05 m, the upper sunk `depth` of the edge into the lower: with
+// matched meshes, then shifted across the interface.
+template <class Body>
+void for_pressed_interfaces(double depth, Body body) {
+  const double h = 0.05;
+  const auto lower = cube_layer(3, h, Vec3(0, 0, -h));
+  for (const double shift : {0.0, 0.37}) {
+    INFO("shift " << shift << " depth " << depth);
+    body(cube_layer(3, h, Vec3(shift * h, 0.3 * shift * h, -depth * h)), lower);
+  }
+}
+
 struct PairCheck {
   int pairs = 0, violations = 0;
 };
@@ -79,19 +91,16 @@ TEST_CASE("the pair force bound holds on random overlapping pairs", "[contact]")
 
 TEST_CASE("the pair force bound holds across pressed interfaces from 1e-10 to 1e-2 deep",
           "[contact]") {
-  const double h = 0.05, penalty = 5.0e10;
-  const auto lower = cube_layer(3, h, Vec3(0, 0, -h));
-  for (const double shift : {0.0, 0.37}) {  // matched meshes, then shifted across
-    for (const double depth : {1e-10, 1e-8, 1e-6, 1e-4, 1e-2}) {
-      const auto upper = cube_layer(3, h, Vec3(shift * h, 0.3 * shift * h, -depth * h));
-      PairCheck check;
-      for (const TetCorners& c : upper)
-        for (const TetCorners& t : lower) check_bound(c, t, penalty, check);
-      INFO("shift " << shift << " depth " << depth);
-      CHECK(check.pairs > 200);
-      CHECK(check.violations == 0);
-    }
-  }
+  const double penalty = 5.0e10;
+  for (const double depth : {1e-10, 1e-8, 1e-6, 1e-4, 1e-2})
+    for_pressed_interfaces(
+        depth, [&](const std::vector<TetCorners>& upper, const std::vector<TetCorners>& lower) {
+          PairCheck check;
+          for (const TetCorners& c : upper)
+            for (const TetCorners& t : lower) check_bound(c, t, penalty, check);
+          CHECK(check.pairs > 200);
+          CHECK(check.violations == 0);
+        });
 }
 
 TEST_CASE("matched interface pressed 1e-6 deep: the slivers are skipped and no pressed pair",
@@ -235,19 +244,16 @@ void check_pieces(const TetCorners& c, const TetCorners& t, double penalty, Piec
 }  // namespace
 
 TEST_CASE("a piece left out moves no nodal force beyond its bound", "[contact]") {
-  const double h = 0.05, penalty = 5.0e10;
-  const auto lower = cube_layer(3, h, Vec3(0, 0, -h));
-  for (const double shift : {0.0, 0.37}) {
-    for (const double depth : {1e-10, 1e-8, 1e-6, 1e-4, 1e-3}) {
-      const auto upper = cube_layer(3, h, Vec3(shift * h, 0.3 * shift * h, -depth * h));
-      PieceCheck check;
-      for (const TetCorners& c : upper)
-        for (const TetCorners& t : lower) check_pieces(c, t, penalty, check);
-      INFO("shift " << shift << " depth " << depth);
-      CHECK(check.pieces > 200);
-      CHECK(check.violations == 0);
-    }
-  }
+  const double penalty = 5.0e10;
+  for (const double depth : {1e-10, 1e-8, 1e-6, 1e-4, 1e-3})
+    for_pressed_interfaces(
+        depth, [&](const std::vector<TetCorners>& upper, const std::vector<TetCorners>& lower) {
+          PieceCheck check;
+          for (const TetCorners& c : upper)
+            for (const TetCorners& t : lower) check_pieces(c, t, penalty, check);
+          CHECK(check.pieces > 200);
+          CHECK(check.violations == 0);
+        });
   std::mt19937_64 rng(20261130);
   PieceCheck random;
   for (int i = 0; i < 4000; ++i) {
