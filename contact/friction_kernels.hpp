@@ -107,13 +107,6 @@ struct PairGradients {
   Vec3 contactor[4], target[4];
 };
 
-inline bool pair_gradients(const TetCorners& contactor, const TetCorners& target,
-                           PairGradients& out) {
-  double det = 0.0;
-  return barycentric_gradients(contactor, out.contactor, det) &&
-         barycentric_gradients(target, out.target, det);
-}
-
 // The point of an attached spring: midway between its anchors at the tets' current positions.
 // False (and `point` untouched) for a degenerate tet, which has no barycentric coordinates.
 inline bool spring_point(const FrictionHistory& history, const TetCorners& contactor,
@@ -143,7 +136,9 @@ inline bool spring_point(const FrictionHistory& history, const TetCorners& conta
 inline bool spring_point(const FrictionHistory& history, const TetCorners& contactor,
                          const TetCorners& target, FrictionPoint& point) {
   PairGradients gradients;
-  return pair_gradients(contactor, target, gradients) &&
+  double det = 0.0;
+  return barycentric_gradients(contactor, gradients.contactor, det) &&
+         barycentric_gradients(target, gradients.target, det) &&
          spring_point(history, contactor, target, gradients, point);
 }
 

@@ -127,11 +127,11 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty
 // lambda_i^T is the smallest of tet T's, so it is below every mu_a^T: the piece lies in the slab
 // of face i thinned to m_T = min_a mu_a^T besides the pair's slabs, and beside a pressed face F
 // the pieces of the sub-tets next to F lie in the prism of the slabs i and F, both m_T thin.
-// The piece's terms: its volume term on T's nodes (<= 4 G_T V) and its surface terms on the other
-// tet's nodes (<= Phi_T S, Phi_T = 4 m_T).  Leaving it out also leaves out its share of the flux
-// through the sub-tet boundaries, which the pieces' sum cancels: the remaining forces are the
-// gradient of the remaining energy to within the same bound.  A tet whose every piece is sure to
-// exceed `above` (or that has no slab thinner than kPrismSlab) gets infinity, uncomputed.
+// Leaving the piece out removes its volume term on T's nodes (<= 4 G_T V) and its surface terms on
+// the other tet's nodes (<= Phi_T S, Phi_T = 4 m_T), and hands its kept neighbours the boundary
+// term it cancelled (<= Phi_T S on T's nodes; potential_contact.cpp adds it, so the forces stay
+// the gradient of the kept energy).  A tet whose every piece is sure to exceed `above` (or that
+// has no slab thinner than kPrismSlab) gets infinity, uncomputed.
 inline void piece_force_bounds(const TetPairFrame& frame, const double (&mu)[8],
                                const PairForceBound& pair, double above, double (&bound)[8]) {
   for (int T = 0; T < 2; ++T) {
@@ -191,10 +191,6 @@ inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   unsigned skipped = 0;
   for (int k = 0; k < 8; ++k) skipped |= piece[k] <= limit ? 1u << k : 0u;
   return skipped;
-}
-
-inline bool contact_negligible(const TetPairFrame& frame, double tolerance) {
-  return negligible_parts(frame, tolerance) == kEveryPiece;
 }
 
 }  // namespace fdem

@@ -180,7 +180,7 @@ TEST_CASE("meshes shifted across a pressed interface have no slivers to skip", "
 
 TEST_CASE("a pressed face is never skipped, from round-off depth to deep, at the largest tolerance",
           "[contact]") {
-  // The second condition of contact_negligible (below 1/1000 of what a face pressed as deep
+  // The second condition of negligible_parts (below 1/1000 of what a face pressed as deep
   // carries): without it a face contact starting from touching would be skipped until its force
   // reached the tolerance, then enter with its energy at once.
   const double h = 1.0, penalty = 1.0;
