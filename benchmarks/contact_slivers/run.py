@@ -6,7 +6,7 @@ algorithm), alternating in one invocation, one core each.
 
   benchmarks/contact_slivers/run.py [--fdem build/drivers/fdem] [--repeats 3]
       [--tolerances 0,1e-9] [--cases wall_tilt,arch,tower,dry_wall]
-      [--baseline OLD_FDEM] [--csv docs/data/bench_contact_slivers.csv]
+      [--baseline OLD_FDEM [--baseline-tolerance none]] [--csv docs/data/bench_contact_slivers.csv]
 
 With --baseline, a third variant runs that binary (an older build) at the last tolerance, in the
 same alternation: the ratio of the current code's skipping against the older one's.
@@ -18,6 +18,7 @@ tolerances):
   arch       the 20-voussoir arch (t/R 0.15) under 0.13 g horizontal, 0.02 s (516 tets)
   tower      the default example (tower and projectile), first 0.1 s: the projectile hits at 14 ms
   dry_wall   examples/dry-stone-wall-seismic.yaml, first 0.2 s (2 mm mortar gaps: the stones land)
+  pile       bench_contact_pile's dense pile of 64 blocks (3,558 tets) as a scene, first 4 ms
 Measured per run: user CPU seconds, steps, the contact stage's seconds, the energy balance error,
 the state_hash; per case: the speed-up (best of the repeats) and the largest difference of a
 piece's centroid between the tolerances.
@@ -46,7 +47,37 @@ def case_scene(name, workdir):
         return os.path.join(root, "examples", "tower-projectile.yaml"), ["time.end=0.1"]
     if name == "dry_wall":
         return os.path.join(root, "examples", "dry-stone-wall-seismic.yaml"), ["time.end=0.2"]
-    raise SystemExit(f"unknown case {name}: wall_tilt, arch, tower or dry_wall")
+    if name == "pile":
+        path = os.path.join(workdir, "pile.yaml")
+        with open(path, "w") as f:
+            f.write(pile_scene(4, 0.004))
+        return path, []
+    raise SystemExit(f"unknown case {name}: wall_tilt, arch, tower, dry_wall or pile")
+
+
+def pile_scene(k, end):
+    """bench_contact_pile's dense pile as a scene: k³ blocks of 0.2 m (2×2×2 cells) stacked
+    touching on a fixed base, falling at 0.5 m/s with small lateral velocities."""
+    a = 0.2
+    lines = [f"name: pile", f"time: {{end: {end}, step: auto, safety: 0.7}}",
+             "gravity: [0, 0, -9.81]", "materials:", "  stone:", "    density: 2500",
+             "    elastic: {young: 1.0e9, poisson: 0.2}", "    contact: {friction: 0.5}",
+             "bodies:", "  - name: base",
+             f"    mesh: {{box: {{min: [-0.1, -0.1, -0.2], max: [{k * a + 0.1}, {k * a + 0.1}, 0],"
+             f" cells: [{2 * k + 1}, {2 * k + 1}, 1]}}}}",
+             "    material: stone", "    fixed: true"]
+    for i in range(k):
+        for j in range(k):
+            for l in range(k):
+                lo = (i * a, j * a, l * a)
+                hi = tuple(c + a for c in lo)
+                lines += [f"  - name: b{i}_{j}_{l}",
+                          f"    mesh: {{box: {{min: [{lo[0]:.6g}, {lo[1]:.6g}, {lo[2]:.6g}], "
+                          f"max: [{hi[0]:.6g}, {hi[1]:.6g}, {hi[2]:.6g}], cells: [2, 2, 2]}}}}",
+                          "    material: stone",
+                          f"    velocity: [{0.01 * (i - j):.6g}, {0.01 * (l - i):.6g}, -0.5]"]
+    lines += ["output: {every: 0}"]
+    return "\n".join(lines) + "\n"
 
 
 def final_centroids(outdir):
@@ -58,15 +89,16 @@ def final_centroids(outdir):
 
 def run_once(fdem, scene, overrides, tolerance, outdir):
     before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
-    args = [fdem, "run", scene, "-o", outdir, "-q", "--set",
-            f"contact.sliver_tolerance={tolerance}"]
+    args = [fdem, "run", scene, "-o", outdir, "-q"]
+    if tolerance != "none":  # "none": a binary older than the key
+        args += ["--set", f"contact.sliver_tolerance={tolerance}"]
     for o in overrides:
         args += ["--set", o]
     subprocess.run(args, check=True, stdout=subprocess.DEVNULL)
     cpu = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - before
     summary = json.load(open(os.path.join(outdir, "summary.json")))
-    return {"cpu": cpu, "steps": summary["steps"], "hash": summary["state_hash"],
-            "contact": summary["stages"]["contact_forces"]["seconds"],
+    return {"cpu": cpu, "steps": summary["steps"], "hash": summary.get("state_hash", "-"),
+            "contact": summary.get("stages", {}).get("contact_forces", {}).get("seconds", 0.0),
             "balance": summary["energy"]["balance_error"],
             "centroids": final_centroids(outdir)}
 
@@ -78,6 +110,8 @@ def main():
     ap.add_argument("--tolerances", default="0,1e-9")
     ap.add_argument("--cases", default="wall_tilt,arch,tower,dry_wall")
     ap.add_argument("--baseline", help="an older fdem binary, run at the last tolerance")
+    ap.add_argument("--baseline-tolerance",
+                    help="the baseline's tolerance instead (none: a binary without the key)")
     ap.add_argument("--csv", default=os.path.join(root, "docs", "data",
                                                   "bench_contact_slivers.csv"))
     a = ap.parse_args()
@@ -85,7 +119,8 @@ def main():
     # (label, binary, tolerance); the first is the reference of the speed-ups
     variants = [(f"tolerance {t}", a.fdem, t) for t in tolerances]
     if a.baseline:
-        variants.append((f"baseline {tolerances[-1]}", a.baseline, tolerances[-1]))
+        t = a.baseline_tolerance or tolerances[-1]
+        variants.append((f"baseline {t}", a.baseline, t))
     rows = []
     with tempfile.TemporaryDirectory() as workdir:
         for name in a.cases.split(","):
