@@ -36,6 +36,13 @@ struct PairForceBound {
   double thinnest = 1.0;     // the thinnest slab mu (barycentric): ~ depth / size when pressed
 };
 
+inline double longest_edge_squared(const Vec3 (&x)[4]) {
+  double longest = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (x[a] - x[b]).squaredNorm());
+  return longest;
+}
+
 // Prisms are formed from slabs thinner than this (barycentric units) only: a thicker slab's prism
 // is rarely the smallest, and each costs a cross product and a square root.
 constexpr double kPrismSlab = 1e-2;
@@ -61,24 +68,23 @@ inline double slab_depths(const TetPairFrame& frame, double (&mu)[8]) {
 inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (&mu)[8],
                                        double penalty) {
   const Vec3* gradient[8];
-  const double* gradient_norm[8];
   double potential_bound[2], gradient_max[2], volume[2];
   int thin[8], thin_count = 0;  // slabs thin enough for their prisms to matter
   for (int T = 0; T < 2; ++T) {
-    double smallest_mu = 1.0;
+    double smallest_mu = 1.0, largest_gradient_squared = 0.0;
     for (int a = 0; a < 4; ++a) {
       const int k = 4 * T + a;
       smallest_mu = std::min(smallest_mu, mu[k]);
       gradient[k] = &frame.map[T].gradient[a];
-      gradient_norm[k] = &frame.shape(T).gradient_norm[a];
+      largest_gradient_squared = std::max(largest_gradient_squared, gradient[k]->squaredNorm());
       if (mu[k] < kPrismSlab) thin[thin_count++] = k;
     }
     potential_bound[T] = 4.0 * smallest_mu;
-    gradient_max[T] = frame.shape(T).largest_gradient;
-    volume[T] = frame.shape(T).volume;
+    gradient_max[T] = std::sqrt(largest_gradient_squared);
+    volume[T] = std::abs(frame.map[T].edge_det) / 6.0;
   }
-  const double length =
-      std::sqrt(std::min(frame.shape(0).longest_edge_squared, frame.shape(1).longest_edge_squared));
+  const double length = std::sqrt(
+      std::min(longest_edge_squared(frame.local[0]), longest_edge_squared(frame.local[1])));
 
   // Whole tets: face a's area is 3V |grad lambda_a| <= 3V G_T.
   double volume_bound = std::min(volume[0], volume[1]);
@@ -88,14 +94,11 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
   for (int i = 0; i < thin_count; ++i)
     for (int j = i + 1; j < thin_count; ++j) {
       const int k = thin[i], l = thin[j];
-      const TetShape& shape = frame.shape(k / 4);  // (k < l: one tet when k / 4 == l / 4)
-      const double cross = k / 4 == l / 4 && shape.has_cross
-                               ? shape.gradient_cross[k % 4][l % 4]
-                               : gradient[k]->cross(*gradient[l]).norm();
+      const double cross = gradient[k]->cross(*gradient[l]).norm();
       if (!(cross > 0.0)) continue;
       const double section = mu[k] * mu[l] / cross;
       const double perimeter =
-          2.0 * (mu[k] * *gradient_norm[l] + mu[l] * *gradient_norm[k]) / cross;
+          2.0 * (mu[k] * gradient[l]->norm() + mu[l] * gradient[k]->norm()) / cross;
       volume_bound = std::min(volume_bound, section * length);
       surface_bound = std::min(surface_bound, 2.0 * section + perimeter * length);
     }
@@ -129,22 +132,23 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty
 // term it cancelled (<= Phi_T S on T's nodes; potential_contact.cpp adds it, so the forces stay
 // the gradient of the kept energy).  A tet whose every piece is sure to exceed `above` (or that
 // has no slab thinner than kPrismSlab) gets infinity, uncomputed.
-inline void piece_force_bounds(TetPairFrame& frame, const double (&mu)[8],
+inline void piece_force_bounds(const TetPairFrame& frame, const double (&mu)[8],
                                const PairForceBound& pair, double above, double (&bound)[8]) {
   for (int T = 0; T < 2; ++T) {
     for (int i = 0; i < 4; ++i) bound[4 * T + i] = std::numeric_limits<double>::infinity();
     const double* own = mu + 4 * T;
     const double thinnest_own = std::min(std::min(own[0], own[1]), std::min(own[2], own[3]));
     if (!(thinnest_own < kPrismSlab)) continue;
-    const TetShape& shape = frame.shape(T);
-    const double* norm = shape.gradient_norm;
-    const double largest = shape.largest_gradient;
+    const Vec3* gradient = frame.map[T].gradient;
+    double norm[4], largest = 0.0;
+    for (int a = 0; a < 4; ++a) largest = std::max(largest, norm[a] = gradient[a].norm());
     // Every section below is at least m_T² / G_T² (|g_a × g_b| <= G_T²).
     const double least_volume =
         std::min(pair.volume, thinnest_own * thinnest_own * pair.length / (largest * largest));
     if (!(4.0 * largest * least_volume <= above)) continue;
-    if (!shape.has_cross) fill_gradient_cross(frame.map[1], frame.target_shape());  // T == 1
-    const double(&cross)[4][4] = shape.gradient_cross;
+    double cross[4][4];
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) cross[a][b] = gradient[a].cross(gradient[b]).norm();
     for (int i = 0; i < 4; ++i) {
       double nu[4];
       for (int a = 0; a < 4; ++a) nu[a] = a == i ? thinnest_own : own[a];
@@ -174,7 +178,7 @@ inline void piece_force_bounds(TetPairFrame& frame, const double (&mu)[8],
 constexpr double kPressedFaceShare = 1e-3;
 constexpr unsigned kEveryPiece = 0xFFu;
 
-inline unsigned negligible_parts(TetPairFrame& frame, double tolerance) {
+inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   constexpr double kThinSlab = 1e-3;
   double mu[8];
   if (!(slab_depths(frame, mu) < kThinSlab)) return 0;

@@ -136,6 +136,7 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
 void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned left_out,
                     SideIntegrals& out) {
   const BarycentricMap& own_map = frame.map[own];
+  const BarycentricMap& other_map = frame.map[1 - own];
   const double(&other_at_corner)[4][4] = frame.lambda_other[own];
   const double(&own_at_other_corner)[4][4] = frame.lambda_other[1 - own];
   // Other tet's barycentrics at the own centroid: the corner average (so that a corner set
@@ -149,7 +150,7 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
   // value keeps "outward" outward for either orientation); rows of D^-1 are grad lambda_1..3.
   double area_weight[4][3];
   for (int j = 0; j < 4; ++j) {
-    const Vec3 normal = -frame.shape(1 - own).inward_normal[j];
+    const Vec3 normal = -other_map.gradient[j].normalized();
     for (int k = 0; k < 3; ++k)
       area_weight[j][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
   }
@@ -199,7 +200,7 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
       const unsigned slots = flux_slots & ~(1u << i);
       for (int slot = 0; slot < 4; ++slot) {
         if (!((slots >> slot) & 1u)) continue;
-        const Vec3& normal = frame.shape(own).side_normal[i][slot];
+        const Vec3 normal = (own_map.gradient[i] - own_map.gradient[slot]).normalized();
         for (int k = 0; k < 3; ++k)
           side_weight[slot][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
       }
@@ -208,11 +209,8 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
   }
 }
 
-ContactPairResult assemble(TetPairFrame& frame, double penalty, unsigned left_out = 0) {
+ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned left_out = 0) {
   ContactPairResult r = zero_result();
-  // The planes between a left-out piece and its kept neighbours (a contactor's shape has them).
-  if ((left_out >> 4) && !frame.shape(1).has_side_normals)
-    fill_side_normals(frame.map[1], frame.target_shape());
 
   SideIntegrals side[2];
   // (side 0 carries the other tet's moments too: they give the centroid's weights)
@@ -238,7 +236,8 @@ ContactPairResult assemble(TetPairFrame& frame, double penalty, unsigned left_ou
     const BarycentricMap& own = frame.map[s];
     const SideIntegrals& other_side = side[1 - s];  // its surfaces lie on this tet's faces
     for (int i = 0; i < 4; ++i) energy += vol_integral[s][i][i];
-    const Vec3(&inward_normal)[4] = frame.shape(s).inward_normal;  // of own face i
+    Vec3 inward_normal[4];  // of own face i: grad lambda_i / |grad lambda_i|
+    for (int i = 0; i < 4; ++i) inward_normal[i] = own.gradient[i].normalized();
     for (int a = 0; a < 4; ++a) {
       Vec3 f = Vec3::Zero();
       for (int i = 0; i < 4; ++i) {
@@ -257,7 +256,7 @@ ContactPairResult assemble(TetPairFrame& frame, double penalty, unsigned left_ou
       if (!((left_out >> (4 * s + i)) & 1u)) continue;
       for (int k = 0; k < 4; ++k) {
         if (k == i || !((side[s].nonempty >> k) & 1u)) continue;  // an empty piece shares nothing
-        const Vec3& normal = frame.shape(s).side_normal[k][i];
+        const Vec3 normal = (own.gradient[k] - own.gradient[i]).normalized();
         for (int a = 0; a < 4; ++a)
           force[s][a] -= (penalty * side[s].flux[k][i][a] * (1.0 / 24.0)) * normal;
       }
@@ -311,9 +310,6 @@ ContactPairResult potential_contact_unculled(const TetCorners& contactor, const 
     return zero_result();
   barycentric_at_corners(frame.map[1], frame.local[0], frame.lambda_other[0]);
   barycentric_at_corners(frame.map[0], frame.local[1], frame.lambda_other[1]);
-  for (int s = 0; s < 2; ++s)
-    make_tet_shape(frame.map[s], frame.local[s], s == 0, frame.own_shape[s]);
-  frame.contactor_shape = &frame.own_shape[0];
   return assemble(frame, penalty);
 }
 

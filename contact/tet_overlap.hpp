@@ -143,79 +143,12 @@ inline bool separated_by_edge_axis(const TetCorners& a, const TetCorners& b) {
   return false;
 }
 
-// What every pair of a tet uses of its shape, from its map and local corners: computed once per
-// contactor and once per target and pair, instead of in each of the kernel's parts.
-struct TetShape {
-  Vec3 inward_normal[4];          // grad lambda_a / |grad lambda_a| (unit)
-  double gradient_norm[4];        // |grad lambda_a| = 1 / altitude over face a (1/m)
-  double largest_gradient;        // max_a |grad lambda_a| (1/m)
-  double volume;                  // m^3
-  double longest_edge_squared;    // m^2
-  bool has_cross = false;         // gradient_cross is filled
-  double gradient_cross[4][4];    // [a][b], a < b: |grad lambda_a × grad lambda_b| (1/m^2)
-  bool has_side_normals = false;  // side_normal is filled
-  Vec3 side_normal[4][4];         // [a][b], a != b: unit (grad lambda_a - grad lambda_b), the
-                                  // normal of the plane lambda_a = lambda_b out of sub-tet a
-};
-
-inline double longest_edge_squared(const Vec3 (&x)[4]) {
-  double longest = 0.0;
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (x[a] - x[b]).squaredNorm());
-  return longest;
-}
-
-inline void fill_gradient_cross(const BarycentricMap& map, TetShape& shape) {
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b)
-      shape.gradient_cross[a][b] = map.gradient[a].cross(map.gradient[b]).norm();
-  shape.has_cross = true;
-}
-
-inline void fill_side_normals(const BarycentricMap& map, TetShape& shape) {
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) {
-      shape.side_normal[a][b] = (map.gradient[a] - map.gradient[b]).normalized();
-      shape.side_normal[b][a] = -shape.side_normal[a][b];  // exact: g_b - g_a = -(g_a - g_b)
-    }
-  shape.has_side_normals = true;
-}
-
-// `local`: the corners in the frame's coordinates (their edges are what the frame's tests see).
-// with_all: also the cross products and side normals, which only some pairs need (a contactor,
-// prepared once for all its pairs, takes them all).
-inline void make_tet_shape(const BarycentricMap& map, const Vec3 (&local)[4], bool with_all,
-                           TetShape& shape) {
-  double largest_squared = 0.0;
-  for (int a = 0; a < 4; ++a) {
-    const double squared = map.gradient[a].squaredNorm();
-    largest_squared = std::max(largest_squared, squared);
-    shape.gradient_norm[a] = std::sqrt(squared);
-    shape.inward_normal[a] = map.gradient[a].normalized();
-  }
-  shape.largest_gradient = std::sqrt(largest_squared);
-  shape.volume = std::abs(map.edge_det) / 6.0;
-  shape.longest_edge_squared = longest_edge_squared(local);
-  shape.has_cross = shape.has_side_normals = false;
-  if (with_all) {
-    fill_gradient_cross(map, shape);
-    fill_side_normals(map, shape);
-  }
-}
-
 // Everything the exact kernel needs about a pair once it has passed the cheap rejection.
 struct TetPairFrame {
   Vec3 origin;                   // local origin = centroid of the contactor (m)
   Vec3 local[2][4];              // corner positions relative to origin; [0] contactor, [1] target
   BarycentricMap map[2];         // [0] contactor, [1] target
   double lambda_other[2][4][4];  // [s][v][a]: lambda of tet 1-s, component a, at corner v of s
-  // The prepared contactor's shape, or own_shape[0]; made with_all, so that only the target's
-  // optional parts are ever filled later.
-  const TetShape* contactor_shape = nullptr;
-  TetShape own_shape[2];  // [1]: the target's (filled for each pair); [0]: see contactor_shape
-  const TetShape& shape(int T) const { return T == 0 ? *contactor_shape : own_shape[1]; }
-  // The target's shape, whose optional parts are filled when a pair needs them.
-  TetShape& target_shape() { return own_shape[1]; }
 };
 
 // A contactor's share of its pairs' frames, prepared once for all its pairs (the contact stage
@@ -227,7 +160,6 @@ struct PreparedContactor {
   Vec3 origin;    // the centroid (m)
   Vec3 local[4];  // corners - origin (m)
   BarycentricMap map{};
-  TetShape shape{};
   bool valid = false;  // false: degenerate, overlaps nothing
 };
 
@@ -237,7 +169,6 @@ inline void prepare_contactor(const TetCorners& contactor, PreparedContactor& ou
   out.origin = tet_centroid(contactor);
   for (int v = 0; v < 4; ++v) out.local[v] = contactor.x[v] - out.origin;
   out.valid = make_barycentric_map(contactor, out.origin, out.map);
-  if (out.valid) make_tet_shape(out.map, out.local, true, out.shape);
 }
 
 // Bounding boxes, then the 4+4 face planes.  False when the pair certainly does not overlap
@@ -257,8 +188,6 @@ inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetCorner
   if (separated_by_face_plane(frame.lambda_other[0])) return false;
   barycentric_at_corners(frame.map[0], frame.local[1], frame.lambda_other[1]);
   if (separated_by_face_plane(frame.lambda_other[1])) return false;
-  frame.contactor_shape = &contactor.shape;
-  make_tet_shape(frame.map[1], frame.local[1], false, frame.target_shape());
   return true;
 }
 

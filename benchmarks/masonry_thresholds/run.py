@@ -7,6 +7,7 @@ from the start at `ratio` × the rigid-block threshold and held under local damp
   benchmarks/masonry_thresholds/run.py [--fdem build/drivers/fdem] [--cases all|NAME,...]
                                        [--ratios all|R,...] [--hold-scale 1]
                                        [--equilibrium-ratio R] [--penalty-factor F]
+                                       [--set KEY=VALUE ...]
                                        [--csv docs/data/masonry_thresholds.csv]
   benchmarks/masonry_thresholds/run.py --references   # the rigid-block values only
 
@@ -223,13 +224,15 @@ def outcome(rows, still, moving):
     return "undecided", u[-1], d1
 
 
-def run(fdem, text, workdir):
+def run(fdem, text, workdir, overrides=()):
     path = os.path.join(workdir, "scene.yaml")
     with open(path, "w") as f:
         f.write(text)
     out = os.path.join(workdir, "out")
-    timing = subprocess.run(["/usr/bin/time", "-f", "%U", fdem, "run", path, "-o", out, "-q"],
-                            capture_output=True, text=True)
+    command = ["/usr/bin/time", "-f", "%U", fdem, "run", path, "-o", out, "-q"]
+    for o in overrides:
+        command += ["--set", o]
+    timing = subprocess.run(command, capture_output=True, text=True)
     if timing.returncode != 0:
         sys.exit(f"fdem failed:\n{timing.stderr}")
     cpu = float(timing.stderr.strip().splitlines()[-1])
@@ -251,6 +254,9 @@ def main():
                    help="multiplies every hold (a quick check of the script: 0.1)")
     p.add_argument("--penalty-factor", type=float, default=0.0,
                    help="contact penalty as a multiple of E (default: the scene's auto, 10 E)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="a scene override passed to every hold (fdem run --set), e.g. "
+                        "contact.sliver_tolerance=1e-8")
     p.add_argument("--equilibrium-ratio", type=float, default=0.0,
                    help="end holds at equilibrium (quasi_static.equilibrium_ratio), e.g. 1e-4")
     a = p.parse_args()
@@ -281,7 +287,7 @@ def main():
             text = text.replace("contact: {friction: 0.8}",
                                 "contact: {friction: 0.8, penalty: %g}" % (a.penalty_factor * 1.0e9))
         with tempfile.TemporaryDirectory() as workdir:
-            rows, cpu, steps, at_equilibrium = run(a.fdem, text, workdir)
+            rows, cpu, steps, at_equilibrium = run(a.fdem, text, workdir, a.set)
         verdict, end, d1 = outcome(rows, still, moving)
         if at_equilibrium:
             verdict = "stands (equilibrium)"
@@ -290,6 +296,7 @@ def main():
         results.append({"problem": name, "ratio": ratio, "reference": refs[name], "hold_s": hold,
                         "equilibrium_ratio": a.equilibrium_ratio,
                         "penalty_factor": a.penalty_factor or 10.0,
+                        "overrides": " ".join(a.set),
                         "steps": steps, "cpu_s": cpu, "displacement_m": end,
                         "last_window_m": d1, "outcome": verdict})
     os.makedirs(os.path.dirname(a.csv), exist_ok=True)
