@@ -324,7 +324,7 @@ struct Scene {
   bool contact_exact_narrowing = true;  // contact.narrowing (ContactSettings::exact_narrowing)
   double contact_friction_anchor_lag = 0.05;  // s, contact.friction_anchor_lag
   bool contact_body_dashpot = true;           // contact.dashpot (ContactSettings::body_dashpot)
-  double contact_sliver_tolerance = 1e-9;     // contact.sliver_tolerance (ContactSettings)
+  double contact_sliver_tolerance = 1e-6;     // contact.sliver_tolerance (ContactSettings)
   ParallelSpec parallel;
   LimitsSpec limits;
 

@@ -5,7 +5,7 @@ default tolerance against 0 (every pair the face planes pass is integrated, the 
 algorithm), alternating in one invocation, one core each.
 
   benchmarks/contact_slivers/run.py [--fdem build/drivers/fdem] [--repeats 3]
-      [--tolerances 0,1e-9] [--cases wall_tilt,arch,tower,dry_wall]
+      [--tolerances 0,1e-6] [--cases wall_tilt,arch,tower,dry_wall]
       [--baseline OLD_FDEM [--baseline-tolerance none]] [--csv docs/data/bench_contact_slivers.csv]
 
 With --baseline, a third variant runs that binary (an older build) at the last tolerance, in the
@@ -107,7 +107,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--fdem", default=os.path.join(root, "build", "drivers", "fdem"))
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--tolerances", default="0,1e-9")
+    ap.add_argument("--tolerances", default="0,1e-6")
     ap.add_argument("--cases", default="wall_tilt,arch,tower,dry_wall")
     ap.add_argument("--baseline", help="an older fdem binary, run at the last tolerance")
     ap.add_argument("--baseline-tolerance",

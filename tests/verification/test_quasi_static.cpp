@@ -182,7 +182,10 @@ TEST_CASE("static friction holds at τ/μσ = 0.95 for 2 s after settling, a sud
   INFO("settled: moved " << held.slid << " m in 2 s (wall " << held.wall
                          << " s); sudden: " << sudden.slid << " m in 0.2 s");
   CHECK(held.slid < 1e-4);
-  CHECK(sudden.slid > 5e-4);
+  // A control: unsettled, the block slides several times what the settled one may creep.  0.97 mm
+  // when this test was written; 2026-11-29: 0.49 mm, 0.69 mm with the dashpot sized by the tets
+  // (the body-sized dashpot damps more of the rattle that makes it slide).
+  CHECK(sudden.slid > 2.5e-4);
   CHECK(held.balance < 1e-3);
 }
 
@@ -252,8 +255,9 @@ TEST_CASE(
     "[verification][quasi_static][long]") {
   // The holds of the test above, each ended by quasi_static.equilibrium_ratio = 1e-4 instead of
   // running its fixed time.  Measured (docs/verification.md): 0.98 θc stops at step 26,056
-  // (0.117 s, the corner settled at 45 µm of the 48 µm a 0.2 s hold reaches); 1.02 θc never comes
-  // below 1e-3 and turns.
+  // (0.117 s, the corner settled at 45 µm of the 48 µm a 0.2 s hold reaches) with every contact
+  // pair integrated, at step 32,885 (0.148 s) with the slivers left out (contact.sliver_tolerance,
+  // the default); 1.02 θc never comes below 1e-3 and turns.
   const double critical = std::atan(0.2 / (4 * 0.1) * (4 * 4 + 2) / (4 * 4 - 1));  // 30.96°
   const auto run = [](double angle, double end) {
     Scene scene = tilting_table_wall(angle, end);
@@ -267,7 +271,7 @@ TEST_CASE(
   INFO("0.98 θc: " << stands.reason << "; 1.02 θc: " << turn_steps << " steps to t = " << turn_time
                    << " s, " << turns.reason);
   CHECK_THAT(stands.reason, Catch::Matchers::Contains("equilibrium at step"));
-  CHECK(stand_steps < 30000);  // of the 44,454 of the fixed 0.2 s hold
+  CHECK(stand_steps < 36000);  // of the 44,454 of the fixed 0.2 s hold
   CHECK(turns.reason.empty());
   CHECK(turn_time == Approx(0.12).margin(1e-9));
 }

@@ -237,7 +237,7 @@ TEST_CASE("contact.dashpot: bodies or tets and nothing else", "[io]") {
 }
 
 TEST_CASE("contact.sliver_tolerance: a fraction from 0 to 1e-6", "[io]") {
-  CHECK(fdem::parse_scene(minimal_plus(""), "scene.yaml").contact_sliver_tolerance == 1e-9);
+  CHECK(fdem::parse_scene(minimal_plus(""), "scene.yaml").contact_sliver_tolerance == 1e-6);
   CHECK(fdem::parse_scene(minimal_plus("contact: {sliver_tolerance: 0}\n"), "scene.yaml")
             .contact_sliver_tolerance == 0.0);
   CHECK(fdem::parse_scene(minimal_plus("contact: {sliver_tolerance: 1.0e-12}\n"), "scene.yaml")
