@@ -311,7 +311,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     const int ma = tets.material[pair.a], mb = tets.material[pair.b];
     const double penalty = std::min(penalty_[ma], penalty_[mb]);
     const double mu = std::min(friction_coefficient_[ma], friction_coefficient_[mb]);
-    const ContactPairResult r = potential_contact(contactor, b, penalty, sliver_tolerance_);
+    PairGradients gradients;  // for friction: the kernel's maps of both tets
+    const ContactPairResult r =
+        potential_contact(contactor, b, penalty, sliver_tolerance_, gradients.target);
     const PairId key{tets.gid[pair.a], tets.gid[pair.b]};
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
@@ -402,16 +404,12 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
           history.follow(r, -std::expm1(-dt / friction_anchor_lag_));
       }
       FrictionPoint point = centroid_point(r);
-      // The kernel found both tets sound; the contactor's gradients are those it used.
-      PairGradients gradients;
+      // An overlapping pair's tets are sound: the kernel built both maps.
       std::copy_n(contactor.map.gradient, 4, gradients.contactor);
-      for (Vec3& g : gradients.target) g.setZero();  // (written below unless degenerate)
-      double det = 0.0;
-      const bool sound = barycentric_gradients(b, gradients.target, det);
-      if (history.attached() && sound) spring_point(history, a, b, gradients, point);
+      if (history.attached()) spring_point(history, a, b, gradients, point);
       const FrictionResult f =
           coulomb_friction(law, r, point, relative_velocity_at(point, va, vb), dt, history);
-      if (f.slipping && history.attached() && sound) slide_anchors(history, gradients, f.slip);
+      if (f.slipping && history.attached()) slide_anchors(history, gradients, f.slip);
       double* friction_force = writable(friction_force_, friction_written_);
       for (int c = 0; c < 4; ++c) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];

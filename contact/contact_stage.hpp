@@ -239,11 +239,12 @@ class ContactStage {
   std::vector<LocalIndex> bonds_;  // 4 per tet: partner bonded by an intact joint, or −1
   using JointState = TetJointState;
   std::vector<JointState> joint_state_;
-  bool skip_enclosed_ = true;
-  bool exact_narrowing_ = true;
-  double friction_anchor_lag_ = 0.05;       // s
-  bool body_dashpot_ = true;                // ContactSettings::body_dashpot
-  double sliver_tolerance_ = 1e-6;          // ContactSettings::sliver_tolerance (-)
+  // The settings' own defaults (the constructor sets every one from its ContactSettings).
+  bool skip_enclosed_ = ContactSettings{}.skip_enclosed;
+  bool exact_narrowing_ = ContactSettings{}.exact_narrowing;
+  double friction_anchor_lag_ = ContactSettings{}.friction_anchor_lag;  // s
+  bool body_dashpot_ = ContactSettings{}.body_dashpot;
+  double sliver_tolerance_ = ContactSettings{}.sliver_tolerance;  // (-)
   std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;

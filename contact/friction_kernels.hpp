@@ -102,7 +102,7 @@ inline FrictionPoint centroid_point(const ContactPairResult& pair) {
 }
 
 // Barycentric gradients of a pair's two tets (1/m).  They do not depend on the origin of the
-// map, so one computation serves every point a step looks at; false for a degenerate tet.
+// map, so the kernel's serve every point a step looks at.
 struct PairGradients {
   Vec3 contactor[4], target[4];
 };

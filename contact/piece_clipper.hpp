@@ -123,6 +123,8 @@ struct SideIntegrals {
   // [sub-tet k][slot s][own node a]: ∫ 4 lambda_k lambda_a dS * 24 (physical area) over piece k's
   // face on the plane it shares with sub-tet s (lambda_k = lambda_s), for left-out pieces s only
   double flux[4][4][4];
+  // [sub-tet k][slot s]: unit normal of that plane out of sub-tet k (where flux[k][s] is written)
+  Vec3 flux_normal[4][4];
 };
 
 inline ContactPairResult zero_result() {

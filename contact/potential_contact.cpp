@@ -1,4 +1,5 @@
 // Exact potential contact between two tets; see potential_contact_kernels.hpp for the formulas.
+#include <algorithm>
 #include <cmath>
 
 #include "contact/pair_force_bound.hpp"
@@ -200,7 +201,8 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
       const unsigned slots = flux_slots & ~(1u << i);
       for (int slot = 0; slot < 4; ++slot) {
         if (!((slots >> slot) & 1u)) continue;
-        const Vec3 normal = (own_map.gradient[i] - own_map.gradient[slot]).normalized();
+        const Vec3& normal = out.flux_normal[i][slot] =
+            (own_map.gradient[i] - own_map.gradient[slot]).normalized();
         for (int k = 0; k < 3; ++k)
           side_weight[slot][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
       }
@@ -256,7 +258,7 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned l
       if (!((left_out >> (4 * s + i)) & 1u)) continue;
       for (int k = 0; k < 4; ++k) {
         if (k == i || !((side[s].nonempty >> k) & 1u)) continue;  // an empty piece shares nothing
-        const Vec3 normal = (own.gradient[k] - own.gradient[i]).normalized();
+        const Vec3& normal = side[s].flux_normal[k][i];
         for (int a = 0; a < 4; ++a)
           force[s][a] -= (penalty * side[s].flux[k][i][a] * (1.0 / 24.0)) * normal;
       }
@@ -274,12 +276,15 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned l
 }  // namespace
 
 ContactPairResult potential_contact(const PreparedContactor& contactor, const TetCorners& target,
-                                    double penalty, double sliver_tolerance) {
+                                    double penalty, double sliver_tolerance,
+                                    Vec3* target_gradients) {
   TetPairFrame frame;
   if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
   const unsigned left_out = sliver_tolerance > 0.0 ? negligible_parts(frame, sliver_tolerance) : 0u;
   if (left_out == kEveryPiece) return zero_result();
-  return assemble(frame, penalty, left_out);
+  const ContactPairResult r = assemble(frame, penalty, left_out);
+  if (r.overlapping && target_gradients) std::copy_n(frame.map[1].gradient, 4, target_gradients);
+  return r;
 }
 
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,

@@ -61,8 +61,11 @@ ContactPairResult potential_contact_without(const TetCorners& contactor, const T
                                             double penalty, unsigned left_out);
 
 // The same with the contactor prepared once for all its pairs (tet_overlap.hpp): bit for bit.
+// For an overlapping pair, target_gradients (when given, 4 entries) receives the target's
+// barycentric gradients (1/m) that the kernel used, for friction.
 ContactPairResult potential_contact(const PreparedContactor& contactor, const TetCorners& target,
-                                    double penalty, double sliver_tolerance = 0.0);
+                                    double penalty, double sliver_tolerance = 0.0,
+                                    Vec3* target_gradients = nullptr);
 
 // The exact integration alone, with only the degenerate-tet check (no box or face-plane
 // rejection).  Same results as potential_contact for every pair that passes the rejection;
