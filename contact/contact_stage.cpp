@@ -131,6 +131,7 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
   detected_ = detected;
   travel_bound_ = std::numeric_limits<double>::infinity();  // x_at_detection is not x now
   pairs_.clear();
+  candidates_changed();
   release(x_at_detection_);
   release(kept_nodes_);
   every_node_kept_ = true;
@@ -159,7 +160,7 @@ void ContactStage::rebind(const Model& model, std::vector<double> x_at_detection
     pairs_.push_back({a->second, b->second});
   }
   std::sort(pairs_.begin(), pairs_.end());
-  may_hold_friction_.assign(pairs_.size(), 1);
+  candidates_changed();
   keep();
 }
 
@@ -229,10 +230,53 @@ std::vector<GidPair> ContactStage::candidate_gids(const Model& model) const {
   return out;  // pairs_ is in ascending (a, b) and local tets in ascending gid
 }
 
+void ContactStage::candidates_changed() {
+  may_hold_friction_.assign(pairs_.size(), 1);
+  release(friction_of_pair_);
+  pair_slots_.clear();
+  pair_tets_.clear();
+}
+
+void ContactStage::index_pair_tets() {
+  pair_tets_.clear();
+  pair_tets_.reserve(pairs_.size());
+  for (const CandidatePair& p : pairs_) {
+    pair_tets_.push_back(p.a);
+    pair_tets_.push_back(p.b);
+  }
+  std::sort(pair_tets_.begin(), pair_tets_.end());
+  pair_tets_.erase(std::unique(pair_tets_.begin(), pair_tets_.end()), pair_tets_.end());
+  pair_tets_.shrink_to_fit();
+  pair_slots_.resize(2 * pairs_.size());
+  const auto slot = [&](LocalIndex t) {
+    return static_cast<std::int32_t>(std::lower_bound(pair_tets_.begin(), pair_tets_.end(), t) -
+                                     pair_tets_.begin());
+  };
+  for (std::size_t i = 0; i < pairs_.size(); ++i) {
+    pair_slots_[2 * i] = slot(pairs_[i].a);
+    pair_slots_[2 * i + 1] = slot(pairs_[i].b);
+  }
+}
+
+void ContactStage::update_tet_geometry(const Model& model) {
+  if (pair_slots_.size() != 2 * pairs_.size()) index_pair_tets();
+  tet_geometry_.resize(pair_tets_.size());
+  for (std::size_t i = 0; i < pair_tets_.size(); ++i) {
+    TetCorners corners;
+    for (int c = 0; c < 4; ++c)
+      corners.x[c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * pair_tets_[i] + c]);
+    compute_tet_geometry(corners, tet_geometry_[i]);
+  }
+}
+
 void ContactStage::release_until_rebind() {
   release(pairs_);
   release(overlapping_);
   release(may_hold_friction_);
+  release(friction_of_pair_);
+  release(pair_tets_);
+  release(pair_slots_);
+  release(tet_geometry_);
   release(records_);
   release(boxes_);
   release(x_at_detection_);
@@ -293,34 +337,40 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   };
   clear(friction_force_, friction_written_);
   clear(damping_force_, damping_written_);
+  update_tet_geometry(model);
   // Pairs come in contactor order: each contactor is prepared once for all its pairs.
   PreparedContactor contactor;
   LocalIndex prepared = -1;
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
     const CandidatePair& pair = pairs_[index];
+    const TetGeometry& geometry_a = tet_geometry_[pair_slots_[2 * index]];
+    const TetGeometry& geometry_b = tet_geometry_[pair_slots_[2 * index + 1]];
+    const int ma = tets.material[pair.a], mb = tets.material[pair.b];
+    const double mu = std::min(friction_coefficient_[ma], friction_coefficient_[mb]);
+    const auto lost = [&] {  // not overlapping: a stick spring is released
+      if (mu > 0.0 && may_hold_friction_[index]) {
+        friction_.erase(PairId{tets.gid[pair.a], tets.gid[pair.b]});
+        if (!friction_of_pair_.empty()) friction_of_pair_[index] = nullptr;
+      }
+      may_hold_friction_[index] = 0;
+    };
+    if (!boxes_intersect(geometry_a.box, geometry_b.box)) {  // most candidates, most steps
+      lost();
+      continue;
+    }
     if (pair.a != prepared) {
-      TetCorners corners;
-      for (int c = 0; c < 4; ++c)
-        corners.x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * pair.a + c]);
-      prepare_contactor(corners, contactor);
+      prepare_contactor(geometry_a, contactor);
       prepared = pair.a;
     }
-    const TetCorners& a = contactor.corners;
-    TetCorners b;
-    for (int c = 0; c < 4; ++c) b.x[c] = vec3_at(nodes.x.data(), tets.nodes[4 * pair.b + c]);
-    const int ma = tets.material[pair.a], mb = tets.material[pair.b];
+    const TetCorners& a = geometry_a.corners;
+    const TetCorners& b = geometry_b.corners;
     const double penalty = std::min(penalty_[ma], penalty_[mb]);
-    const double mu = std::min(friction_coefficient_[ma], friction_coefficient_[mb]);
-    PairGradients gradients;  // for friction: the kernel's maps of both tets
     const ContactPairResult r =
-        potential_contact(contactor, b, penalty, sliver_tolerance_, gradients.target);
-    const PairId key{tets.gid[pair.a], tets.gid[pair.b]};
+        potential_contact(contactor, geometry_b, penalty, sliver_tolerance_);
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
     if (!r.overlapping) {
-      if (mu > 0.0 && may_hold_friction_[index])
-        friction_.erase(key);  // contact lost: the stick spring is released
-      may_hold_friction_[index] = 0;
+      lost();
       continue;
     }
     overlapping_[index] = 1;
@@ -387,7 +437,10 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     if (mu > 0.0) {
       // Stick spring k_t = p·s (N/m) with s the pair's size: as stiff as the normal contact.
       // (set once per contact: the pair's reference volumes do not change)
-      PairFriction& pair_friction = friction_[key];
+      if (friction_of_pair_.empty()) friction_of_pair_.assign(pairs_.size(), nullptr);
+      PairFriction*& entry = friction_of_pair_[index];
+      if (!entry) entry = &friction_[PairId{tets.gid[pair.a], tets.gid[pair.b]}];
+      PairFriction& pair_friction = *entry;
       if (!(pair_friction.stiffness > 0.0))
         pair_friction.stiffness =
             penalty * std::cbrt(std::abs(tets.volume0[pair.a]) + std::abs(tets.volume0[pair.b]));
@@ -404,8 +457,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
           history.follow(r, -std::expm1(-dt / friction_anchor_lag_));
       }
       FrictionPoint point = centroid_point(r);
-      // An overlapping pair's tets are sound: the kernel built both maps.
-      std::copy_n(contactor.map.gradient, 4, gradients.contactor);
+      PairGradients gradients;  // an overlapping pair's tets are sound: both have their maps
+      std::copy_n(geometry_a.gradient, 4, gradients.contactor);
+      std::copy_n(geometry_b.gradient, 4, gradients.target);
       if (history.attached()) spring_point(history, a, b, gradients, point);
       const FrictionResult f =
           coulomb_friction(law, r, point, relative_velocity_at(point, va, vb), dt, history);

@@ -211,6 +211,19 @@ class ContactStage {
   // the list is new since): only those pay a map lookup when they do not overlap.
   std::vector<std::uint8_t> may_hold_friction_;
   std::vector<ContactRecord> records_;
+  // The distinct tets of pairs_ (ascending), per pair the indices of its two tets in that list
+  // (2 per pair), and their geometry, computed once per step for all their pairs (a surface tet
+  // of a dense pile is in ~14 pairs; rejecting a pair then costs a box test).  The lists follow
+  // pairs_ (candidates_changed); the geometry is per step.
+  std::vector<LocalIndex> pair_tets_;
+  std::vector<std::int32_t> pair_slots_;
+  std::vector<TetGeometry> tet_geometry_;
+  // Fills pair_tets_ and pair_slots_ for the current pairs_.
+  void index_pair_tets();
+  // tet_geometry_ at the current positions (indexing the pairs' tets first when pairs_ changed).
+  void update_tet_geometry(const Model& model);
+  // Per-pair state starts afresh after pairs_ changed.
+  void candidates_changed();
   // Friction history per pair, keyed by the two tets' global ids; kept across re-detection.
   struct PairFriction {
     FrictionHistory history;
@@ -231,6 +244,10 @@ class ContactStage {
     }
   };
   std::unordered_map<PairId, PairFriction, PairIdHash> friction_;
+  // Per candidate pair: its entry in friction_ once looked up (null: not yet, or none), so that a
+  // lasting contact pays one hash lookup, not one per step.  Entries of an unordered_map stay
+  // put; every erase clears the pointer to it (the pair's own, or all with candidates_changed).
+  std::vector<PairFriction*> friction_of_pair_;
   std::vector<double> friction_coefficient_, damping_ratio_;
   // Friction and dashpot forces of the last add_forces per local node (N, xyz), for their work;
   // empty until a step writes such a force.

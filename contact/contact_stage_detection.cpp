@@ -182,7 +182,7 @@ void ContactStage::run_detection(const Model& model, const double* x) {
   release(boxes_);
   if (!all)
     for (CandidatePair& p : pairs_) p = {tet(p.a), tet(p.b)};
-  may_hold_friction_.assign(pairs_.size(), 1);
+  candidates_changed();
 }
 
 // The pairs a detection at the positions of the last one would add after the eligibility of the
@@ -228,7 +228,7 @@ void ContactStage::add_pairs_of(const Model& model, const std::vector<LocalIndex
   pairs_.insert(pairs_.end(), added.begin(), added.end());
   std::inplace_merge(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(old_size),
                      pairs_.end());
-  may_hold_friction_.assign(pairs_.size(), 1);
+  candidates_changed();
 }
 
 void ContactStage::set_bonds(LocalIndex n_tets,

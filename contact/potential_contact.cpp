@@ -275,16 +275,13 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned l
 
 }  // namespace
 
-ContactPairResult potential_contact(const PreparedContactor& contactor, const TetCorners& target,
-                                    double penalty, double sliver_tolerance,
-                                    Vec3* target_gradients) {
+ContactPairResult potential_contact(const PreparedContactor& contactor, const TetGeometry& target,
+                                    double penalty, double sliver_tolerance) {
   TetPairFrame frame;
   if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
   const unsigned left_out = sliver_tolerance > 0.0 ? negligible_parts(frame, sliver_tolerance) : 0u;
   if (left_out == kEveryPiece) return zero_result();
-  const ContactPairResult r = assemble(frame, penalty, left_out);
-  if (r.overlapping && target_gradients) std::copy_n(frame.map[1].gradient, 4, target_gradients);
-  return r;
+  return assemble(frame, penalty, left_out);
 }
 
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,
@@ -292,7 +289,9 @@ ContactPairResult potential_contact(const TetCorners& contactor, const TetCorner
   if (!tet_boxes_intersect(contactor, target)) return zero_result();
   PreparedContactor prepared;
   prepare_contactor(contactor, prepared);
-  return potential_contact(prepared, target, penalty, sliver_tolerance);
+  TetGeometry geometry;
+  compute_tet_geometry(target, geometry);
+  return potential_contact(prepared, geometry, penalty, sliver_tolerance);
 }
 
 ContactPairResult potential_contact_without(const TetCorners& contactor, const TetCorners& target,

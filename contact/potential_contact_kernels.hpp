@@ -60,12 +60,10 @@ ContactPairResult potential_contact(const TetCorners& contactor, const TetCorner
 ContactPairResult potential_contact_without(const TetCorners& contactor, const TetCorners& target,
                                             double penalty, unsigned left_out);
 
-// The same with the contactor prepared once for all its pairs (tet_overlap.hpp): bit for bit.
-// For an overlapping pair, target_gradients (when given, 4 entries) receives the target's
-// barycentric gradients (1/m) that the kernel used, for friction.
-ContactPairResult potential_contact(const PreparedContactor& contactor, const TetCorners& target,
-                                    double penalty, double sliver_tolerance = 0.0,
-                                    Vec3* target_gradients = nullptr);
+// The same with the contactor prepared once for all its pairs and the target's geometry computed
+// once for all of its (tet_overlap.hpp): bit for bit.
+ContactPairResult potential_contact(const PreparedContactor& contactor, const TetGeometry& target,
+                                    double penalty, double sliver_tolerance = 0.0);
 
 // The exact integration alone, with only the degenerate-tet check (no box or face-plane
 // rejection).  Same results as potential_contact for every pair that passes the rejection;
