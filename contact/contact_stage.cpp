@@ -260,11 +260,13 @@ void ContactStage::index_pair_tets() {
 
 void ContactStage::update_tet_geometry(const Model& model) {
   if (pair_slots_.size() != 2 * pairs_.size()) index_pair_tets();
+  tet_boxes_.resize(pair_tets_.size());
   tet_geometry_.resize(pair_tets_.size());
   for (std::size_t i = 0; i < pair_tets_.size(); ++i) {
     TetCorners corners;
     for (int c = 0; c < 4; ++c)
       corners.x[c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * pair_tets_[i] + c]);
+    tet_boxes_[i] = tet_box(corners);
     compute_tet_geometry(corners, tet_geometry_[i]);
   }
 }
@@ -276,6 +278,7 @@ void ContactStage::release_until_rebind() {
   release(friction_of_pair_);
   release(pair_tets_);
   release(pair_slots_);
+  release(tet_boxes_);
   release(tet_geometry_);
   release(records_);
   release(boxes_);
@@ -341,23 +344,29 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   // Pairs come in contactor order: each contactor is prepared once for all its pairs.
   PreparedContactor contactor;
   LocalIndex prepared = -1;
+  const auto friction_of = [&](const CandidatePair& pair) {
+    return std::min(friction_coefficient_[tets.material[pair.a]],
+                    friction_coefficient_[tets.material[pair.b]]);
+  };
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
     const CandidatePair& pair = pairs_[index];
-    const TetGeometry& geometry_a = tet_geometry_[pair_slots_[2 * index]];
-    const TetGeometry& geometry_b = tet_geometry_[pair_slots_[2 * index + 1]];
-    const int ma = tets.material[pair.a], mb = tets.material[pair.b];
-    const double mu = std::min(friction_coefficient_[ma], friction_coefficient_[mb]);
+    const std::int32_t slot_a = pair_slots_[2 * index], slot_b = pair_slots_[2 * index + 1];
     const auto lost = [&] {  // not overlapping: a stick spring is released
-      if (mu > 0.0 && may_hold_friction_[index]) {
+      if (!may_hold_friction_[index]) return;
+      if (friction_of(pair) > 0.0) {
         friction_.erase(PairId{tets.gid[pair.a], tets.gid[pair.b]});
         if (!friction_of_pair_.empty()) friction_of_pair_[index] = nullptr;
       }
       may_hold_friction_[index] = 0;
     };
-    if (!boxes_intersect(geometry_a.box, geometry_b.box)) {  // most candidates, most steps
+    if (!boxes_intersect(tet_boxes_[slot_a], tet_boxes_[slot_b])) {  // most candidates and steps
       lost();
       continue;
     }
+    const TetGeometry& geometry_a = tet_geometry_[slot_a];
+    const TetGeometry& geometry_b = tet_geometry_[slot_b];
+    const int ma = tets.material[pair.a], mb = tets.material[pair.b];
+    const double mu = friction_of(pair);
     if (pair.a != prepared) {
       prepare_contactor(geometry_a, contactor);
       prepared = pair.a;

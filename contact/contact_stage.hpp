@@ -212,15 +212,18 @@ class ContactStage {
   std::vector<std::uint8_t> may_hold_friction_;
   std::vector<ContactRecord> records_;
   // The distinct tets of pairs_ (ascending), per pair the indices of its two tets in that list
-  // (2 per pair), and their geometry, computed once per step for all their pairs (a surface tet
-  // of a dense pile is in ~14 pairs; rejecting a pair then costs a box test).  The lists follow
-  // pairs_ (candidates_changed); the geometry is per step.
+  // (2 per pair), and their boxes and geometry, computed once per step for all their pairs (a
+  // surface tet of a dense pile is in ~14 pairs; rejecting a pair then costs a box test, over
+  // boxes kept apart so that they stay in cache).  The lists follow pairs_ (candidates_changed);
+  // boxes and geometry are per step.
   std::vector<LocalIndex> pair_tets_;
   std::vector<std::int32_t> pair_slots_;
+  std::vector<TetBox> tet_boxes_;
   std::vector<TetGeometry> tet_geometry_;
   // Fills pair_tets_ and pair_slots_ for the current pairs_.
   void index_pair_tets();
-  // tet_geometry_ at the current positions (indexing the pairs' tets first when pairs_ changed).
+  // tet_boxes_ and tet_geometry_ at the current positions (indexing the pairs' tets first when
+  // pairs_ changed).
   void update_tet_geometry(const Model& model);
   // Per-pair state starts afresh after pairs_ changed.
   void candidates_changed();

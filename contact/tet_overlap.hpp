@@ -151,13 +151,12 @@ struct TetPairFrame {
   double lambda_other[2][4][4];  // [s][v][a]: lambda of tet 1-s, component a, at corner v of s
 };
 
-// What a tet brings to every pair it is in: its corners, box and the origin-free part of its
+// What a tet brings to every pair it is in: its corners and the origin-free part of its
 // barycentric map.  The contact stage computes it once per tet and step for all the tet's pairs
 // (a surface tet of a dense pile is in ~14); pairs built from it equal those built from the
 // corners, bit for bit.
 struct TetGeometry {
   TetCorners corners;
-  TetBox box;
   Vec3 gradient[4];       // of the barycentric coordinates (1/m)
   double edge_det = 0.0;  // m^3
   bool valid = false;     // false: degenerate (flat or non-finite), overlaps nothing
@@ -165,7 +164,6 @@ struct TetGeometry {
 
 inline void compute_tet_geometry(const TetCorners& corners, TetGeometry& out) {
   out.corners = corners;
-  out.box = tet_box(corners);
   out.valid = barycentric_gradients(corners, out.gradient, out.edge_det);
   if (!out.valid) {  // no map: zeros rather than whatever was there
     for (Vec3& g : out.gradient) g.setZero();
@@ -174,11 +172,10 @@ inline void compute_tet_geometry(const TetCorners& corners, TetGeometry& out) {
 }
 
 // A contactor's share of its pairs' frames, prepared once for all its pairs (the contact stage
-// visits the pairs in contactor order): its geometry, centroid (the frames' origin) and
+// visits the pairs in contactor order): its corners, centroid (the frames' origin) and
 // barycentric map about it.  A frame built with it is the one built from the corners, bit for bit.
 struct PreparedContactor {
   TetCorners corners;
-  TetBox box;
   Vec3 origin;    // the centroid (m)
   Vec3 local[4];  // corners - origin (m)
   BarycentricMap map{};
@@ -187,7 +184,6 @@ struct PreparedContactor {
 
 inline void prepare_contactor(const TetGeometry& contactor, PreparedContactor& out) {
   out.corners = contactor.corners;
-  out.box = contactor.box;
   out.origin = tet_centroid(contactor.corners);
   for (int v = 0; v < 4; ++v) out.local[v] = contactor.corners.x[v] - out.origin;
   std::copy_n(contactor.gradient, 4, out.map.gradient);
@@ -201,11 +197,11 @@ inline void prepare_contactor(const TetCorners& contactor, PreparedContactor& ou
   prepare_contactor(geometry, out);
 }
 
-// Bounding boxes, then the 4+4 face planes.  False when the pair certainly does not overlap
-// (or a tet is degenerate); true means "may overlap" and fills `frame`.
+// The 4+4 face planes (the caller has tested the boxes: a pair whose boxes are apart ends the same,
+// only later).  False when the pair certainly does not overlap (or a tet is degenerate); true
+// means "may overlap" and fills `frame`.
 inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetGeometry& target,
                              TetPairFrame& frame) {
-  if (!boxes_intersect(contactor.box, target.box)) return false;
   if (!contactor.valid || !target.valid) return false;
   frame.origin = contactor.origin;
   for (int v = 0; v < 4; ++v) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "contact/contact_stage.hpp"
+#include "contact/potential_contact_kernels.hpp"
 #include "core/model_builder.hpp"
 
 using namespace fdem;
@@ -157,4 +158,108 @@ TEST_CASE("a bonded pair never pairs, and pairs again as soon as its bond is rel
   fresh.release_bonds(model, {bonded});
   CHECK(fresh.detect_if_needed(model));
   CHECK(pairs_of(fresh) == all);
+}
+
+namespace {
+
+// Moves every node of the block (piece 1) by `by`.
+void move_block(Model& model, const Vec3& by) {
+  std::vector<std::uint8_t> moved(static_cast<std::size_t>(model.nodes.size()), 0);
+  for (LocalIndex t = 0; t < model.tets.size(); ++t) {
+    if (model.tets.piece[t] != 1) continue;
+    for (int c = 0; c < 4; ++c) {
+      const LocalIndex n = model.tets.nodes[4 * t + c];
+      if (!moved[n]) vec3_at(model.nodes.x.data(), n) += by;
+      moved[n] = 1;
+    }
+  }
+}
+
+TetCorners corners_of(const Model& model, LocalIndex t) {
+  TetCorners c;
+  for (int k = 0; k < 4; ++k) c.x[k] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * t + k]);
+  return c;
+}
+
+}  // namespace
+
+// The stage computes each tet's geometry once per step and finds it through per-pair slots that
+// must follow every change of the candidate list: its forces must be the kernel's on each pair
+// from the corners, summed in the same order, bit for bit, before and after the list changes.
+TEST_CASE("contact forces equal the kernel's pair by pair while the candidate list changes",
+          "[contact][stage]") {
+  Model model = block_on_base(0.0);
+  ContactStage stage(model, ContactSettings{0.02});
+  const double penalty = stage.material_penalty()[0];
+  const double tolerance = ContactSettings{}.sliver_tolerance;
+  const auto kernel_forces = [&] {
+    std::vector<double> f(model.nodes.f.size(), 0.0);
+    for (const CandidatePair& p : stage.candidates()) {
+      const ContactPairResult r =
+          potential_contact(corners_of(model, p.a), corners_of(model, p.b), penalty, tolerance);
+      if (!r.overlapping) continue;
+      for (int c = 0; c < 4; ++c) {
+        vec3_at(f.data(), model.tets.nodes[4 * p.a + c]) += r.force_contactor[c];
+        vec3_at(f.data(), model.tets.nodes[4 * p.b + c]) += r.force_target[c];
+      }
+    }
+    return f;
+  };
+  const auto step = [&] {
+    std::fill(model.nodes.f.begin(), model.nodes.f.end(), 0.0);
+    stage.detect_if_needed(model);
+    const ContactForceSummary summary = stage.add_forces(model, 1e-6);
+    CHECK(model.nodes.f == kernel_forces());
+    return summary.active_pairs;
+  };
+  CHECK(step() > 0);  // pressed 1 mm into the base
+  const std::vector<CandidatePair> first = stage.candidates();
+  move_block(model, Vec3(0.25, 0.0, 0.0));  // further than buffer / 2: a new list
+  CHECK(step() > 0);
+  CHECK(stage.detections() == 2);
+  CHECK(stage.candidates() != first);
+  move_block(model, Vec3(0.0, 0.0, 0.005));  // lifted clear, no detection due
+  CHECK(step() == 0);
+  CHECK(stage.detections() == 2);
+}
+
+// A lasting contact's friction history is looked up once and then held by the pair; parting
+// erases it (and the pair's hold on it), meeting again starts a new one, and a new list starts
+// afresh.  Under the sanitizers a stale hold would be a use after free.
+TEST_CASE("a stick spring ends when its pair parts and starts afresh when the pair meets again",
+          "[contact][stage]") {
+  Model model = block_on_base(0.6);
+  ContactStage stage(model, ContactSettings{0.02});
+  stage.detect(model);
+  const auto entries_after_step = [&] {
+    stage.detect_if_needed(model);
+    stage.add_forces(model, 1e-6);
+    return stage.friction_entries();
+  };
+  const std::vector<FrictionEntry> pressed = entries_after_step();
+  REQUIRE(!pressed.empty());
+  CHECK(entries_after_step().size() == pressed.size());  // held: the same pairs
+  move_block(model, Vec3(0.0, 0.0, 0.005));              // parted (no detection due)
+  CHECK(entries_after_step().empty());
+  move_block(model, Vec3(0.0, 0.0, -0.005));  // pressed again
+  const std::vector<FrictionEntry> again = entries_after_step();
+  REQUIRE(again.size() == pressed.size());
+  for (std::size_t i = 0; i < again.size(); ++i) {
+    CHECK(again[i].a == pressed[i].a);
+    CHECK(again[i].b == pressed[i].b);
+    CHECK(again[i].stiffness == pressed[i].stiffness);
+  }
+  move_block(model, Vec3(0.25, 0.0, 0.0));  // a new list: every history of a pair still in it
+  const long detections = stage.detections();
+  const std::vector<FrictionEntry> moved = entries_after_step();
+  CHECK(stage.detections() == detections + 1);
+  CHECK(!moved.empty());
+  for (const FrictionEntry& e : moved) {
+    const auto in_list = std::any_of(
+        stage.candidates().begin(), stage.candidates().end(), [&](const CandidatePair& p) {
+          return model.tets.gid[p.a] == e.a && model.tets.gid[p.b] == e.b;
+        });
+    CHECK(in_list);
+  }
+  CHECK(entries_after_step().size() == moved.size());
 }
