@@ -168,16 +168,17 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
     for (int s = 0; s < 4; ++s) slot_other[s] = (s == i) ? other_at_centroid : other_at_corner[s];
     // Quick rejection: the four vertices strictly outside one plane of the other tet, or the
     // other tet's four corners strictly outside one side plane of the sub-tet (lambda_i <=
-    // lambda_k inside it).  Either way the piece has no volume.
+    // lambda_k inside it).  Either way the piece has no volume.  Bitwise, not short-circuit:
+    // which test decides is data-dependent.
     bool empty = false;
-    for (int b = 0; b < 4 && !empty; ++b)
-      empty = slot_other[0][b] < 0.0 && slot_other[1][b] < 0.0 && slot_other[2][b] < 0.0 &&
-              slot_other[3][b] < 0.0;
-    for (int k = 0; k < 4 && !empty; ++k)
-      empty = k != i && own_at_other_corner[0][i] > own_at_other_corner[0][k] &&
-              own_at_other_corner[1][i] > own_at_other_corner[1][k] &&
-              own_at_other_corner[2][i] > own_at_other_corner[2][k] &&
-              own_at_other_corner[3][i] > own_at_other_corner[3][k];
+    for (int b = 0; b < 4; ++b)
+      empty |= (slot_other[0][b] < 0.0) & (slot_other[1][b] < 0.0) & (slot_other[2][b] < 0.0) &
+               (slot_other[3][b] < 0.0);
+    for (int k = 0; k < 4; ++k)
+      empty |= (k != i) & (own_at_other_corner[0][i] > own_at_other_corner[0][k]) &
+               (own_at_other_corner[1][i] > own_at_other_corner[1][k]) &
+               (own_at_other_corner[2][i] > own_at_other_corner[2][k]) &
+               (own_at_other_corner[3][i] > own_at_other_corner[3][k]);
     if (empty || (left_out >> (4 * own + i)) & 1u) continue;
     piece.count = 4;
     for (int s = 0; s < 4; ++s) {

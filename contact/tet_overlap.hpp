@@ -81,11 +81,12 @@ inline TetBox tet_box(const TetCorners& t) {
   return box;
 }
 
-// True when the boxes intersect (touching counts as intersecting).
+// True when the boxes intersect (touching counts as intersecting).  Bitwise, not short-circuit:
+// which comparison decides is data-dependent, and one branch on the result mispredicts less.
 inline bool boxes_intersect(const TetBox& a, const TetBox& b) {
-  for (int k = 0; k < 3; ++k)
-    if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
-  return true;
+  bool apart = false;
+  for (int k = 0; k < 3; ++k) apart |= (a.hi[k] < b.lo[k]) | (b.hi[k] < a.lo[k]);
+  return !apart;
 }
 
 inline bool tet_boxes_intersect(const TetCorners& a, const TetCorners& b) {
@@ -105,12 +106,13 @@ inline void barycentric_at_corners(const BarycentricMap& map, const Vec3 (&other
 
 // True when some face plane of the map's tet has all four corners of the other tet strictly
 // outside (lambda < 0 at every corner).
+// (bitwise, as boxes_intersect).
 inline bool separated_by_face_plane(const double (&lambda)[4][4]) {
-  for (int a = 0; a < 4; ++a) {
-    if (lambda[0][a] < 0.0 && lambda[1][a] < 0.0 && lambda[2][a] < 0.0 && lambda[3][a] < 0.0)
-      return true;
-  }
-  return false;
+  bool separated = false;
+  for (int a = 0; a < 4; ++a)
+    separated |=
+        (lambda[0][a] < 0.0) & (lambda[1][a] < 0.0) & (lambda[2][a] < 0.0) & (lambda[3][a] < 0.0);
+  return separated;
 }
 
 // Separating-axis test on the 36 edge-edge cross products (the face normals are covered by
