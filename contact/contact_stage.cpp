@@ -344,6 +344,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   // Pairs come in contactor order: each contactor is prepared once for all its pairs.
   PreparedContactor contactor;
   LocalIndex prepared = -1;
+  // Share of the way to the overlap centroid an attached spring's anchors follow in one step.
+  const double anchor_follow = -std::expm1(-dt / friction_anchor_lag_);
   const auto friction_of = [&](const CandidatePair& pair) {
     return std::min(friction_coefficient_[tets.material[pair.a]],
                     friction_coefficient_[tets.material[pair.b]]);
@@ -463,7 +465,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         if (!history.attached())
           history.attach(r);
         else
-          history.follow(r, -std::expm1(-dt / friction_anchor_lag_));
+          history.follow(r, anchor_follow);
       }
       FrictionPoint point = centroid_point(r);
       PairGradients gradients;  // an overlapping pair's tets are sound: both have their maps

@@ -20,9 +20,23 @@ using Catch::Matchers::Contains;
 
 namespace {
 
+// This process's directory of record files, removed when the process ends (ctest runs every test
+// case as a process of its own: left behind, they pile up in the temporary directory).
+const std::filesystem::path& temp_dir() {
+  struct Directory {
+    std::filesystem::path path;
+    ~Directory() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  };
+  static const Directory directory{std::filesystem::temp_directory_path() /
+                                   ("fdem_loads_" + std::to_string(::getpid()))};
+  return directory.path;
+}
+
 std::string temp_file(const std::string& name, const std::string& text) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("fdem_loads_" + std::to_string(::getpid()));
+  const std::filesystem::path& dir = temp_dir();
   std::filesystem::create_directories(dir);
   const std::string path = (dir / name).string();
   std::ofstream(path) << text;
