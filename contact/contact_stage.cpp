@@ -239,7 +239,7 @@ void ContactStage::candidates_changed() {
 
 void ContactStage::index_pair_tets() {
   pair_tets_.clear();
-  pair_tets_.reserve(pairs_.size());
+  pair_tets_.reserve(2 * pairs_.size());
   for (const CandidatePair& p : pairs_) {
     pair_tets_.push_back(p.a);
     pair_tets_.push_back(p.b);
