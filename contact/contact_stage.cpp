@@ -373,8 +373,6 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       prepare_contactor(geometry_a, contactor);
       prepared = pair.a;
     }
-    const TetCorners& a = geometry_a.corners;
-    const TetCorners& b = geometry_b.corners;
     const double penalty = std::min(penalty_[ma], penalty_[mb]);
     const ContactPairResult r =
         potential_contact(contactor, geometry_b, penalty, sliver_tolerance_);
@@ -468,13 +466,10 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
           history.follow(r, anchor_follow);
       }
       FrictionPoint point = centroid_point(r);
-      PairGradients gradients;  // an overlapping pair's tets are sound: both have their maps
-      std::copy_n(geometry_a.gradient, 4, gradients.contactor);
-      std::copy_n(geometry_b.gradient, 4, gradients.target);
-      if (history.attached()) spring_point(history, a, b, gradients, point);
+      if (history.attached()) spring_point(history, geometry_a, geometry_b, point);
       const FrictionResult f =
           coulomb_friction(law, r, point, relative_velocity_at(point, va, vb), dt, history);
-      if (f.slipping && history.attached()) slide_anchors(history, gradients, f.slip);
+      if (f.slipping && history.attached()) slide_anchors(history, geometry_a, geometry_b, f.slip);
       double* friction_force = writable(friction_force_, friction_written_);
       for (int c = 0; c < 4; ++c) {
         vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];

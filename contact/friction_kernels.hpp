@@ -101,30 +101,20 @@ inline FrictionPoint centroid_point(const ContactPairResult& pair) {
   return p;
 }
 
-// Barycentric gradients of a pair's two tets (1/m).  They do not depend on the origin of the
-// map, so the kernel's serve every point a step looks at.
-struct PairGradients {
-  Vec3 contactor[4], target[4];
-};
-
-// The point of an attached spring: midway between its anchors at the tets' current positions.
+// The point of an attached spring: midway between its anchors at the tets' current positions
+// (TetGeometry: corners and barycentric gradients, which do not depend on the map's origin).
 // False (and `point` untouched) for a degenerate tet, which has no barycentric coordinates.
-inline bool spring_point(const FrictionHistory& history, const TetCorners& contactor,
-                         const TetCorners& target, const PairGradients& gradients,
-                         FrictionPoint& point) {
+inline bool spring_point(const FrictionHistory& history, const TetGeometry& contactor,
+                         const TetGeometry& target, FrictionPoint& point) {
   Vec3 anchor_c = Vec3::Zero(), anchor_t = Vec3::Zero();
   for (int a = 0; a < 4; ++a) {
-    anchor_c += history.anchor_contactor[a] * contactor.x[a];
-    anchor_t += history.anchor_target[a] * target.x[a];
+    anchor_c += history.anchor_contactor[a] * contactor.corners.x[a];
+    anchor_t += history.anchor_target[a] * target.corners.x[a];
   }
   const Vec3 middle = 0.5 * (anchor_c + anchor_t);
   BarycentricMap map_c, map_t;
-  for (int a = 0; a < 4; ++a) {
-    map_c.gradient[a] = gradients.contactor[a];
-    map_t.gradient[a] = gradients.target[a];
-  }
-  if (!barycentric_offsets(contactor.x[0], middle, map_c) ||
-      !barycentric_offsets(target.x[0], middle, map_t))
+  if (!barycentric_map_about(contactor, middle, map_c) ||
+      !barycentric_map_about(target, middle, map_t))
     return false;
   for (int a = 0; a < 4; ++a) {  // at y = middle - origin = 0 the map's value is its offset
     point.contactor[a] = map_c.offset[a];
@@ -135,21 +125,20 @@ inline bool spring_point(const FrictionHistory& history, const TetCorners& conta
 
 inline bool spring_point(const FrictionHistory& history, const TetCorners& contactor,
                          const TetCorners& target, FrictionPoint& point) {
-  PairGradients gradients;
-  double det = 0.0;
-  return barycentric_gradients(contactor, gradients.contactor, det) &&
-         barycentric_gradients(target, gradients.target, det) &&
-         spring_point(history, contactor, target, gradients, point);
+  TetGeometry geometry_c, geometry_t;
+  compute_tet_geometry(contactor, geometry_c);
+  compute_tet_geometry(target, geometry_t);
+  return spring_point(history, geometry_c, geometry_t, point);
 }
 
 // A slipping spring's anchors follow the slip: the contactor's moves back by half the relative
 // displacement `slip` (m) that the spring did not take up, the target's forward by half, so that
 // they stay as far apart as the spring is long.
-inline void slide_anchors(FrictionHistory& history, const PairGradients& gradients,
-                          const Vec3& slip) {
+inline void slide_anchors(FrictionHistory& history, const TetGeometry& contactor,
+                          const TetGeometry& target, const Vec3& slip) {
   for (int a = 0; a < 4; ++a) {  // barycentric coordinates are affine: shift = gradient · move
-    history.anchor_contactor[a] -= 0.5 * gradients.contactor[a].dot(slip);
-    history.anchor_target[a] += 0.5 * gradients.target[a].dot(slip);
+    history.anchor_contactor[a] -= 0.5 * contactor.gradient[a].dot(slip);
+    history.anchor_target[a] += 0.5 * target.gradient[a].dot(slip);
   }
 }
 

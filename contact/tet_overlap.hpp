@@ -105,8 +105,7 @@ inline void barycentric_at_corners(const BarycentricMap& map, const Vec3 (&other
 }
 
 // True when some face plane of the map's tet has all four corners of the other tet strictly
-// outside (lambda < 0 at every corner).
-// (bitwise, as boxes_intersect).
+// outside (lambda < 0 at every corner).  Bitwise, as boxes_intersect.
 inline bool separated_by_face_plane(const double (&lambda)[4][4]) {
   bool separated = false;
   for (int a = 0; a < 4; ++a)
@@ -173,11 +172,18 @@ inline void compute_tet_geometry(const TetCorners& corners, TetGeometry& out) {
   }
 }
 
+// The tet's map about `origin` (its gradients and the offsets for that origin): the map
+// make_barycentric_map builds from the corners, bit for bit.  False for a degenerate tet.
+inline bool barycentric_map_about(const TetGeometry& tet, const Vec3& origin, BarycentricMap& map) {
+  std::copy_n(tet.gradient, 4, map.gradient);
+  map.edge_det = tet.edge_det;
+  return tet.valid && barycentric_offsets(tet.corners.x[0], origin, map);
+}
+
 // A contactor's share of its pairs' frames, prepared once for all its pairs (the contact stage
-// visits the pairs in contactor order): its corners, centroid (the frames' origin) and
+// visits the pairs in contactor order): its centroid (the frames' origin), corners about it and
 // barycentric map about it.  A frame built with it is the one built from the corners, bit for bit.
 struct PreparedContactor {
-  TetCorners corners;
   Vec3 origin;    // the centroid (m)
   Vec3 local[4];  // corners - origin (m)
   BarycentricMap map{};
@@ -185,12 +191,9 @@ struct PreparedContactor {
 };
 
 inline void prepare_contactor(const TetGeometry& contactor, PreparedContactor& out) {
-  out.corners = contactor.corners;
   out.origin = tet_centroid(contactor.corners);
   for (int v = 0; v < 4; ++v) out.local[v] = contactor.corners.x[v] - out.origin;
-  std::copy_n(contactor.gradient, 4, out.map.gradient);
-  out.map.edge_det = contactor.edge_det;
-  out.valid = contactor.valid && barycentric_offsets(contactor.corners.x[0], out.origin, out.map);
+  out.valid = barycentric_map_about(contactor, out.origin, out.map);
 }
 
 inline void prepare_contactor(const TetCorners& contactor, PreparedContactor& out) {
@@ -204,16 +207,14 @@ inline void prepare_contactor(const TetCorners& contactor, PreparedContactor& ou
 // means "may overlap" and fills `frame`.
 inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetGeometry& target,
                              TetPairFrame& frame) {
-  if (!contactor.valid || !target.valid) return false;
+  if (!contactor.valid) return false;
   frame.origin = contactor.origin;
   for (int v = 0; v < 4; ++v) {
     frame.local[0][v] = contactor.local[v];
     frame.local[1][v] = target.corners.x[v] - frame.origin;
   }
   frame.map[0] = contactor.map;
-  std::copy_n(target.gradient, 4, frame.map[1].gradient);
-  frame.map[1].edge_det = target.edge_det;
-  if (!barycentric_offsets(target.corners.x[0], frame.origin, frame.map[1])) return false;
+  if (!barycentric_map_about(target, frame.origin, frame.map[1])) return false;
   barycentric_at_corners(frame.map[1], frame.local[0], frame.lambda_other[0]);
   if (separated_by_face_plane(frame.lambda_other[0])) return false;
   barycentric_at_corners(frame.map[0], frame.local[1], frame.lambda_other[1]);
