@@ -1,5 +1,5 @@
-// What the scene reader's files share beyond the YAML Reader (io/yaml_reader.hpp): body lists and
-// the boundary readers (io/scene_reader*.cpp only).
+// What the scene reader's files share beyond the YAML Reader (io/yaml_reader.hpp): body lists,
+// the mesh reader and the boundary readers (io/scene_reader*.cpp only).
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -37,6 +37,11 @@ std::vector<AbsorbingSpec> read_absorbing(const Reader& r, const YAML::Node& nod
 std::vector<InitialStressSpec> read_initial_stress(const Reader& r, const YAML::Node& node,
                                                    const std::vector<std::string>& body_names,
                                                    const Vec3& gravity);
+
+// A body's `mesh:` (io/scene_reader_meshes.cpp): box, file (relative to `scene_dir`), wall, arch
+// or tower.
+MeshSpec read_mesh(const Reader& r, const YAML::Node& node, const std::string& path,
+                   const std::string& scene_dir);
 
 // `quasi_static:` (io/scene_reader_boundaries.cpp): {local_damping: α, until: t}.
 QuasiStaticSpec read_quasi_static(const Reader& r, const YAML::Node& node);

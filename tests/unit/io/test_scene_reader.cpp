@@ -6,63 +6,17 @@
 
 #include "core/error.hpp"
 #include "io/scene_reader.hpp"
+#include "minimal_scene.hpp"
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::StartsWith;
+
+using namespace fdem::test_scenes;
 
 namespace {
 
 std::string scene_file(const std::string& name) {
   return std::string(FDEM_TEST_DATA) + "/scenes/" + name;
-}
-
-// The message of the InputError that parsing `text` (as "scene.yaml") raises; "" when it parses.
-std::string input_error(const std::string& text, const std::vector<std::string>& overrides = {}) {
-  try {
-    fdem::parse_scene(text, "scene.yaml", overrides);
-  } catch (const fdem::InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-// A valid scene; line numbers (1-based) are quoted by the tests that edit one line.
-//  1 time: {end: 0.1}
-//  2 materials:
-//  3   rock:
-//  4     density: 2500
-//  5     elastic: {young: 1.0e9, poisson: 0.25}
-//  6 bodies:
-//  7   - name: block
-//  8     mesh: {box: {min: [0, 0, 0], max: [1, 1, 1]}}
-//  9     material: rock
-std::vector<std::string> minimal_lines() {
-  return {"time: {end: 0.1}",
-          "materials:",
-          "  rock:",
-          "    density: 2500",
-          "    elastic: {young: 1.0e9, poisson: 0.25}",
-          "bodies:",
-          "  - name: block",
-          "    mesh: {box: {min: [0, 0, 0], max: [1, 1, 1]}}",
-          "    material: rock"};
-}
-
-std::string join_lines(const std::vector<std::string>& lines) {
-  std::string text;
-  for (const auto& l : lines) text += l + "\n";
-  return text;
-}
-
-// The minimal scene with line `line` (1-based) replaced.
-std::string minimal_with(int line, const std::string& replacement) {
-  auto lines = minimal_lines();
-  lines.at(line - 1) = replacement;
-  return join_lines(lines);
-}
-
-std::string minimal_plus(const std::string& extra) {
-  return join_lines(minimal_lines()) + extra;
 }
 
 }  // namespace
@@ -337,53 +291,6 @@ TEST_CASE("missing required keys name the parent's line and the missing key", "[
     const std::string msg = input_error("");
     CHECK_THAT(msg, StartsWith("scene.yaml"));
     CHECK_THAT(msg, Contains("expected a mapping (key: value pairs)"));
-  }
-}
-
-TEST_CASE("the parallel block reads its two keys and rejects others", "[io]") {
-  const fdem::Scene s =
-      fdem::parse_scene(join_lines(minimal_lines()) +
-                            "parallel: {rebalance_threshold: 1.25, redistribute_every: 40}\n",
-                        "scene.yaml");
-  CHECK(s.parallel.rebalance_threshold == 1.25);
-  CHECK(s.parallel.redistribute_every == 40);
-  const std::string typo =
-      input_error(join_lines(minimal_lines()) + "parallel: {rebalance_treshold: 1.2}\n");
-  CHECK_THAT(typo, Contains("parallel.rebalance_treshold") && Contains("rebalance_threshold"));
-  const std::string negative =
-      input_error(join_lines(minimal_lines()) + "parallel: {redistribute_every: -5}\n");
-  CHECK_THAT(negative, Contains("parallel.redistribute_every") && Contains(">= 0"));
-}
-
-TEST_CASE("parallel.migration and parallel.repartition: defaults, choices, clear errors", "[io]") {
-  const fdem::Scene defaults = fdem::parse_scene(minimal_plus(""), "scene.yaml");
-  CHECK(defaults.parallel.migration == "incremental");
-  CHECK(defaults.parallel.repartition == "measured");
-  const fdem::Scene s = fdem::parse_scene(
-      minimal_plus("parallel: {migration: full, repartition: threshold}\n"), "scene.yaml");
-  CHECK(s.parallel.migration == "full");
-  CHECK(s.parallel.repartition == "threshold");
-  const std::string bad = input_error(minimal_plus("parallel: {migration: partial}\n"));
-  CHECK_THAT(bad, Contains("parallel.migration") && Contains("incremental") && Contains("full"));
-  const std::string worse = input_error(minimal_plus("parallel: {repartition: always}\n"));
-  CHECK_THAT(worse, Contains("parallel.repartition") && Contains("measured"));
-}
-
-TEST_CASE("parallel.gid_offset: a 64-bit integer from 0 to below 2^62", "[io]") {
-  CHECK(fdem::parse_scene(minimal_plus(""), "scene.yaml").parallel.gid_offset == 0);
-  for (const std::string value : {"4294979641", "1099511627775", "4611686018427387903"})
-    CHECK(fdem::parse_scene(minimal_plus("parallel: {gid_offset: " + value + "}\n"), "scene.yaml")
-              .parallel.gid_offset == std::stoll(value));
-  // From the command line too (the way the tests run a scene with large gids).
-  CHECK(fdem::parse_scene(minimal_plus(""), "scene.yaml", {"parallel.gid_offset=4294979641"})
-            .parallel.gid_offset == 4294979641LL);
-  for (const std::string value : {"-1", "4611686018427387904", "9223372036854775807"}) {
-    const std::string msg = input_error(minimal_plus("parallel: {gid_offset: " + value + "}\n"));
-    CHECK_THAT(msg, Contains("parallel.gid_offset") && Contains(">= 0 and < 2^62"));
-  }
-  for (const std::string value : {"1.5", "1e12", "lots", "18446744073709551616"}) {
-    const std::string msg = input_error(minimal_plus("parallel: {gid_offset: " + value + "}\n"));
-    CHECK_THAT(msg, Contains("parallel.gid_offset") && Contains("expected an integer"));
   }
 }
 
@@ -706,47 +613,5 @@ TEST_CASE("errors in --set values point at the override, not at a line of the fi
                StartsWith("--set bodies.name=x: 'bodies' is not a mapping"));
     CHECK_THAT(input_error(text, {"bodies.99999999999999999999.name=x"}),
                Contains("is past the end of the list"));
-  }
-}
-
-TEST_CASE("output.format and output.mpi_io_hints: xdmf frames with MPI-IO hints", "[io]") {
-  const fdem::Scene d = fdem::parse_scene(join_lines(minimal_lines()), "scene.yaml");
-  CHECK(d.output.format == fdem::OutputSpec::FrameFormat::vtu);  // today's frames by default
-  CHECK(d.output.mpi_io_hints.empty());
-
-  const fdem::Scene x =
-      fdem::parse_scene(minimal_plus("output: {format: xdmf, mpi_io_hints: {striping_factor: 16, "
-                                     "striping_unit: 4194304, romio_cb_write: enable}}\n"),
-                        "scene.yaml");
-  CHECK(x.output.format == fdem::OutputSpec::FrameFormat::xdmf);
-  using Hints = std::vector<std::pair<std::string, std::string>>;
-  CHECK(x.output.mpi_io_hints == Hints{{"striping_factor", "16"},
-                                       {"striping_unit", "4194304"},
-                                       {"romio_cb_write", "enable"}});
-
-  const fdem::Scene v =
-      fdem::parse_scene(join_lines(minimal_lines()), "scene.yaml", {"output.format=xdmf"});
-  CHECK(v.output.format == fdem::OutputSpec::FrameFormat::xdmf);
-
-  SECTION("a bad format names the key, the valid values and the nearest one") {
-    const std::string msg = input_error(minimal_plus("output: {format: xdfm}\n"));
-    CHECK_THAT(msg, StartsWith("scene.yaml:10:18: output.format: 'xdfm' is not valid."));
-    CHECK_THAT(msg, Contains("Did you mean 'xdmf'?"));
-    CHECK_THAT(msg, Contains("Valid values: vtu, xdmf."));
-    CHECK_THAT(
-        input_error(join_lines(minimal_lines()), {"output.format=hdf5"}),
-        StartsWith("scene.yaml: --set output.format=hdf5: output.format: 'hdf5' is not valid."));
-  }
-  SECTION("hints must be a mapping of names to single values") {
-    CHECK_THAT(
-        input_error(minimal_plus("output: {mpi_io_hints: [striping_factor]}\n")),
-        StartsWith("scene.yaml:10:24: output.mpi_io_hints: expected a mapping of MPI-IO hint "
-                   "names to values"));
-    CHECK_THAT(input_error(minimal_plus("output: {mpi_io_hints: {striping_factor: [1, 2]}}\n")),
-               StartsWith("scene.yaml:10:42: output.mpi_io_hints.striping_factor: expected one "
-                          "value"));
-    CHECK_THAT(input_error(minimal_plus("output: {mpi_io_hints: {cb-nodes: 4}}\n")),
-               Contains("output.mpi_io_hints.cb-nodes: an MPI-IO hint name is letters, digits and "
-                        "'_'"));
   }
 }
