@@ -19,6 +19,7 @@
 
 #include "contact/contact_stage.hpp"
 #include "core/model.hpp"
+#include "drivers/scene_builders.hpp"
 #include "drivers/simulation.hpp"
 
 using namespace fdem;
@@ -50,13 +51,7 @@ Case run(const std::string& name, int cells, long steps) {
   m.density = 2500;
   m.elastic.young = 30e9;
   m.elastic.poisson = 0.2;
-  FractureSpec f;
-  f.tensile_strength = 5e6;
-  f.cohesion = 10e6;
-  f.friction_angle_deg = 30;
-  f.energy_I = 50;
-  f.energy_II = 250;
-  m.fracture = f;
+  m.fracture = builders::rock_fracture();
   m.contact.friction = 0.5;
   scene.materials.push_back(m);
   BodySpec body;

@@ -37,6 +37,12 @@ inline FractureSpec fracture_spec(double tensile_strength = 1e6, double cohesion
   return f;
 }
 
+// The rock of the cohesive law's tests and of the fracture problems: f_t = 5 MPa, c = 10 MPa,
+// φ = 30°, G_I = 50 J/m², G_II = 250 J/m².
+inline FractureSpec rock_fracture() {
+  return fracture_spec(5e6, 10e6, 30.0, 50.0, 250.0);
+}
+
 inline BodySpec box_body(const std::string& name, const Vec3& lo, const Vec3& hi, int nx, int ny,
                          int nz, int material = 0) {
   BodySpec b;
@@ -57,6 +63,23 @@ inline Scene basic_scene(double end_time) {
   s.source_path = "verification";
   s.time.end = end_time;
   return s;
+}
+
+// Two blocks [0, L]×[0, w]² and [L, 2L]×[0, w]² (ρ 2500, E 30 GPa, ν 0) joined by an interface
+// with the cohesive law `f` at x = L.
+inline Scene two_block_scene(double L, double w, int cells_x, int cells_yz, const FractureSpec& f,
+                             double end_time) {
+  Scene scene = basic_scene(end_time);
+  scene.materials.push_back(elastic_material(2500, 30e9, 0.0));
+  scene.bodies.push_back(box_body("a", Vec3(0, 0, 0), Vec3(L, w, w), cells_x, cells_yz, cells_yz));
+  scene.bodies.push_back(
+      box_body("b", Vec3(L, 0, 0), Vec3(2 * L, w, w), cells_x, cells_yz, cells_yz));
+  InterfaceSpec joint;
+  joint.body_a = 0;
+  joint.body_b = 1;
+  joint.fracture = f;
+  scene.interfaces.push_back(joint);
+  return scene;
 }
 
 // Run options without progress output or files.

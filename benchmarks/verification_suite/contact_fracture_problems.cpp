@@ -124,36 +124,11 @@ std::vector<Measure> stacked_blocks(const Setting& s) {
 // ------------------------------------------------------------------------------------------------
 // 10. Cohesive layer in tension: two-block bar pulled apart through the whole engine
 // ------------------------------------------------------------------------------------------------
-FractureSpec rock_fracture() {
-  FractureSpec f;
-  f.tensile_strength = 5e6;
-  f.cohesion = 10e6;
-  f.friction_angle_deg = 30;
-  f.energy_I = 50;
-  f.energy_II = 250;
-  return f;
-}
-
-Scene two_block_scene(double L, double w, int cells_x, int cells_yz, const FractureSpec& f,
-                      double end_time, double dt_fraction) {
-  Scene scene = basic_scene(end_time, dt_fraction);
-  scene.materials.push_back(elastic_material(2500, 30e9, 0.0));
-  scene.bodies.push_back(box_body("a", Vec3(0, 0, 0), Vec3(L, w, w), cells_x, cells_yz, cells_yz));
-  scene.bodies.push_back(
-      box_body("b", Vec3(L, 0, 0), Vec3(2 * L, w, w), cells_x, cells_yz, cells_yz));
-  InterfaceSpec joint;
-  joint.body_a = 0;
-  joint.body_b = 1;
-  joint.fracture = f;
-  scene.interfaces.push_back(joint);
-  return scene;
-}
-
 std::vector<Measure> cohesive_layer(const Setting& s) {
   const double L = 0.1, w = 0.05, v = 0.01;
   const FractureSpec f = rock_fracture();
-  Scene scene =
-      two_block_scene(L, w, cells_for(L, s.h), cells_for(w, s.h), f, 10e-3, s.dt_fraction);
+  Scene scene = two_block_scene(L, w, cells_for(L, s.h), cells_for(w, s.h), f, 10e-3);
+  scene.time.safety = s.dt_fraction;
   scene.loads.push_back(load_on_region(Vec3(-1, -1, -1), Vec3(1e-9, 1, 1), Vec3(-v / 2, 0, 0)));
   scene.loads.push_back(
       load_on_region(Vec3(2 * L - 1e-9, -1, -1), Vec3(1, 1, 1), Vec3(v / 2, 0, 0)));
@@ -176,13 +151,16 @@ std::vector<Measure> cohesive_layer(const Setting& s) {
 // ------------------------------------------------------------------------------------------------
 // 12. Dry-joint shear (Smoljanović et al. 2013): block a fixed, block b pressed then slid
 // ------------------------------------------------------------------------------------------------
+namespace {
+
 struct ShearRun {
   double peak = 0, sigma_at_peak = 0, final_shear = 0;
 };
 
 ShearRun rigid_shear(const FractureSpec& f, double L, double w, int cells_x, int cells_yz,
                      double sigma, double slide, double v, double dt_fraction) {
-  Scene scene = two_block_scene(L, w, cells_x, cells_yz, f, 1.0, dt_fraction);
+  Scene scene = two_block_scene(L, w, cells_x, cells_yz, f, 1.0);
+  scene.time.safety = dt_fraction;
   scene.bodies[0].fixed = true;
   scene.materials[0].contact.friction = std::tan(f.friction_angle_deg * M_PI / 180);
   scene.contact_buffer = 2e-4;
@@ -216,6 +194,8 @@ ShearRun rigid_shear(const FractureSpec& f, double L, double w, int cells_x, int
   }
   return out;
 }
+
+}  // namespace
 
 std::vector<Measure> dry_joint_shear(const Setting& s) {
   FractureSpec dry;

@@ -113,6 +113,8 @@ std::vector<Measure> two_bar_impact(const Setting& s) {
 // ------------------------------------------------------------------------------------------------
 // 3. Tet–tet impact (Munjiza 2004)
 // ------------------------------------------------------------------------------------------------
+namespace {
+
 BodyMesh single_tet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   BodyMesh m;
   m.source = "verification";
@@ -122,6 +124,8 @@ BodyMesh single_tet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) 
   if (tet_reference(X).volume < 0) std::swap(m.tets[2], m.tets[3]);
   return m;
 }
+
+}  // namespace
 
 std::vector<Measure> tet_tet_impact(const Setting& s) {
   const double a = 1.34, E = 100e9;

@@ -12,37 +12,6 @@
 using namespace fdem;
 using namespace fdem::testing;
 
-namespace {
-
-// The test rock of the law's unit tests: f_t = 5 MPa, c = 10 MPa, φ = 30°, G_I = 50, G_II = 250.
-FractureSpec rock_fracture() {
-  FractureSpec f;
-  f.tensile_strength = 5e6;
-  f.cohesion = 10e6;
-  f.friction_angle_deg = 30;
-  f.energy_I = 50;
-  f.energy_II = 250;
-  return f;
-}
-
-// Two blocks [0, L]×[0, w]² and [L, 2L]×[0, w]² joined by an interface at x = L.
-Scene two_block_scene(double L, double w, int cells_x, int cells_yz, const FractureSpec& f,
-                      double end_time) {
-  Scene scene = basic_scene(end_time);
-  scene.materials.push_back(elastic_material(2500, 30e9, 0.0));
-  scene.bodies.push_back(box_body("a", Vec3(0, 0, 0), Vec3(L, w, w), cells_x, cells_yz, cells_yz));
-  scene.bodies.push_back(
-      box_body("b", Vec3(L, 0, 0), Vec3(2 * L, w, w), cells_x, cells_yz, cells_yz));
-  InterfaceSpec joint;
-  joint.body_a = 0;
-  joint.body_b = 1;
-  joint.fracture = f;
-  scene.interfaces.push_back(joint);
-  return scene;
-}
-
-}  // namespace
-
 TEST_CASE("interface placement: coincident faces only, canonical joints, clear error",
           "[verification][fracture]") {
   Scene scene = two_block_scene(0.1, 0.05, 2, 2, rock_fracture(), 1e-3);
