@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "contact/clip_replay.hpp"
 #include "contact/dashpot_kernels.hpp"
 #include "contact/detection.hpp"
 #include "contact/potential_contact_kernels.hpp"
@@ -41,6 +42,7 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   body_dashpot_ = settings.body_dashpot;
   FDEM_VERIFY(settings.sliver_tolerance >= 0.0, "sliver tolerance >= 0");
   sliver_tolerance_ = settings.sliver_tolerance;
+  clip_replay_ = settings.clip_replay;
   body_cracked_.assign(static_cast<std::size_t>(std::max(model.pieces.bodies(), 0)), 0);
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
@@ -233,6 +235,7 @@ std::vector<GidPair> ContactStage::candidate_gids(const Model& model) const {
 void ContactStage::candidates_changed() {
   may_hold_friction_.assign(pairs_.size(), 1);
   release(friction_of_pair_);
+  release(clip_record_at_);
   pair_slots_.clear();
   pair_tets_.clear();
 }
@@ -276,6 +279,9 @@ void ContactStage::release_until_rebind() {
   release(overlapping_);
   release(may_hold_friction_);
   release(friction_of_pair_);
+  release(clip_record_at_);
+  release(clip_records_[0]);
+  release(clip_records_[1]);
   release(pair_tets_);
   release(pair_slots_);
   release(tet_boxes_);
@@ -350,7 +356,14 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     return std::min(friction_coefficient_[tets.material[pair.a]],
                     friction_coefficient_[tets.material[pair.b]]);
   };
+  // This step's clip records go to the other buffer; every pair's offset is renewed or cleared.
+  const std::vector<std::uint8_t>& clip_read = clip_records_[clip_parity_];
+  std::vector<std::uint8_t>& clip_written = clip_records_[clip_parity_ ^ 1];
+  clip_written.clear();
+  clip_parity_ ^= 1;
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
+    std::uint32_t clip_read_at = kNoClipRecord;
+    if (!clip_record_at_.empty()) std::swap(clip_read_at, clip_record_at_[index]);
     const CandidatePair& pair = pairs_[index];
     const std::int32_t slot_a = pair_slots_[2 * index], slot_b = pair_slots_[2 * index + 1];
     const auto lost = [&] {  // not overlapping: a stick spring is released
@@ -374,8 +387,34 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       prepared = pair.a;
     }
     const double penalty = std::min(penalty_[ma], penalty_[mb]);
-    const ContactPairResult r =
-        potential_contact(contactor, geometry_b, penalty, sliver_tolerance_);
+    ClipMemo memo;
+    std::size_t record_start = 0;
+    if (clip_replay_) {
+      if (clip_record_at_.size() != pairs_.size())
+        clip_record_at_.assign(pairs_.size(), kNoClipRecord);
+      if (clip_read_at != kNoClipRecord) {
+        memo.previous = clip_read.data() + clip_read_at + 2;
+        memo.previous_end =
+            memo.previous + (clip_read[clip_read_at] | (clip_read[clip_read_at + 1] << 8));
+      }
+      record_start = clip_written.size();
+      clip_written.resize(record_start + 2);  // the pair's length, once known
+      memo.record = &clip_written;
+    }
+    const ContactPairResult r = potential_contact(contactor, geometry_b, penalty, sliver_tolerance_,
+                                                  clip_replay_ ? &memo : nullptr);
+    if (clip_replay_) {
+      const std::size_t length = clip_written.size() - record_start - 2;
+      if (length == 0 || length > 0xFFFFu || record_start >= kNoClipRecord) {
+        clip_written.resize(record_start);
+      } else {
+        clip_written[record_start] = static_cast<std::uint8_t>(length & 0xFFu);
+        clip_written[record_start + 1] = static_cast<std::uint8_t>(length >> 8);
+        clip_record_at_[index] = static_cast<std::uint32_t>(record_start);
+      }
+      pieces_replayed_ += memo.replayed;
+      pieces_clipped_ += memo.clipped;
+    }
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
     if (!r.overlapping) {

@@ -37,6 +37,10 @@ struct ContactSettings {
   // pair_force_bound.hpp); at the default 1e-6 the second condition decides.  0 integrates every
   // pair that the face planes pass (the previous algorithm, for benchmarks).
   double sliver_tolerance = 1e-6;
+  // Replay each lasting pair's piece clips from the step before where they cut the same vertices
+  // (scene key contact.clip_replay; clip_replay.hpp): the same results bit for bit, without the
+  // clipper's graph work.  false clips every piece afresh (the previous algorithm, for benchmarks).
+  bool clip_replay = true;
 };
 
 // Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with
@@ -174,6 +178,9 @@ class ContactStage {
   double critical_time_step(const Model& model) const;
   double buffer() const { return buffer_; }
   long detections() const { return detections_; }
+  // Pieces replayed from the step before and pieces clipped afresh, over the run (clip_replay).
+  std::uint64_t pieces_replayed() const { return pieces_replayed_; }
+  std::uint64_t pieces_clipped() const { return pieces_clipped_; }
   const std::vector<CandidatePair>& candidates() const { return pairs_; }
   // Per candidate pair: whether it overlapped at the last add_forces (it then costs the full
   // overlap integration, ~60× a tet's internal force; a separated pair is rejected early).
@@ -265,6 +272,16 @@ class ContactStage {
   double friction_anchor_lag_ = ContactSettings{}.friction_anchor_lag;  // s
   bool body_dashpot_ = ContactSettings{}.body_dashpot;
   double sliver_tolerance_ = ContactSettings{}.sliver_tolerance;  // (-)
+  bool clip_replay_ = ContactSettings{}.clip_replay;
+  // The pieces' clips of the last add_forces (clip_replay.hpp), for the next one to replay: each
+  // pair's record in clip_records_[clip_parity_] at clip_record_at_[pair] (kNoClipRecord: none),
+  // the pair's length in its first two bytes.  The offsets exist from the first pair whose boxes
+  // meet, and go with the candidate list.
+  static constexpr std::uint32_t kNoClipRecord = 0xFFFFFFFFu;
+  std::vector<std::uint8_t> clip_records_[2];
+  std::vector<std::uint32_t> clip_record_at_;
+  int clip_parity_ = 0;
+  std::uint64_t pieces_replayed_ = 0, pieces_clipped_ = 0;
   std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;

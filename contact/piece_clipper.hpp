@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 
 #include "contact/potential_contact_kernels.hpp"
 
@@ -35,22 +36,64 @@ struct Piece {
 // outside.  In own-barycentric space every sub-tet is positively oriented (see build_piece).
 constexpr int kTetNeighbours[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
+// The new vertex on edge a–b where the plane lam[k] = 0 cuts it (dist_a = a.lam[k] >= 0 >
+// dist_b = b.lam[k]): interpolated from the kept end a, so that a shared edge gives the same point
+// in every piece that holds it.  One function for the clip and its replay (clip_replay.hpp): the
+// same operations, bit for bit.
+inline void cut_edge(const PieceVertex& a, const PieceVertex& b, double dist_a, double dist_b,
+                     int k, unsigned plane_bit, PieceVertex& w) {
+  const double t = dist_a / (dist_a - dist_b);  // in [0, 1)
+  for (int c = 0; c < 8; ++c) w.lam[c] = a.lam[c] + t * (b.lam[c] - a.lam[c]);
+  w.lam[k] = 0.0;
+  w.planes = (a.planes & b.planes) | plane_bit;
+}
+
+// What one clip did, for its replay at the next step (clip_replay.hpp): per plane, which
+// vertices lay outside and which edges were cut, in the order the clipper made the new vertices.
+// `valid` turns false where the record would not fit (or the graph was corrupted).
+struct ClipLog {
+  static constexpr int kMaxBytes = 255;
+  static constexpr int kMaxStageVertices = 16;  // the outside mask is 16 bits
+  std::uint8_t bytes[kMaxBytes];
+  int size = 0;
+  int made = 4;  // vertices made so far, the sub-tet's four included: the replay's pool size
+  bool valid = true;
+  bool room(int count) {
+    valid = valid && size + count <= kMaxBytes;
+    return valid;
+  }
+  void put(unsigned value) { bytes[size++] = static_cast<std::uint8_t>(value); }
+};
+
 // Keeps the part of the piece where lam[k] >= 0 (Powell & Abel's r3d clip on a degree-3 vertex
 // graph).  New vertices get lam[k] = 0 exactly and the plane bit.  False when nothing is left.
-inline bool clip_piece(Piece& piece, int k, unsigned plane_bit) {
+// With a log, what it did is appended there.
+inline bool clip_piece(Piece& piece, int k, unsigned plane_bit, ClipLog* log = nullptr) {
   const int n = piece.count;
   double dist[kMaxVertices];
   bool outside[kMaxVertices];
   int n_outside = 0;
+  unsigned mask = 0;
   for (int i = 0; i < n; ++i) {
     dist[i] = piece.v[i].lam[k];
     outside[i] = dist[i] < 0.0;
     n_outside += outside[i];
+    mask |= static_cast<unsigned>(outside[i]) << (i & 31);
+  }
+  if (log && (n > ClipLog::kMaxStageVertices || !log->room(3))) log->valid = false;
+  if (log && log->valid) {
+    log->put(mask & 0xFFu);
+    log->put(mask >> 8);
   }
   if (n_outside == 0) return true;
   if (n_outside == n) {
     piece.count = 0;
     return false;
+  }
+  int count_at = -1;  // where the log keeps the number of new vertices
+  if (log && log->valid) {
+    count_at = log->size;
+    log->put(0);
   }
   // One new vertex on every edge from a kept vertex to a clipped one.  Always interpolate from
   // the kept end so that a shared edge gives the same point in every piece that holds it.
@@ -61,16 +104,19 @@ inline bool clip_piece(Piece& piece, int k, unsigned plane_bit) {
       const int vn = piece.v[vc].next[e];
       if (!outside[vn]) continue;
       if (m == kMaxVertices) {  // unreachable for tet ∩ half-spaces; stay finite regardless
+        if (log) log->valid = false;
         piece.count = 0;
         return false;
       }
       PieceVertex& w = piece.v[m];
-      const PieceVertex& a = piece.v[vc];
-      const PieceVertex& b = piece.v[vn];
-      const double t = dist[vc] / (dist[vc] - dist[vn]);  // in [0, 1): dist[vc] >= 0 > dist[vn]
-      for (int c = 0; c < 8; ++c) w.lam[c] = a.lam[c] + t * (b.lam[c] - a.lam[c]);
-      w.lam[k] = 0.0;
-      w.planes = (a.planes & b.planes) | plane_bit;
+      cut_edge(piece.v[vc], piece.v[vn], dist[vc], dist[vn], k, plane_bit, w);
+      if (log && log->valid && log->room(2) && ++log->made <= kMaxVertices) {
+        log->put(static_cast<unsigned>(vc));
+        log->put(static_cast<unsigned>(vn));
+        ++log->bytes[count_at];
+      } else if (log) {
+        log->valid = false;
+      }
       w.next[0] = vc;
       w.next[1] = -1;
       w.next[2] = -1;
@@ -88,6 +134,7 @@ inline bool clip_piece(Piece& piece, int k, unsigned plane_bit) {
       int e = 0;
       while (e < 3 && piece.v[vn].next[e] != vc) ++e;
       if (e == 3 || ++guard > 3 * kMaxVertices) {  // corrupted graph: cannot happen
+        if (log) log->valid = false;
         piece.count = 0;
         return false;
       }

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "contact/clip_replay.hpp"
 #include "contact/pair_force_bound.hpp"
 #include "contact/piece_clipper.hpp"
 #include "contact/potential_contact_kernels.hpp"
@@ -11,99 +12,78 @@ namespace {
 
 using namespace piece_clip;
 
-// Accumulates one piece (sub-tet `own_sub` clipped): cone sums over all faces from an apex at the
-// piece's first vertex (a point of the piece: no cancellation between remote cones, so slivers
+// Accumulates one piece (sub-tet `own_sub` clipped; its n vertices in the clipper's order and its
+// faces, from a fresh clip or its replay): cone sums over all faces from an apex at the piece's
+// first vertex (a point of the piece: no cancellation between remote cones, so slivers
 // of overlap keep full relative precision), and the surface integrals on the faces that lie on
 // the other tet's faces.  Both sums are linear in the vertex values, so each fan triangle only
 // adds scalar weights to its three vertices; the values (8 per vertex) are weighted once at the
 // end.  `moments`: how many carried values need their moment (4: own only, 8: own and other).
 // area_weight[j]: maps a barycentric-space doubled area vector to the doubled physical area
 // projected on face j's outward unit normal.
-void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight)[4][3],
-                     const double (&side_weight)[4][3], unsigned flux_slots, int moments,
-                     SideIntegrals& out) {
-  const int n = piece.count;
-  bool used[kMaxVertices][3];
+void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& faces, int own_sub,
+                     const double (&area_weight)[4][3], const double (&side_weight)[4][3],
+                     unsigned flux_slots, int moments, SideIntegrals& out) {
   double volume_weight[kMaxVertices];      // Σ vol6 of the cones having the vertex on their base
   double surface_weight[4][kMaxVertices];  // per other face: Σ area × (f_k + Σf) of its triangles
   bool on_face[4] = {false, false, false, false};
   double flux_weight[4][kMaxVertices];  // per side slot s in flux_slots: as surface_weight
   bool on_side[4] = {false, false, false, false};
-  for (int v = 0; v < n; ++v) {
-    used[v][0] = used[v][1] = used[v][2] = false;
-    volume_weight[v] = 0.0;
-  }
-  const double* apex = piece.v[0].lam;  // apex: the first vertex of the piece
+  for (int v = 0; v < n; ++v) volume_weight[v] = 0.0;
+  const double* apex = vertex[0]->lam;  // apex: the first vertex of the piece
   double piece_vol6 = 0.0;
-  int face[kMaxVertices];
-  for (int vs = 0; vs < n; ++vs) {
-    for (int es = 0; es < 3; ++es) {
-      if (used[vs][es]) continue;
-      // Walk one face.
-      int nf = 0;
-      unsigned face_planes = ~0u;
-      int vc = vs, e = es;
-      do {
-        used[vc][e] = true;
-        if (nf < kMaxVertices) face[nf++] = vc;
-        face_planes &= piece.v[vc].planes;
-        const int vn = piece.v[vc].next[e];
-        const int* back = piece.v[vn].next;
-        const int b = back[0] == vc ? 0 : back[1] == vc ? 1 : back[2] == vc ? 2 : 3;
-        if (b == 3) return;  // corrupted graph: cannot happen
-        vc = vn;
-        e = b == 2 ? 0 : b + 1;
-      } while (vc != vs && nf < kMaxVertices);
-      if (nf < 3) continue;
-      int other_face = -1;
-      if (face_planes & kOtherFaceBits) {
-        const unsigned bits = (face_planes & kOtherFaceBits) >> kOtherFaceShift;
-        other_face = (bits & 1u) ? 0 : (bits & 2u) ? 1 : (bits & 4u) ? 2 : 3;
-        if (!on_face[other_face]) {
-          on_face[other_face] = true;
-          for (int v = 0; v < n; ++v) surface_weight[other_face][v] = 0.0;
-        }
+  const std::uint8_t* face = faces.vertex;
+  for (int f = 0; f < faces.count; face += faces.size[f], ++f) {
+    const int nf = faces.size[f];
+    const unsigned face_planes = faces.planes[f];
+    int other_face = -1;
+    if (face_planes & kOtherFaceBits) {
+      const unsigned bits = (face_planes & kOtherFaceBits) >> kOtherFaceShift;
+      other_face = (bits & 1u) ? 0 : (bits & 2u) ? 1 : (bits & 4u) ? 2 : 3;
+      if (!on_face[other_face]) {
+        on_face[other_face] = true;
+        for (int v = 0; v < n; ++v) surface_weight[other_face][v] = 0.0;
       }
-      int side_slot = -1;  // a face on the plane shared with a left-out piece's sub-tet
-      if (const unsigned side = (face_planes >> 1) & flux_slots & 0xFu) {
-        side_slot = (side & 1u) ? 0 : (side & 2u) ? 1 : (side & 4u) ? 2 : 3;
-        if (!on_side[side_slot]) {
-          on_side[side_slot] = true;
-          for (int v = 0; v < n; ++v) flux_weight[side_slot][v] = 0.0;
-        }
+    }
+    int side_slot = -1;  // a face on the plane shared with a left-out piece's sub-tet
+    if (const unsigned side = (face_planes >> 1) & flux_slots & 0xFu) {
+      side_slot = (side & 1u) ? 0 : (side & 2u) ? 1 : (side & 4u) ? 2 : 3;
+      if (!on_side[side_slot]) {
+        on_side[side_slot] = true;
+        for (int v = 0; v < n; ++v) flux_weight[side_slot][v] = 0.0;
       }
-      // Fan from the face's first vertex.
-      const double* x0 = piece.v[face[0]].lam;
-      const double h0[3] = {x0[1] - apex[1], x0[2] - apex[2], x0[3] - apex[3]};
-      for (int k = 1; k + 1 < nf; ++k) {
-        const double* x1 = piece.v[face[k]].lam;
-        const double* x2 = piece.v[face[k + 1]].lam;
-        const double u[3] = {x1[1] - x0[1], x1[2] - x0[2], x1[3] - x0[3]};
-        const double w[3] = {x2[1] - x0[1], x2[2] - x0[2], x2[3] - x0[3]};
-        const double area2[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                                 u[0] * w[1] - u[1] * w[0]};
-        const double vol6 = h0[0] * area2[0] + h0[1] * area2[1] + h0[2] * area2[2];
-        piece_vol6 += vol6;
-        volume_weight[face[0]] += vol6;
-        volume_weight[face[k]] += vol6;
-        volume_weight[face[k + 1]] += vol6;
-        // ∫_tri f g dS = A/12 (sum f_k g_k + (sum f)(sum g)), f = 4 lambda_own, g any carried
-        // value: vertex k carries A (f_k + sum f), A the triangle's area on the plane that
-        // `weight` projects onto.
-        const auto add_quadratic = [&](const double* weight, double* vertex_weight) {
-          const double area_phys2 =
-              area2[0] * weight[0] + area2[1] * weight[1] + area2[2] * weight[2];
-          const double f0 = 4.0 * x0[own_sub], f1 = 4.0 * x1[own_sub], f2 = 4.0 * x2[own_sub];
-          const double fsum = f0 + f1 + f2;
-          vertex_weight[face[0]] += area_phys2 * (f0 + fsum);
-          vertex_weight[face[k]] += area_phys2 * (f1 + fsum);
-          vertex_weight[face[k + 1]] += area_phys2 * (f2 + fsum);
-        };
-        if (other_face >= 0)  // the other tet's face: g = lambda_other_b
-          add_quadratic(area_weight[other_face], surface_weight[other_face]);
-        if (side_slot >= 0)  // the plane shared with a left-out sub-tet: g = lambda_own_a
-          add_quadratic(side_weight[side_slot], flux_weight[side_slot]);
-      }
+    }
+    // Fan from the face's first vertex.
+    const double* x0 = vertex[face[0]]->lam;
+    const double h0[3] = {x0[1] - apex[1], x0[2] - apex[2], x0[3] - apex[3]};
+    for (int k = 1; k + 1 < nf; ++k) {
+      const double* x1 = vertex[face[k]]->lam;
+      const double* x2 = vertex[face[k + 1]]->lam;
+      const double u[3] = {x1[1] - x0[1], x1[2] - x0[2], x1[3] - x0[3]};
+      const double w[3] = {x2[1] - x0[1], x2[2] - x0[2], x2[3] - x0[3]};
+      const double area2[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                               u[0] * w[1] - u[1] * w[0]};
+      const double vol6 = h0[0] * area2[0] + h0[1] * area2[1] + h0[2] * area2[2];
+      piece_vol6 += vol6;
+      volume_weight[face[0]] += vol6;
+      volume_weight[face[k]] += vol6;
+      volume_weight[face[k + 1]] += vol6;
+      // ∫_tri f g dS = A/12 (sum f_k g_k + (sum f)(sum g)), f = 4 lambda_own, g any carried
+      // value: vertex k carries A (f_k + sum f), A the triangle's area on the plane that
+      // `weight` projects onto.
+      const auto add_quadratic = [&](const double* weight, double* vertex_weight) {
+        const double area_phys2 =
+            area2[0] * weight[0] + area2[1] * weight[1] + area2[2] * weight[2];
+        const double f0 = 4.0 * x0[own_sub], f1 = 4.0 * x1[own_sub], f2 = 4.0 * x2[own_sub];
+        const double fsum = f0 + f1 + f2;
+        vertex_weight[face[0]] += area_phys2 * (f0 + fsum);
+        vertex_weight[face[k]] += area_phys2 * (f1 + fsum);
+        vertex_weight[face[k + 1]] += area_phys2 * (f2 + fsum);
+      };
+      if (other_face >= 0)  // the other tet's face: g = lambda_other_b
+        add_quadratic(area_weight[other_face], surface_weight[other_face]);
+      if (side_slot >= 0)  // the plane shared with a left-out sub-tet: g = lambda_own_a
+        add_quadratic(side_weight[side_slot], flux_weight[side_slot]);
     }
   }
   volume_weight[0] += piece_vol6;  // the apex term: vol6 of the piece times the apex's values
@@ -111,7 +91,7 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
   double* moment = out.moment[own_sub];
   for (int v = 0; v < n; ++v) {
     const double wv = volume_weight[v];
-    const double* lam = piece.v[v].lam;
+    const double* lam = vertex[v]->lam;
     for (int c = 0; c < moments; ++c) moment[c] += wv * lam[c];
   }
   for (int slot = 0; slot < 4; ++slot) {
@@ -120,22 +100,30 @@ void integrate_piece(const Piece& piece, int own_sub, const double (&area_weight
       for (int a = 0; a < 4; ++a) flux[a] = 0.0;
     if (!on_side[slot]) continue;
     for (int v = 0; v < n; ++v)
-      for (int a = 0; a < 4; ++a) flux[a] += flux_weight[slot][v] * piece.v[v].lam[a];
+      for (int a = 0; a < 4; ++a) flux[a] += flux_weight[slot][v] * vertex[v]->lam[a];
   }
   for (int j = 0; j < 4; ++j) {
     if (!on_face[j]) continue;
     double* surface = out.surface[j];
     for (int v = 0; v < n; ++v) {
       const double sv = surface_weight[j][v];
-      const double* lam = piece.v[v].lam + 4;
+      const double* lam = vertex[v]->lam + 4;
       for (int b = 0; b < 4; ++b) surface[b] += sv * lam[b];
     }
   }
 }
 
+// The record of piece `key` in the pair's record from the step before ([key][length][bytes]), or
+// null.  Pieces are looked up in the kernel's order, so the search resumes where it stopped.
+const std::uint8_t* find_recorded_piece(ClipMemo& memo, unsigned key) {
+  const std::uint8_t*& at = memo.previous;
+  while (at && memo.previous_end - at >= 2 && at[0] < key) at += 2 + at[1];
+  return at && memo.previous_end - at >= 2 && at[0] == key ? at : nullptr;
+}
+
 // Integrates the four pieces (sub-tet i of `own`) ∩ other.
 void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned left_out,
-                    SideIntegrals& out) {
+                    ClipMemo* memo, SideIntegrals& out) {
   const BarycentricMap& own_map = frame.map[own];
   const BarycentricMap& other_map = frame.map[1 - own];
   const double(&other_at_corner)[4][4] = frame.lambda_other[own];
@@ -193,9 +181,43 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
         if (s2 != s) planes |= (s2 == i) ? kOuterFaceBit : (1u << (1 + s2));
       v.planes = planes;
     }
-    bool alive = true;
-    for (int b = 0; b < 4 && alive; ++b)
-      alive = clip_piece(piece, 4 + b, 1u << (kOtherFaceShift + b));
+    // The piece's clip: replayed from the step before where every vertex kept its side of every
+    // plane (clip_replay.hpp), else clipped afresh (and recorded for the next step).
+    const unsigned key = 4u * static_cast<unsigned>(own) + static_cast<unsigned>(i);
+    const PieceVertex* vertex[kMaxVertices];
+    int n_vertices = 0;
+    PieceFaces faces;
+    const std::uint8_t* recorded = memo ? find_recorded_piece(*memo, key) : nullptr;
+    const Replay replay = recorded ? replay_piece(piece, recorded + 2, recorded + 2 + recorded[1],
+                                                  vertex, n_vertices, faces)
+                                   : Replay::side_changed;
+    bool alive = replay == Replay::kept;
+    bool walked = alive;
+    if (replay != Replay::side_changed) {
+      ++memo->replayed;
+      if (memo->record)
+        memo->record->insert(memo->record->end(), recorded, recorded + 2 + recorded[1]);
+    } else {
+      ClipLog log;
+      ClipLog* const logged = memo && memo->record ? &log : nullptr;
+      alive = true;
+      for (int b = 0; b < 4 && alive; ++b)
+        alive = clip_piece(piece, 4 + b, 1u << (kOtherFaceShift + b), logged);
+      walked = alive && walk_faces(piece, faces);
+      if (walked) {
+        n_vertices = piece.count;
+        for (int v = 0; v < n_vertices; ++v) vertex[v] = &piece.v[v];
+      }
+      if (memo) ++memo->clipped;
+      if (logged && alive == walked) {
+        if (walked) log_faces(faces, log);
+        if (log.valid) {
+          memo->record->push_back(static_cast<std::uint8_t>(key));
+          memo->record->push_back(static_cast<std::uint8_t>(log.size));
+          memo->record->insert(memo->record->end(), log.bytes, log.bytes + log.size);
+        }
+      }
+    }
     if (alive) {
       out.nonempty |= 1u << i;
       double side_weight[4][3] = {};
@@ -207,18 +229,21 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
         for (int k = 0; k < 3; ++k)
           side_weight[slot][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
       }
-      integrate_piece(piece, i, area_weight, side_weight, slots, moments, out);
+      if (walked)
+        integrate_piece(vertex, n_vertices, faces, i, area_weight, side_weight, slots, moments,
+                        out);
     }
   }
 }
 
-ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned left_out = 0) {
+ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned left_out = 0,
+                           ClipMemo* memo = nullptr) {
   ContactPairResult r = zero_result();
 
   SideIntegrals side[2];
   // (side 0 carries the other tet's moments too: they give the centroid's weights)
-  integrate_side(frame, 0, 8, left_out, side[0]);
-  integrate_side(frame, 1, 4, left_out, side[1]);
+  integrate_side(frame, 0, 8, left_out, memo, side[0]);
+  integrate_side(frame, 1, 4, left_out, memo, side[1]);
 
   // Physical volume integrals: ∫_{piece i} lam_c dV = |det| * moment / 24 (moment includes the
   // apex term vol6 * lam_c(apex)).
@@ -277,12 +302,12 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned l
 }  // namespace
 
 ContactPairResult potential_contact(const PreparedContactor& contactor, const TetGeometry& target,
-                                    double penalty, double sliver_tolerance) {
+                                    double penalty, double sliver_tolerance, ClipMemo* memo) {
   TetPairFrame frame;
   if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
   const unsigned left_out = sliver_tolerance > 0.0 ? negligible_parts(frame, sliver_tolerance) : 0u;
   if (left_out == kEveryPiece) return zero_result();
-  return assemble(frame, penalty, left_out);
+  return assemble(frame, penalty, left_out, memo);
 }
 
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,

@@ -61,9 +61,13 @@ ContactPairResult potential_contact_without(const TetCorners& contactor, const T
                                             double penalty, unsigned left_out);
 
 // The same with the contactor prepared once for all its pairs and the target's geometry computed
-// once for all of its (tet_overlap.hpp): bit for bit.
+// once for all of its (tet_overlap.hpp): bit for bit.  With a memo, the pieces' clips are
+// replayed from the pair's record of the step before where they cut the same vertices, and
+// recorded for the next step (clip_replay.hpp): bit for bit too, whatever the record holds.
+struct ClipMemo;
 ContactPairResult potential_contact(const PreparedContactor& contactor, const TetGeometry& target,
-                                    double penalty, double sliver_tolerance = 0.0);
+                                    double penalty, double sliver_tolerance = 0.0,
+                                    ClipMemo* memo = nullptr);
 
 // The exact integration alone, with only the degenerate-tet check (no box or face-plane
 // rejection).  Same results as potential_contact for every pair that passes the rejection;

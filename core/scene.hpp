@@ -325,6 +325,7 @@ struct Scene {
   double contact_friction_anchor_lag = 0.05;  // s, contact.friction_anchor_lag
   bool contact_body_dashpot = true;           // contact.dashpot (ContactSettings::body_dashpot)
   double contact_sliver_tolerance = 1e-6;     // contact.sliver_tolerance (ContactSettings)
+  bool contact_clip_replay = true;            // contact.clip_replay (ContactSettings)
   ParallelSpec parallel;
   LimitsSpec limits;
 

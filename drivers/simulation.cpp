@@ -128,7 +128,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
         model_, ContactSettings{distributed ? contact_buffer : scene_.contact_buffer,
                                 scene_.contact_skip_enclosed, scene_.contact_exact_narrowing,
                                 scene_.contact_friction_anchor_lag, scene_.contact_body_dashpot,
-                                scene_.contact_sliver_tolerance});
+                                scene_.contact_sliver_tolerance, scene_.contact_clip_replay});
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
     const double dt_contact = global_min(contact_->critical_time_step(model_));
     // Tunnelling guard (check_tunnelling): the thinnest element a node could cross unseen.

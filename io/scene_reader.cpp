@@ -508,7 +508,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   if (const YAML::Node contact = root["contact"]) {
     r.check_keys(contact, "contact",
                  {"buffer", "skip_enclosed", "narrowing", "friction_anchor_lag", "dashpot",
-                  "sliver_tolerance"});
+                  "sliver_tolerance", "clip_replay"});
     if (contact["sliver_tolerance"]) {
       const double tolerance = r.number(contact["sliver_tolerance"], "contact.sliver_tolerance");
       if (!(tolerance >= 0.0 && tolerance <= 1e-6))
@@ -516,7 +516,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
                Reader::format(tolerance) +
                    " is impossible: the largest nodal force a skipped pair may carry, as a "
                    "fraction of p·ℓ², must be between 0 (integrate every pair) and 1e-6 "
-                   "(default 1e-9)");
+                   "(the default)");
       scene.contact_sliver_tolerance = tolerance;
     }
     if (contact["dashpot"])
@@ -526,6 +526,8 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
       scene.contact_friction_anchor_lag =
           r.positive(contact["friction_anchor_lag"], "contact.friction_anchor_lag",
                      "time (s) with which stick springs' anchors follow the contact");
+    if (contact["clip_replay"])
+      scene.contact_clip_replay = r.boolean(contact["clip_replay"], "contact.clip_replay");
     if (contact["skip_enclosed"])
       scene.contact_skip_enclosed = r.boolean(contact["skip_enclosed"], "contact.skip_enclosed");
     if (contact["narrowing"])

@@ -312,26 +312,36 @@ TEST_CASE(
   CHECK(e_t == Approx(predicted).epsilon(0.03));
 }
 
+namespace {
+
+// Blocks tumbling onto a base and each other with friction, for 0.06 s.
+Scene tumbling_blocks_scene() {
+  Scene scene = basic_scene(0.06);
+  scene.gravity = Vec3(0, 0, -9.81);
+  scene.materials.push_back(elastic_material(2000, 1e8, 0.25));
+  scene.materials[0].contact.friction = 0.4;
+  scene.bodies.push_back(box_body("base", Vec3(-1, -1, -0.2), Vec3(1, 1, 0), 6, 6, 1));
+  scene.bodies[0].fixed = true;
+  for (int i = 0; i < 4; ++i) {
+    scene.bodies.push_back(box_body("block" + std::to_string(i),
+                                    Vec3(-0.3 + 0.22 * i, -0.1, 0.002 + 0.05 * i),
+                                    Vec3(-0.1 + 0.22 * i, 0.1, 0.202 + 0.05 * i), 2, 2, 2));
+    scene.bodies.back().velocity = Vec3(0.5 - 0.3 * i, 0.2 * i, -2.0);
+    scene.bodies.back().angular_velocity = Vec3(3.0 * i, -2.0, 1.0);
+  }
+  return scene;
+}
+
+}  // namespace
+
 TEST_CASE("the buffer rule misses nothing: same state bit for bit as detection every step",
           "[verification][contact]") {
-  // Blocks tumbling onto a base and each other with friction: a run that re-detects only when the
-  // buffer is used up and one that re-detects every step evaluate the same overlapping pairs in the
-  // same order, so their states must agree to the last bit.
+  // A run that re-detects only when the buffer is used up and one that re-detects every step
+  // evaluate the same overlapping pairs in the same order, so their states must agree to the last
+  // bit.
   auto run = [](double buffer) {
-    Scene scene = basic_scene(0.06);
-    scene.gravity = Vec3(0, 0, -9.81);
-    scene.materials.push_back(elastic_material(2000, 1e8, 0.25));
-    scene.materials[0].contact.friction = 0.4;
+    Scene scene = tumbling_blocks_scene();
     scene.contact_buffer = buffer;
-    scene.bodies.push_back(box_body("base", Vec3(-1, -1, -0.2), Vec3(1, 1, 0), 6, 6, 1));
-    scene.bodies[0].fixed = true;
-    for (int i = 0; i < 4; ++i) {
-      scene.bodies.push_back(box_body("block" + std::to_string(i),
-                                      Vec3(-0.3 + 0.22 * i, -0.1, 0.002 + 0.05 * i),
-                                      Vec3(-0.1 + 0.22 * i, 0.1, 0.202 + 0.05 * i), 2, 2, 2));
-      scene.bodies.back().velocity = Vec3(0.5 - 0.3 * i, 0.2 * i, -2.0);
-      scene.bodies.back().angular_velocity = Vec3(3.0 * i, -2.0, 1.0);
-    }
     auto sim = quiet_simulation(scene);
     while (sim->time() < scene.time.end) sim->step();
     return std::make_pair(sim->report().state_hash, sim->contact_stage()->detections());
@@ -341,6 +351,29 @@ TEST_CASE("the buffer rule misses nothing: same state bit for bit as detection e
   INFO("detections: buffered " << lazy.second << ", every step " << eager.second);
   CHECK(lazy.second < eager.second / 10);
   CHECK(lazy.first == eager.first);
+}
+
+TEST_CASE("clips replayed from the step before leave the state bit for bit as fresh clips",
+          "[verification][contact]") {
+  // contact.clip_replay (clip_replay.hpp): the same operations in the same order whether a piece
+  // is replayed or clipped afresh; tumbling blocks make both happen.
+  auto run = [](bool replay, std::uint64_t& replayed, std::uint64_t& clipped) {
+    Scene scene = tumbling_blocks_scene();
+    scene.contact_clip_replay = replay;
+    auto sim = quiet_simulation(scene);
+    while (sim->time() < scene.time.end) sim->step();
+    replayed = sim->contact_stage()->pieces_replayed();
+    clipped = sim->contact_stage()->pieces_clipped();
+    return sim->report().state_hash;
+  };
+  std::uint64_t replayed = 0, clipped = 0, replayed_off = 0, clipped_off = 0;
+  const auto with_replay = run(true, replayed, clipped);
+  const auto without = run(false, replayed_off, clipped_off);
+  INFO(replayed << " pieces replayed, " << clipped << " clipped afresh");
+  CHECK(with_replay == without);
+  CHECK(replayed > 5 * clipped);
+  CHECK(clipped > 0);
+  CHECK(replayed_off + clipped_off == 0);  // not counted when the replay is off
 }
 
 namespace {

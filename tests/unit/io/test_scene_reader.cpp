@@ -178,34 +178,6 @@ TEST_CASE("omitted optional keys take the documented defaults", "[io]") {
   }
 }
 
-TEST_CASE("contact.dashpot: bodies or tets and nothing else", "[io]") {
-  CHECK(fdem::parse_scene(minimal_plus("contact: {dashpot: bodies}\n"), "scene.yaml")
-            .contact_body_dashpot);
-  CHECK_FALSE(fdem::parse_scene(minimal_plus("contact: {dashpot: tets}\n"), "scene.yaml")
-                  .contact_body_dashpot);
-  const std::string msg = input_error(minimal_plus("contact: {dashpot: pieces}\n"));
-  CHECK_THAT(msg, StartsWith("scene.yaml:10:"));
-  CHECK_THAT(msg, Contains("contact.dashpot"));
-  CHECK_THAT(msg, Contains("bodies"));
-  CHECK_THAT(msg, Contains("tets"));
-}
-
-TEST_CASE("contact.sliver_tolerance: a fraction from 0 to 1e-6", "[io]") {
-  CHECK(fdem::parse_scene(minimal_plus(""), "scene.yaml").contact_sliver_tolerance == 1e-6);
-  CHECK(fdem::parse_scene(minimal_plus("contact: {sliver_tolerance: 0}\n"), "scene.yaml")
-            .contact_sliver_tolerance == 0.0);
-  CHECK(fdem::parse_scene(minimal_plus("contact: {sliver_tolerance: 1.0e-12}\n"), "scene.yaml")
-            .contact_sliver_tolerance == 1e-12);
-  for (const char* bad : {"-1e-9", "0.001", "small"}) {
-    const std::string msg =
-        input_error(minimal_plus(std::string("contact: {sliver_tolerance: ") + bad + "}\n"));
-    CHECK_THAT(msg, StartsWith("scene.yaml:10:"));
-    CHECK_THAT(msg, Contains("contact.sliver_tolerance"));
-  }
-  CHECK_THAT(input_error(minimal_plus("contact: {sliver_tolerance: 0.001}\n")),
-             Contains("between 0"));
-}
-
 TEST_CASE("unknown keys are reported with file, line, path and the nearest valid key", "[io]") {
   SECTION("misspelt material key") {
     const std::string msg = input_error(minimal_with(4, "    densty: 2500"));

@@ -1,0 +1,153 @@
+// A piece's clip replayed from the step before (potential_contact.cpp).  A lasting pair clips
+// each of its pieces to the same vertex graph step after step: in the default example 99.7 % of
+// the clipped pieces cut the same vertices at every plane as one step earlier (docs/benchmarks.md,
+// "Where the default example's pairs go").  Which vertices a plane cuts off decides the whole
+// graph: the same cut edges, the same new vertices in the same order, the same faces.  So a
+// record of the clip (per plane: which vertices lay outside and which edges were cut; then the
+// faces) lets the next step redo the same arithmetic without the graph work (the cut-edge search,
+// the cap walk, the renumbering, the face walk), after checking every vertex's side.  Where one
+// side differs the piece is clipped afresh.  The same operations in the same order: bit for bit,
+// whatever the records hold (a restart or a migration that drops them changes nothing).
+//
+// A pair's record, as the contact stage keeps it between steps: for each piece that was clipped,
+// [key = 4 side + sub-tet][length][the piece's bytes], pieces in the kernel's order.  A piece's
+// bytes: per plane [outside mask, 16 bits][new vertices][their edges, 2 bytes each] (a plane that
+// cuts off nothing ends at its mask, one that cuts off everything ends the piece); then, for a
+// piece that keeps a volume, [faces] and per face [size][planes, 16 bits][its vertices].
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "contact/piece_clipper.hpp"
+
+namespace fdem {
+
+// What the contact stage hands the kernel for one pair.  Every part is optional.
+struct ClipMemo {
+  const std::uint8_t* previous = nullptr;  // the pair's record from the step before, or null
+  const std::uint8_t* previous_end = nullptr;
+  std::vector<std::uint8_t>* record = nullptr;  // this evaluation's record is appended here
+  std::uint32_t replayed = 0;                   // pieces replayed from the record
+  std::uint32_t clipped = 0;                    // pieces clipped afresh
+};
+
+namespace piece_clip {
+
+// The faces of a clipped piece, each walked counter-clockwise seen from outside.
+struct PieceFaces {
+  int count = 0;
+  std::uint8_t size[kMaxVertices];
+  unsigned planes[kMaxVertices];          // the planes all of a face's vertices lie on
+  std::uint8_t vertex[3 * kMaxVertices];  // face after face (each vertex is on 3 faces)
+};
+
+// The faces of the piece's vertex graph, faces of fewer than three vertices dropped.  False for a
+// corrupted graph (cannot happen).
+inline bool walk_faces(const Piece& piece, PieceFaces& faces) {
+  const int n = piece.count;
+  bool used[kMaxVertices][3];
+  for (int v = 0; v < n; ++v) used[v][0] = used[v][1] = used[v][2] = false;
+  faces.count = 0;
+  int entries = 0;
+  for (int vs = 0; vs < n; ++vs) {
+    for (int es = 0; es < 3; ++es) {
+      if (used[vs][es]) continue;
+      std::uint8_t* face = faces.vertex + entries;
+      int nf = 0;
+      unsigned face_planes = ~0u;
+      int vc = vs, e = es;
+      do {
+        used[vc][e] = true;
+        if (nf < kMaxVertices) face[nf++] = static_cast<std::uint8_t>(vc);
+        face_planes &= piece.v[vc].planes;
+        const int vn = piece.v[vc].next[e];
+        const int* back = piece.v[vn].next;
+        const int b = back[0] == vc ? 0 : back[1] == vc ? 1 : back[2] == vc ? 2 : 3;
+        if (b == 3) return false;
+        vc = vn;
+        e = b == 2 ? 0 : b + 1;
+      } while (vc != vs && nf < kMaxVertices);
+      if (nf < 3) continue;
+      faces.size[faces.count] = static_cast<std::uint8_t>(nf);
+      faces.planes[faces.count] = face_planes;
+      ++faces.count;
+      entries += nf;
+    }
+  }
+  return true;
+}
+
+// Appends the faces to a piece's log (the log turns invalid where they do not fit).
+inline void log_faces(const PieceFaces& faces, ClipLog& log) {
+  int entries = 0;
+  for (int f = 0; f < faces.count; ++f) entries += faces.size[f];
+  if (!log.room(1 + 3 * faces.count + entries)) return;
+  log.put(static_cast<unsigned>(faces.count));
+  const std::uint8_t* vertex = faces.vertex;
+  for (int f = 0; f < faces.count; ++f) {
+    log.put(faces.size[f]);
+    log.put(faces.planes[f] & 0xFFu);
+    log.put((faces.planes[f] >> 8) & 0xFFu);
+    for (int j = 0; j < faces.size[f]; ++j) log.put(*vertex++);
+  }
+}
+
+enum class Replay { kept, clipped_away, side_changed };
+
+// Redoes the clip of `piece` (its sub-tet's four vertices in v[0..3], graph unused) from the
+// record `bytes`: new vertices are appended to piece.v from slot 4 on; `vertex` gets the kept
+// piece's vertices in the clipper's order and `faces` its faces.  side_changed: some vertex lies
+// on the other side of a plane than in the record (piece.v[0..3] are untouched: clip afresh).
+inline Replay replay_piece(Piece& piece, const std::uint8_t* bytes, const std::uint8_t* end,
+                           const PieceVertex** vertex, int& n_vertices, PieceFaces& faces) {
+  int current[kMaxVertices] = {0, 1, 2, 3};
+  int n = 4, made = 4;
+  for (int b = 0; b < 4; ++b) {
+    if (end - bytes < 2) return Replay::side_changed;  // cannot happen: records are the kernel's
+    const unsigned recorded = bytes[0] | (static_cast<unsigned>(bytes[1]) << 8);
+    bytes += 2;
+    const int k = 4 + b;
+    double dist[ClipLog::kMaxStageVertices];
+    unsigned mask = 0;
+    for (int j = 0; j < n; ++j) {
+      dist[j] = piece.v[current[j]].lam[k];
+      mask |= static_cast<unsigned>(dist[j] < 0.0) << j;
+    }
+    if (mask != recorded) return Replay::side_changed;
+    if (mask == 0) continue;
+    if (mask == (1u << n) - 1u) return Replay::clipped_away;
+    const int n_new = *bytes++;
+    if (end - bytes < 2 * n_new || made + n_new > kMaxVertices) return Replay::side_changed;
+    int next[kMaxVertices];
+    int kept = 0;
+    for (int j = 0; j < n; ++j)
+      if (!((mask >> j) & 1u)) next[kept++] = current[j];
+    const unsigned plane_bit = 1u << (kOtherFaceShift + b);
+    for (int q = 0; q < n_new; ++q, bytes += 2) {
+      const int a = bytes[0], c = bytes[1];
+      cut_edge(piece.v[current[a]], piece.v[current[c]], dist[a], dist[c], k, plane_bit,
+               piece.v[made]);
+      next[kept++] = made++;
+    }
+    if (kept > ClipLog::kMaxStageVertices && b < 3) return Replay::side_changed;
+    for (int j = 0; j < kept; ++j) current[j] = next[j];
+    n = kept;
+  }
+  if (end - bytes < 1) return Replay::side_changed;
+  faces.count = *bytes++;
+  int entries = 0;
+  for (int f = 0; f < faces.count; ++f) {
+    const int size = bytes[0];
+    faces.size[f] = static_cast<std::uint8_t>(size);
+    faces.planes[f] = bytes[1] | (static_cast<unsigned>(bytes[2]) << 8);
+    bytes += 3;
+    for (int j = 0; j < size; ++j) faces.vertex[entries++] = *bytes++;
+  }
+  for (int j = 0; j < n; ++j) vertex[j] = &piece.v[current[j]];
+  n_vertices = n;
+  return Replay::kept;
+}
+
+}  // namespace piece_clip
+}  // namespace fdem

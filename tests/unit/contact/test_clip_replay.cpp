@@ -1,0 +1,178 @@
+// Pieces' clips replayed from the step before (contact/clip_replay.hpp): a pair evaluated with
+// its record of the step before gives the fresh evaluation's results bit for bit, whether the
+// record is replayed (every vertex kept its side of every plane) or falls back to a fresh clip.
+#include <catch2/catch.hpp>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "contact/clip_replay.hpp"
+#include "contact/potential_contact_kernels.hpp"
+#include "test_potential_contact_support.hpp"
+
+using namespace fdem;
+using namespace fdem::test_contact;
+
+namespace {
+
+bool same_bits(const ContactPairResult& a, const ContactPairResult& b) {
+  const auto same = [](const auto& x, const auto& y) {
+    return std::memcmp(&x, &y, sizeof(x)) == 0;
+  };
+  bool equal = a.overlapping == b.overlapping && same(a.energy, b.energy) &&
+               same(a.overlap_volume, b.overlap_volume) && same(a.normal_force, b.normal_force) &&
+               same(a.centroid_weights_contactor, b.centroid_weights_contactor) &&
+               same(a.centroid_weights_target, b.centroid_weights_target);
+  for (int v = 0; v < 4; ++v)
+    equal =
+        equal &&
+        std::memcmp(a.force_contactor[v].data(), b.force_contactor[v].data(), 3 * sizeof(double)) ==
+            0 &&
+        std::memcmp(a.force_target[v].data(), b.force_target[v].data(), 3 * sizeof(double)) == 0;
+  return equal && std::memcmp(a.normal.data(), b.normal.data(), 3 * sizeof(double)) == 0 &&
+         std::memcmp(a.centroid.data(), b.centroid.data(), 3 * sizeof(double)) == 0;
+}
+
+// A pair followed over `steps` steps, each corner moving by up to `step` (m) per step (a random
+// rigid drift plus noise), evaluated fresh and with the record of the step before.
+struct Followed {
+  long evaluations = 0, mismatches = 0;
+  std::uint64_t replayed = 0, clipped = 0;
+};
+
+void follow(std::mt19937_64& rng, TetCorners c, TetCorners t, int steps, double step,
+            double sliver_tolerance, Followed& out) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Vec3 drift = step * random_unit(rng);
+  std::vector<std::uint8_t> records[2];
+  int parity = 0;
+  for (int s = 0; s < steps; ++s) {
+    for (int v = 0; v < 4; ++v) {
+      c.x[v] += drift + 0.3 * step * Vec3(u(rng), u(rng), u(rng));
+      t.x[v] += 0.3 * step * Vec3(u(rng), u(rng), u(rng));
+    }
+    PreparedContactor prepared;
+    prepare_contactor(c, prepared);
+    TetGeometry geometry;
+    compute_tet_geometry(t, geometry);
+    const ContactPairResult fresh = potential_contact(prepared, geometry, 1e9, sliver_tolerance);
+    ClipMemo memo;
+    memo.previous = records[parity].empty() ? nullptr : records[parity].data();
+    memo.previous_end = records[parity].data() + records[parity].size();
+    records[parity ^ 1].clear();
+    memo.record = &records[parity ^ 1];
+    const ContactPairResult replayed =
+        potential_contact(prepared, geometry, 1e9, sliver_tolerance, &memo);
+    parity ^= 1;
+    ++out.evaluations;
+    out.mismatches += same_bits(fresh, replayed) ? 0 : 1;
+    out.replayed += memo.replayed;
+    out.clipped += memo.clipped;
+  }
+}
+
+}  // namespace
+
+TEST_CASE("a pair replayed from its record of the step before equals a fresh clip bit for bit",
+          "[contact][clip_replay]") {
+  std::mt19937_64 rng(20261129);
+  for (const double tolerance : {0.0, 1e-6}) {
+    Followed slow, fast;
+    for (int p = 0; p < 150; ++p) {
+      TetCorners c, t;
+      random_overlapping_pair(rng, Vec3::Zero(), c, t);
+      follow(rng, c, t, 30, 1e-5, tolerance, slow);  // a lasting contact: sides rarely change
+      follow(rng, c, t, 30, 2e-2, tolerance, fast);  // sides change often: many fresh clips
+    }
+    INFO("tolerance " << tolerance << ": slow " << slow.replayed << " replayed, " << slow.clipped
+                      << " clipped; fast " << fast.replayed << " replayed, " << fast.clipped
+                      << " clipped");
+    CHECK(slow.mismatches == 0);
+    CHECK(fast.mismatches == 0);
+    // Most of a slow pair's pieces replay; a fast pair's fall back to the clipper often.
+    CHECK(slow.replayed > 10 * slow.clipped);
+    CHECK(fast.clipped > fast.replayed / 10);
+    CHECK(fast.replayed > 0);
+  }
+}
+
+TEST_CASE("pressed faces sliding on unmatched meshes replay bit for bit",
+          "[contact][clip_replay]") {
+  // The upper tet's bottom face 1e-6 … 1e-3 into the lower tet's top face (z = 0), shifted and
+  // turned in the plane, then sliding: the contact of blocks resting on blocks.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Followed total;
+  for (int p = 0; p < 200; ++p) {
+    const double depth = std::pow(10.0, -6.0 + 3.0 * u(rng));
+    const Mat3 spin = Eigen::AngleAxisd(2.0 * M_PI * u(rng), Vec3::UnitZ()).toRotationMatrix();
+    const Vec3 shift(1.2 * u(rng) - 0.6, 1.2 * u(rng) - 0.6, -depth);
+    TetCorners lower, upper;
+    lower.x[0] = Vec3(0, 0, 0);
+    lower.x[1] = Vec3(1, 0, 0);
+    lower.x[2] = Vec3(0, 1, 0);
+    lower.x[3] = Vec3(0.3 + 0.4 * u(rng), 0.3 + 0.4 * u(rng), -0.5 - 0.5 * u(rng));
+    for (int v = 0; v < 3; ++v) upper.x[v] = spin * lower.x[v] + shift;
+    upper.x[3] = spin * Vec3(0.3 + 0.4 * u(rng), 0.3 + 0.4 * u(rng), 0.5 + 0.5 * u(rng)) + shift;
+    follow(rng, upper, lower, 20, 0.01 * depth, 1e-6, total);
+  }
+  INFO(total.replayed << " replayed, " << total.clipped << " clipped");
+  CHECK(total.mismatches == 0);
+  CHECK(total.replayed > 5 * total.clipped);
+}
+
+TEST_CASE("a clip log replays the clipper's own vertices", "[contact][clip_replay]") {
+  // One sub-tet-like piece cut by four planes through its interior, logged, then replayed on the
+  // same values: the replay makes the same vertices and faces; a changed side is refused.
+  using namespace piece_clip;
+  Piece piece;
+  piece.count = 4;
+  const double other[4][4] = {
+      {0.6, 0.2, -0.3, 0.5}, {-0.2, 0.7, 0.4, 0.1}, {0.3, -0.4, 0.6, 0.5}, {0.4, 0.5, 0.3, -0.2}};
+  for (int s = 0; s < 4; ++s) {
+    for (int a = 0; a < 4; ++a) piece.v[s].lam[a] = a == s ? 1.0 : 0.0;
+    for (int b = 0; b < 4; ++b) piece.v[s].lam[4 + b] = other[s][b];
+    for (int e = 0; e < 3; ++e) piece.v[s].next[e] = kTetNeighbours[s][e];
+    piece.v[s].planes = 0;
+  }
+  Piece fresh = piece;
+  ClipLog log;
+  bool alive = true;
+  for (int b = 0; b < 4 && alive; ++b)
+    alive = clip_piece(fresh, 4 + b, 1u << (kOtherFaceShift + b), &log);
+  REQUIRE(alive);
+  PieceFaces faces;
+  REQUIRE(walk_faces(fresh, faces));
+  log_faces(faces, log);
+  REQUIRE(log.valid);
+  CHECK(fresh.count >= 7);  // every plane cut something
+
+  Piece pool = piece;
+  const PieceVertex* vertex[kMaxVertices];
+  int n = 0;
+  PieceFaces replayed_faces;
+  REQUIRE(replay_piece(pool, log.bytes, log.bytes + log.size, vertex, n, replayed_faces) ==
+          Replay::kept);
+  REQUIRE(n == fresh.count);
+  for (int v = 0; v < n; ++v) {
+    CHECK(std::memcmp(vertex[v]->lam, fresh.v[v].lam, sizeof(fresh.v[v].lam)) == 0);
+    CHECK(vertex[v]->planes == fresh.v[v].planes);
+  }
+  REQUIRE(replayed_faces.count == faces.count);
+  int entries = 0;
+  for (int f = 0; f < faces.count; ++f) {
+    CHECK(replayed_faces.size[f] == faces.size[f]);
+    CHECK(replayed_faces.planes[f] == faces.planes[f]);
+    entries += faces.size[f];
+  }
+  CHECK(std::memcmp(replayed_faces.vertex, faces.vertex, static_cast<std::size_t>(entries)) == 0);
+
+  // Corner 1 moved across plane 0 (outside before, inside now): refused, the corners untouched.
+  Piece moved = piece;
+  moved.v[1].lam[4] = 0.1;
+  const Piece before = moved;
+  REQUIRE(replay_piece(moved, log.bytes, log.bytes + log.size, vertex, n, replayed_faces) ==
+          Replay::side_changed);
+  for (int s = 0; s < 4; ++s)
+    CHECK(std::memcmp(moved.v[s].lam, before.v[s].lam, sizeof(before.v[s].lam)) == 0);
+}
