@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "contact/piece_clipper.hpp"
@@ -101,7 +102,10 @@ enum class Replay { kept, clipped_away, side_changed };
 // on the other side of a plane than in the record (piece.v[0..3] are untouched: clip afresh).
 inline Replay replay_piece(Piece& piece, const std::uint8_t* bytes, const std::uint8_t* end,
                            const PieceVertex** vertex, int& n_vertices, PieceFaces& faces) {
-  int current[kMaxVertices] = {0, 1, 2, 3};
+  int slots[2][kMaxVertices];  // the vertices alive before and after a plane, as pool slots
+  int* current = slots[0];
+  int* next = slots[1];
+  for (int j = 0; j < 4; ++j) current[j] = j;
   int n = 4, made = 4;
   for (int b = 0; b < 4; ++b) {
     if (end - bytes < 2) return Replay::side_changed;  // cannot happen: records are the kernel's
@@ -119,7 +123,6 @@ inline Replay replay_piece(Piece& piece, const std::uint8_t* bytes, const std::u
     if (mask == (1u << n) - 1u) return Replay::clipped_away;
     const int n_new = *bytes++;
     if (end - bytes < 2 * n_new || made + n_new > kMaxVertices) return Replay::side_changed;
-    int next[kMaxVertices];
     int kept = 0;
     for (int j = 0; j < n; ++j)
       if (!((mask >> j) & 1u)) next[kept++] = current[j];
@@ -131,7 +134,7 @@ inline Replay replay_piece(Piece& piece, const std::uint8_t* bytes, const std::u
       next[kept++] = made++;
     }
     if (kept > ClipLog::kMaxStageVertices && b < 3) return Replay::side_changed;
-    for (int j = 0; j < kept; ++j) current[j] = next[j];
+    std::swap(current, next);
     n = kept;
   }
   if (end - bytes < 1) return Replay::side_changed;

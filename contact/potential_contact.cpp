@@ -21,9 +21,10 @@ using namespace piece_clip;
 // end.  `moments`: how many carried values need their moment (4: own only, 8: own and other).
 // area_weight[j]: maps a barycentric-space doubled area vector to the doubled physical area
 // projected on face j's outward unit normal.
+template <int moments>
 void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& faces, int own_sub,
                      const double (&area_weight)[4][3], const double (&side_weight)[4][3],
-                     unsigned flux_slots, int moments, SideIntegrals& out) {
+                     unsigned flux_slots, SideIntegrals& out) {
   double volume_weight[kMaxVertices];      // Σ vol6 of the cones having the vertex on their base
   double surface_weight[4][kMaxVertices];  // per other face: Σ area × (f_k + Σf) of its triangles
   bool on_face[4] = {false, false, false, false};
@@ -230,8 +231,8 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
           side_weight[slot][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
       }
       if (walked)
-        integrate_piece(vertex, n_vertices, faces, i, area_weight, side_weight, slots, moments,
-                        out);
+        (moments == 8 ? integrate_piece<8> : integrate_piece<4>)(
+            vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);
     }
   }
 }

@@ -6,7 +6,11 @@ algorithm), alternating in one invocation, one core each.
 
   benchmarks/contact_slivers/run.py [--fdem build/drivers/fdem] [--repeats 3]
       [--tolerances 0,1e-6] [--cases wall_tilt,arch,tower,dry_wall]
+      [--also 'LABEL=KEY=VALUE' ...]
       [--baseline OLD_FDEM [--baseline-tolerance none]] [--csv docs/data/bench_contact_slivers.csv]
+
+With --also, one more variant per option: the current binary at the last tolerance with the scene
+key KEY set to VALUE (e.g. --also 'no replay=contact.clip_replay=false').
 
 With --baseline, a third variant runs that binary (an older build) at the last tolerance, in the
 same alternation: the ratio of the current code's skipping against the older one's.
@@ -19,6 +23,9 @@ tolerances):
   tower      the default example (tower and projectile), first 0.1 s: the projectile hits at 14 ms
   dry_wall   examples/dry-stone-wall-seismic.yaml, first 0.2 s (2 mm mortar gaps: the stones land)
   pile       bench_contact_pile's dense pile of 64 blocks (3,558 tets) as a scene, first 4 ms
+  wall55     a dry running-bond wall of 55 blocks (10 courses of 5 units, E 5 GPa, penalty auto,
+             642 tets with the table) on a tilting table turning at 10°/s from 0.02 s, fully
+             dynamic (no quasi-static mode), first 0.03 s: issue 12's dry-wall scene
 Measured per run: user CPU seconds, steps, the contact stage's seconds, the energy balance error,
 the state_hash; per case: the speed-up (best of the repeats) and the largest difference of a
 piece's centroid between the tolerances.
@@ -47,12 +54,43 @@ def case_scene(name, workdir):
         return os.path.join(root, "examples", "tower-projectile.yaml"), ["time.end=0.1"]
     if name == "dry_wall":
         return os.path.join(root, "examples", "dry-stone-wall-seismic.yaml"), ["time.end=0.2"]
+    if name == "wall55":
+        path = os.path.join(workdir, "wall55.yaml")
+        with open(path, "w") as f:
+            f.write(wall55_scene(0.03))
+        return path, []
     if name == "pile":
         path = os.path.join(workdir, "pile.yaml")
         with open(path, "w") as f:
             f.write(pile_scene(4, 0.004))
         return path, []
-    raise SystemExit(f"unknown case {name}: wall_tilt, arch, tower, dry_wall or pile")
+    raise SystemExit(f"unknown case {name}: wall_tilt, arch, tower, dry_wall, pile or wall55")
+
+
+def wall55_scene(end):
+    """55 touching blocks in running bond on a fixed table that tilts about y, dynamic."""
+    return f"""name: wall55
+time: {{end: {end}, step: auto, safety: 0.7}}
+gravity: [0, 0, -9.81]
+materials:
+  brick:
+    density: 2000
+    elastic: {{young: 5.0e9, poisson: 0.2}}
+    contact: {{friction: 0.7}}
+bodies:
+  - name: table
+    mesh: {{box: {{min: [-0.2, -0.1, -0.1], max: [1.2, 0.2, 0], cells: [7, 1, 1]}}}}
+    material: brick
+    fixed: true
+  - name: wall
+    mesh: {{wall: {{unit: [0.2, 0.1, 0.1], courses: 10, units_per_course: 5, bond: running,
+                  mortar_gap: 0, cells_per_unit: [2, 1, 1], origin: [0, 0, 0]}}}}
+    material: brick
+loads:
+  - {{tilt: {{axis: [0, 1, 0], rate: 10.0, max: 40, start: 0.02}}}}
+output:
+  every: 0
+"""
 
 
 def pile_scene(k, end):
@@ -109,6 +147,8 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--tolerances", default="0,1e-6")
     ap.add_argument("--cases", default="wall_tilt,arch,tower,dry_wall")
+    ap.add_argument("--also", action="append", default=[],
+                    help="LABEL=KEY=VALUE: the current binary with a scene key set")
     ap.add_argument("--baseline", help="an older fdem binary, run at the last tolerance")
     ap.add_argument("--baseline-tolerance",
                     help="the baseline's tolerance instead (none: a binary without the key)")
@@ -117,23 +157,26 @@ def main():
     a = ap.parse_args()
     tolerances = a.tolerances.split(",")
     # (label, binary, tolerance); the first is the reference of the speed-ups
-    variants = [(f"tolerance {t}", a.fdem, t) for t in tolerances]
+    variants = [(f"tolerance {t}", a.fdem, t, []) for t in tolerances]
+    for also in a.also:
+        label, setting = also.split("=", 1)
+        variants.append((label, a.fdem, tolerances[-1], [setting]))
     if a.baseline:
         t = a.baseline_tolerance or tolerances[-1]
-        variants.append((f"baseline {t}", a.baseline, t))
+        variants.append((f"baseline {t}", a.baseline, t, []))
     rows = []
     with tempfile.TemporaryDirectory() as workdir:
         for name in a.cases.split(","):
             scene, overrides = case_scene(name, workdir)
             best = {}
             for repeat in range(a.repeats):
-                for label, fdem, tol in variants:  # alternating: drift hits every variant
-                    r = run_once(fdem, scene, overrides, tol,
+                for label, fdem, tol, settings in variants:  # alternating: drift hits all
+                    r = run_once(fdem, scene, overrides + settings, tol,
                                  os.path.join(workdir, f"{name}_{len(best)}"))
                     if label not in best or r["cpu"] < best[label]["cpu"]:
                         best[label] = r
             reference = best[variants[0][0]]
-            for label, fdem, tol in variants:
+            for label, fdem, tol, settings in variants:
                 r = best[label]
                 moved = max(
                     (sum((p - q) ** 2 for p, q in zip(r["centroids"][k],
