@@ -105,15 +105,8 @@ TEST_CASE("pressed faces sliding on unmatched meshes replay bit for bit",
   Followed total;
   for (int p = 0; p < 200; ++p) {
     const double depth = std::pow(10.0, -6.0 + 3.0 * u(rng));
-    const Mat3 spin = Eigen::AngleAxisd(2.0 * M_PI * u(rng), Vec3::UnitZ()).toRotationMatrix();
-    const Vec3 shift(1.2 * u(rng) - 0.6, 1.2 * u(rng) - 0.6, -depth);
     TetCorners lower, upper;
-    lower.x[0] = Vec3(0, 0, 0);
-    lower.x[1] = Vec3(1, 0, 0);
-    lower.x[2] = Vec3(0, 1, 0);
-    lower.x[3] = Vec3(0.3 + 0.4 * u(rng), 0.3 + 0.4 * u(rng), -0.5 - 0.5 * u(rng));
-    for (int v = 0; v < 3; ++v) upper.x[v] = spin * lower.x[v] + shift;
-    upper.x[3] = spin * Vec3(0.3 + 0.4 * u(rng), 0.3 + 0.4 * u(rng), 0.5 + 0.5 * u(rng)) + shift;
+    face_on_face(rng, depth, lower, upper);
     follow(rng, upper, lower, 20, 0.01 * depth, 1e-6, total);
   }
   INFO(total.replayed << " replayed, " << total.clipped << " clipped");

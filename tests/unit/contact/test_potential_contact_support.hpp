@@ -61,6 +61,20 @@ inline void random_overlapping_pair(std::mt19937_64& rng, const Vec3& origin, Te
   }
 }
 
+// The upper tet's bottom face in the lower tet's top face plane (z = 0), pressed `depth` into
+// it, shifted and turned in the plane: blocks resting on blocks with unmatched meshes.
+inline void face_on_face(std::mt19937_64& rng, double depth, TetCorners& lower, TetCorners& upper) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Mat3 spin = Eigen::AngleAxisd(2.0 * M_PI * u(rng), Vec3::UnitZ()).toRotationMatrix();
+  const Vec3 shift(1.2 * u(rng) - 0.6, 1.2 * u(rng) - 0.6, -depth);
+  lower.x[0] = Vec3(0, 0, 0);
+  lower.x[1] = Vec3(1, 0, 0);
+  lower.x[2] = Vec3(0, 1, 0);
+  lower.x[3] = Vec3(0.3 + 0.4 * u(rng), 0.3 + 0.4 * u(rng), -0.5 - 0.5 * u(rng));
+  for (int v = 0; v < 3; ++v) upper.x[v] = spin * lower.x[v] + shift;
+  upper.x[3] = spin * Vec3(0.3 + 0.4 * u(rng), 0.3 + 0.4 * u(rng), 0.5 + 0.5 * u(rng)) + shift;
+}
+
 inline double max_force(const ContactPairResult& r) {
   double m = 0.0;
   for (int v = 0; v < 4; ++v) {
