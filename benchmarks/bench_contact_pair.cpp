@@ -243,8 +243,7 @@ int main(int argc, char** argv) {
        {std::pair<const char*, const std::vector<Pair>*>{"overlapping_pairs", &overlapping},
         {"shallow_overlapping_pairs", &shallow},
         {"face_on_face_pairs", &face_on_face}}) {
-    std::vector<std::vector<std::uint8_t>> records(2 * set->size());
-    std::vector<int> parity(set->size(), 0);
+    std::vector<PairClipRecords> records(set->size());
     auto lasting = [&](const Pair& p, bool replay) {
       const std::size_t i = static_cast<std::size_t>(&p - set->data());
       PreparedContactor prepared;
@@ -252,14 +251,7 @@ int main(int argc, char** argv) {
       TetGeometry geometry;
       compute_tet_geometry(p.b, geometry);
       if (!replay) return potential_contact(prepared, geometry, penalty).energy;
-      std::vector<std::uint8_t>& read = records[2 * i + parity[i]];
-      std::vector<std::uint8_t>& written = records[2 * i + (parity[i] ^ 1)];
-      written.clear();
-      ClipMemo memo;
-      memo.previous = read.empty() ? nullptr : read.data();
-      memo.previous_end = read.data() + read.size();
-      memo.record = &written;
-      parity[i] ^= 1;
+      ClipMemo memo = records[i].next();
       return potential_contact(prepared, geometry, penalty, 0.0, &memo).energy;
     };
     rows.push_back({std::string(name) + "_lasting_replayed", set->size(),

@@ -26,11 +26,35 @@ namespace fdem {
 
 // What the contact stage hands the kernel for one pair.  Every part is optional.
 struct ClipMemo {
-  const std::uint8_t* previous = nullptr;  // the pair's record from the step before, or null
+  // The pair's record from the step before, or null; the kernel reads it forward from here.
+  const std::uint8_t* previous = nullptr;
   const std::uint8_t* previous_end = nullptr;
   std::vector<std::uint8_t>* record = nullptr;  // this evaluation's record is appended here
   std::uint32_t replayed = 0;                   // pieces replayed from the record
   std::uint32_t clipped = 0;                    // pieces clipped afresh
+};
+
+// One pair's records from one evaluation to the next, for code that follows single pairs (tests,
+// benchmarks); the contact stage keeps all its pairs' records in two shared buffers instead.
+class PairClipRecords {
+ public:
+  // A memo that reads the record of the evaluation before and writes this one's; valid until
+  // the next call.
+  ClipMemo next() {
+    const std::vector<std::uint8_t>& read = records_[parity_];
+    std::vector<std::uint8_t>& written = records_[parity_ ^ 1];
+    written.clear();
+    parity_ ^= 1;
+    ClipMemo memo;
+    memo.previous = read.empty() ? nullptr : read.data();
+    memo.previous_end = read.data() + read.size();
+    memo.record = &written;
+    return memo;
+  }
+
+ private:
+  std::vector<std::uint8_t> records_[2];
+  int parity_ = 0;
 };
 
 namespace piece_clip {

@@ -73,15 +73,15 @@ inline bool clip_piece(Piece& piece, int k, unsigned plane_bit, ClipLog* log = n
   double dist[kMaxVertices];
   bool outside[kMaxVertices];
   int n_outside = 0;
-  unsigned mask = 0;
   for (int i = 0; i < n; ++i) {
     dist[i] = piece.v[i].lam[k];
     outside[i] = dist[i] < 0.0;
     n_outside += outside[i];
-    mask |= static_cast<unsigned>(outside[i]) << (i & 31);
   }
   if (log && (n > ClipLog::kMaxStageVertices || !log->room(3))) log->valid = false;
   if (log && log->valid) {
+    unsigned mask = 0;
+    for (int i = 0; i < n; ++i) mask |= static_cast<unsigned>(outside[i]) << i;
     log->put(mask & 0xFFu);
     log->put(mask >> 8);
   }

@@ -44,8 +44,7 @@ void follow(std::mt19937_64& rng, TetCorners c, TetCorners t, int steps, double 
             double sliver_tolerance, Followed& out) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const Vec3 drift = step * random_unit(rng);
-  std::vector<std::uint8_t> records[2];
-  int parity = 0;
+  PairClipRecords records;
   for (int s = 0; s < steps; ++s) {
     for (int v = 0; v < 4; ++v) {
       c.x[v] += drift + 0.3 * step * Vec3(u(rng), u(rng), u(rng));
@@ -56,14 +55,9 @@ void follow(std::mt19937_64& rng, TetCorners c, TetCorners t, int steps, double 
     TetGeometry geometry;
     compute_tet_geometry(t, geometry);
     const ContactPairResult fresh = potential_contact(prepared, geometry, 1e9, sliver_tolerance);
-    ClipMemo memo;
-    memo.previous = records[parity].empty() ? nullptr : records[parity].data();
-    memo.previous_end = records[parity].data() + records[parity].size();
-    records[parity ^ 1].clear();
-    memo.record = &records[parity ^ 1];
+    ClipMemo memo = records.next();
     const ContactPairResult replayed =
         potential_contact(prepared, geometry, 1e9, sliver_tolerance, &memo);
-    parity ^= 1;
     ++out.evaluations;
     out.mismatches += same_bits(fresh, replayed) ? 0 : 1;
     out.replayed += memo.replayed;
