@@ -10,8 +10,10 @@
 // a corner).  Two slabs A, B with non-parallel gradients g_A, g_B meet in a prism along
 // g_A × g_B whose cross-section is a parallelogram of area mu_A mu_B / |g_A × g_B| and perimeter
 // 2 (mu_A |g_B| + mu_B |g_A|) / |g_A × g_B|; along the prism Omega is no longer than the shorter
-// tet's longest edge W.  That bounds Omega's volume V and (a convex set inside a convex set has
-// the smaller surface) the area S of its boundary.  On Omega the potentials are bounded too:
+// tet's longest edge W.  Three slabs with independent gradients meet in a parallelepiped, which
+// is thin in all three directions where a corner of one tet pokes into the other.  These bound
+// Omega's volume V and (a convex set inside a convex set has the smaller surface) the area S of
+// its boundary.  On Omega the potentials are bounded too:
 // phi_T = 4 min_a lambda_a^T <= 4 min_a mu_a^T =: Phi_T.
 //
 // With the force formulas of potential_contact_kernels.hpp, every nodal force of tet T obeys
@@ -91,17 +93,36 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
   double surface_bound = 12.0 * std::min(volume[0] * gradient_max[0], volume[1] * gradient_max[1]);
   // One slab alone: the part of T within lambda_a <= mu is at most 3 mu of T's volume.
   for (int k = 0; k < 8; ++k) volume_bound = std::min(volume_bound, 3.0 * mu[k] * volume[k / 4]);
+  double norm[8];
+  for (int i = 0; i < thin_count; ++i) norm[i] = gradient[thin[i]]->norm();
+  Vec3 cross[8][8];  // [i][j], i < j: g_thin[i] × g_thin[j]
   for (int i = 0; i < thin_count; ++i)
     for (int j = i + 1; j < thin_count; ++j) {
       const int k = thin[i], l = thin[j];
-      const double cross = gradient[k]->cross(*gradient[l]).norm();
-      if (!(cross > 0.0)) continue;
-      const double section = mu[k] * mu[l] / cross;
-      const double perimeter =
-          2.0 * (mu[k] * gradient[l]->norm() + mu[l] * gradient[k]->norm()) / cross;
+      cross[i][j] = gradient[k]->cross(*gradient[l]);
+      const double cross_norm = cross[i][j].norm();
+      if (!(cross_norm > 0.0)) continue;
+      const double section = mu[k] * mu[l] / cross_norm;
+      const double perimeter = 2.0 * (mu[k] * norm[j] + mu[l] * norm[i]) / cross_norm;
       volume_bound = std::min(volume_bound, section * length);
       surface_bound = std::min(surface_bound, 2.0 * section + perimeter * length);
     }
+  // Three slabs: a parallelepiped, thin in all three directions where a corner pokes into the
+  // other tet (the prism above stays a whole edge long there).  Its edges are mu_k times the dual
+  // vectors of the three gradients, so volume mu_k mu_l mu_m / |det| and faces mu_l mu_m |g_k| /
+  // |det|, det = g_k · (g_l × g_m).
+  for (int i = 0; i < thin_count; ++i)
+    for (int j = i + 1; j < thin_count; ++j)
+      for (int m = j + 1; m < thin_count; ++m) {
+        const int k = thin[i], l = thin[j], n = thin[m];
+        const double det = std::abs(gradient[n]->dot(cross[i][j]));
+        if (!(det > 0.0)) continue;
+        volume_bound = std::min(volume_bound, mu[k] * mu[l] * mu[n] / det);
+        surface_bound = std::min(
+            surface_bound,
+            2.0 * (mu[l] * mu[n] * norm[i] + mu[k] * mu[n] * norm[j] + mu[k] * mu[l] * norm[m]) /
+                det);
+      }
   PairForceBound bound;
   bound.volume = volume_bound;
   bound.surface = surface_bound;

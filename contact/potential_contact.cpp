@@ -230,11 +230,10 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
         for (int k = 0; k < 3; ++k)
           side_weight[slot][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
       }
-      if (walked)
-        if (moments == 8)
-          integrate_piece<8>(vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);
-        else
-          integrate_piece<4>(vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);
+      if (walked && moments == 8)
+        integrate_piece<8>(vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);
+      else if (walked)
+        integrate_piece<4>(vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);
     }
   }
 }
