@@ -32,6 +32,16 @@ struct ClipMemo {
   std::vector<std::uint8_t>* record = nullptr;  // this evaluation's record is appended here
   std::uint32_t replayed = 0;                   // pieces replayed from the record
   std::uint32_t clipped = 0;                    // pieces clipped afresh
+  // How the pair came out at the step before (kNotApart: overlapping, skipped or not evaluated;
+  // kClippedEmpty: it passed the face planes and the bound but clipped to nothing;
+  // kApartAtAxis + k: edge–edge axis k separated it; kApartAtPlane + j: face plane j did) and,
+  // out, at this one.  A pair apart mostly stays apart the same way: the plane is tested first,
+  // and a pair apart at an edge–edge axis the face planes miss tries the axes first.  The same
+  // decisions as without, so the same results bit for bit.
+  static constexpr std::uint8_t kNotApart = 0, kClippedEmpty = 1, kApartAtAxis = 2,
+                                kApartAtPlane = kApartAtAxis + 36;
+  std::uint8_t apart_before = kNotApart;
+  std::uint8_t apart_now = kNotApart;
 };
 
 // One pair's records from one evaluation to the next, for code that follows single pairs (tests,

@@ -236,6 +236,7 @@ void ContactStage::candidates_changed() {
   may_hold_friction_.assign(pairs_.size(), 1);
   release(friction_of_pair_);
   release(clip_record_at_);
+  release(apart_at_);
   pair_slots_.clear();
   pair_tets_.clear();
 }
@@ -280,6 +281,7 @@ void ContactStage::release_until_rebind() {
   release(may_hold_friction_);
   release(friction_of_pair_);
   release(clip_record_at_);
+  release(apart_at_);
   release(clip_records_[0]);
   release(clip_records_[1]);
   release(pair_tets_);
@@ -364,6 +366,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
     std::uint32_t clip_read_at = kNoClipRecord;
     if (!clip_record_at_.empty()) std::swap(clip_read_at, clip_record_at_[index]);
+    std::uint8_t apart_before = ClipMemo::kNotApart;  // renewed below where the kernel runs
+    if (!apart_at_.empty()) std::swap(apart_before, apart_at_[index]);
     const CandidatePair& pair = pairs_[index];
     const std::int32_t slot_a = pair_slots_[2 * index], slot_b = pair_slots_[2 * index + 1];
     const auto lost = [&] {  // not overlapping: a stick spring is released
@@ -388,10 +392,13 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     }
     const double penalty = std::min(penalty_[ma], penalty_[mb]);
     ClipMemo memo;
+    memo.apart_before = apart_before;
     std::size_t record_start = 0;
     if (clip_replay_) {
-      if (clip_record_at_.size() != pairs_.size())
+      if (clip_record_at_.size() != pairs_.size()) {
         clip_record_at_.assign(pairs_.size(), kNoClipRecord);
+        apart_at_.assign(pairs_.size(), ClipMemo::kNotApart);
+      }
       if (clip_read_at != kNoClipRecord) {
         memo.previous = clip_read.data() + clip_read_at + 2;
         memo.previous_end =
@@ -414,6 +421,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       }
       pieces_replayed_ += memo.replayed;
       pieces_clipped_ += memo.clipped;
+      apart_at_[index] = memo.apart_now;
+      pairs_apart_by_edge_axis_ +=
+          memo.apart_now >= ClipMemo::kApartAtAxis && memo.apart_now < ClipMemo::kApartAtPlane;
     }
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;

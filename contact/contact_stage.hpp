@@ -181,6 +181,8 @@ class ContactStage {
   // Pieces replayed from the step before and pieces clipped afresh, over the run (clip_replay).
   std::uint64_t pieces_replayed() const { return pieces_replayed_; }
   std::uint64_t pieces_clipped() const { return pieces_clipped_; }
+  // Pairs apart at the step before that an edge-edge axis showed still apart (clip_replay.hpp).
+  std::uint64_t pairs_apart_by_edge_axis() const { return pairs_apart_by_edge_axis_; }
   const std::vector<CandidatePair>& candidates() const { return pairs_; }
   // Per candidate pair: whether it overlapped at the last add_forces (it then costs the full
   // overlap integration, ~60× a tet's internal force; a separated pair is rejected early).
@@ -280,8 +282,11 @@ class ContactStage {
   static constexpr std::uint32_t kNoClipRecord = 0xFFFFFFFFu;
   std::vector<std::uint8_t> clip_records_[2];
   std::vector<std::uint32_t> clip_record_at_;
+  // Per candidate pair, how it came out apart at the step before (ClipMemo::apart_before); with
+  // clip_record_at_.
+  std::vector<std::uint8_t> apart_at_;
   int clip_parity_ = 0;
-  std::uint64_t pieces_replayed_ = 0, pieces_clipped_ = 0;
+  std::uint64_t pieces_replayed_ = 0, pieces_clipped_ = 0, pairs_apart_by_edge_axis_ = 0;
   std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;

@@ -306,10 +306,28 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned l
 ContactPairResult potential_contact(const PreparedContactor& contactor, const TetGeometry& target,
                                     double penalty, double sliver_tolerance, ClipMemo* memo) {
   TetPairFrame frame;
-  if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
+  int plane = -1;
+  if (!prepare_tet_pair(contactor, target, frame,
+                        memo ? memo->apart_before - ClipMemo::kApartAtPlane : -1,
+                        memo ? &plane : nullptr)) {
+    if (plane >= 0) memo->apart_now = static_cast<std::uint8_t>(ClipMemo::kApartAtPlane + plane);
+    return zero_result();
+  }
   const unsigned left_out = sliver_tolerance > 0.0 ? negligible_parts(frame, sliver_tolerance) : 0u;
   if (left_out == kEveryPiece) return zero_result();
-  return assemble(frame, penalty, left_out, memo);
+  // Apart at the step before though the face planes passed it: an edge–edge axis, mostly.
+  if (memo && memo->apart_before != ClipMemo::kNotApart &&
+      memo->apart_before < ClipMemo::kApartAtPlane) {
+    const int hint = memo->apart_before - ClipMemo::kApartAtAxis;  // negative: none
+    const int axis = clearly_separating_edge_axis(frame.local[0], frame.local[1], hint);
+    if (axis >= 0) {
+      memo->apart_now = static_cast<std::uint8_t>(ClipMemo::kApartAtAxis + axis);
+      return zero_result();
+    }
+  }
+  ContactPairResult result = assemble(frame, penalty, left_out, memo);
+  if (memo && !result.overlapping) memo->apart_now = ClipMemo::kClippedEmpty;
+  return result;
 }
 
 ContactPairResult potential_contact(const TetCorners& contactor, const TetCorners& target,

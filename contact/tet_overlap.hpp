@@ -144,6 +144,35 @@ inline bool separated_by_edge_axis(const TetCorners& a, const TetCorners& b) {
   return false;
 }
 
+// The edge–edge axis (6 × edge of a + edge of b, 0..35) that separates the two tets (corners in
+// one frame) by a gap above 1e-9 of their two extents along it, or -1.  That gap is far above the
+// round-off of the exact kernel's clip, which therefore finds no overlap either: skipping such a
+// pair changes no result.  Axis `first` (0..35), e.g. the one that separated them at the step
+// before, is tried first.
+inline int clearly_separating_edge_axis(const Vec3 (&a)[4], const Vec3 (&b)[4], int first = -1) {
+  static constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  const auto separates = [&](int axis_index) {
+    const int* ea = kEdge[axis_index / 6];
+    const int* eb = kEdge[axis_index % 6];
+    const Vec3 axis = (a[ea[1]] - a[ea[0]]).cross(b[eb[1]] - b[eb[0]]);
+    double amin = axis.dot(a[0]), amax = amin, bmin = axis.dot(b[0]), bmax = bmin;
+    for (int v = 1; v < 4; ++v) {
+      const double sa = axis.dot(a[v]);
+      const double sb = axis.dot(b[v]);
+      amin = std::min(amin, sa);
+      amax = std::max(amax, sa);
+      bmin = std::min(bmin, sb);
+      bmax = std::max(bmax, sb);
+    }
+    const double margin = 1e-9 * ((amax - amin) + (bmax - bmin));
+    return bmin - amax > margin || amin - bmax > margin;
+  };
+  if (first >= 0 && first < 36 && separates(first)) return first;
+  for (int axis_index = 0; axis_index < 36; ++axis_index)
+    if (axis_index != first && separates(axis_index)) return axis_index;
+  return -1;
+}
+
 // Everything the exact kernel needs about a pair once it has passed the cheap rejection.
 struct TetPairFrame {
   Vec3 origin;                   // local origin = centroid of the contactor (m)
@@ -205,8 +234,14 @@ inline void prepare_contactor(const TetCorners& contactor, PreparedContactor& ou
 // The 4+4 face planes (the caller has tested the boxes: a pair whose boxes are apart ends the same,
 // only later).  False when the pair certainly does not overlap (or a tet is degenerate); true
 // means "may overlap" and fills `frame`.
+// Face planes are numbered 4T + a: face a of tet T (0 contactor, 1 target).  `first_plane`, e.g.
+// the one that separated the pair at the step before, is tested first, with the same arithmetic
+// as the full test (the same decision); `separating_plane`, where given, gets the plane that
+// separated the pair (-1: none, or a degenerate tet).
 inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetGeometry& target,
-                             TetPairFrame& frame) {
+                             TetPairFrame& frame, int first_plane = -1,
+                             int* separating_plane = nullptr) {
+  if (separating_plane) *separating_plane = -1;
   if (!contactor.valid) return false;
   frame.origin = contactor.origin;
   for (int v = 0; v < 4; ++v) {
@@ -215,10 +250,30 @@ inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetGeomet
   }
   frame.map[0] = contactor.map;
   if (!barycentric_map_about(target, frame.origin, frame.map[1])) return false;
+  if (first_plane >= 0 && first_plane < 8) {  // lambda_a^T at the other tet's corners
+    const BarycentricMap& map = frame.map[first_plane / 4];
+    const Vec3(&corners)[4] = frame.local[1 - first_plane / 4];
+    bool outside = true;
+    for (int v = 0; v < 4; ++v) outside &= map.value(first_plane % 4, corners[v]) < 0.0;
+    if (outside) {
+      if (separating_plane) *separating_plane = first_plane;
+      return false;
+    }
+  }
+  // The separating plane among those of tet T whose values at the other's corners are `lambda`.
+  const auto separated = [&](const double(&lambda)[4][4], int T) {
+    if (!separated_by_face_plane(lambda)) return false;
+    if (separating_plane)
+      for (int a = 0; a < 4 && *separating_plane < 0; ++a)
+        if ((lambda[0][a] < 0.0) & (lambda[1][a] < 0.0) & (lambda[2][a] < 0.0) &
+            (lambda[3][a] < 0.0))
+          *separating_plane = 4 * T + a;
+    return true;
+  };
   barycentric_at_corners(frame.map[1], frame.local[0], frame.lambda_other[0]);
-  if (separated_by_face_plane(frame.lambda_other[0])) return false;
+  if (separated(frame.lambda_other[0], 1)) return false;
   barycentric_at_corners(frame.map[0], frame.local[1], frame.lambda_other[1]);
-  if (separated_by_face_plane(frame.lambda_other[1])) return false;
+  if (separated(frame.lambda_other[1], 0)) return false;
   return true;
 }
 

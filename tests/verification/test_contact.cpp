@@ -353,24 +353,30 @@ TEST_CASE("the buffer rule misses nothing: same state bit for bit as detection e
   CHECK(lazy.first == eager.first);
 }
 
-TEST_CASE("clips replayed from the step before leave the state bit for bit as fresh clips",
+TEST_CASE("clips replayed and pairs apart at an edge axis leave the state bit for bit",
           "[verification][contact]") {
   // contact.clip_replay (clip_replay.hpp): the same operations in the same order whether a piece
-  // is replayed or clipped afresh; tumbling blocks make both happen.
-  auto run = [](bool replay, std::uint64_t& replayed, std::uint64_t& clipped) {
+  // is replayed or clipped afresh; tumbling blocks make both happen.  With it, pairs apart at the
+  // step before try an edge-edge axis first (clearly_separating_edge_axis): a pair it skips
+  // would have come out of the kernel with no overlap.
+  std::uint64_t apart_by_edge_axis = 0;
+  auto run = [&](bool replay, std::uint64_t& replayed, std::uint64_t& clipped) {
     Scene scene = tumbling_blocks_scene();
     scene.contact_clip_replay = replay;
     auto sim = quiet_simulation(scene);
     while (sim->time() < scene.time.end) sim->step();
     replayed = sim->contact_stage()->pieces_replayed();
     clipped = sim->contact_stage()->pieces_clipped();
+    apart_by_edge_axis += sim->contact_stage()->pairs_apart_by_edge_axis();
     return sim->report().state_hash;
   };
   std::uint64_t replayed = 0, clipped = 0, replayed_off = 0, clipped_off = 0;
   const auto with_replay = run(true, replayed, clipped);
   const auto without = run(false, replayed_off, clipped_off);
-  INFO(replayed << " pieces replayed, " << clipped << " clipped afresh");
+  INFO(replayed << " pieces replayed, " << clipped << " clipped afresh, " << apart_by_edge_axis
+                << " pairs apart at an edge axis");
   CHECK(with_replay == without);
+  CHECK(apart_by_edge_axis > 0);
   CHECK(replayed > 5 * clipped);
   CHECK(clipped > 0);
   CHECK(replayed_off + clipped_off == 0);  // not counted when the replay is off

@@ -301,6 +301,45 @@ TEST_CASE("tets_may_overlap never rejects an overlapping pair", "[potential_cont
       overlapping, passed, edge_rejected);
 }
 
+TEST_CASE(
+    "an edge-edge axis with a clear gap separates what the face planes pass and never hides an "
+    "overlap",
+    "[potential_contact]") {
+  // A tet's top edge (slanted along x) under another's bottom edge (slanted along y), gap g along
+  // their common normal: their boxes meet, no face plane separates them, the axis of the two
+  // edges does.
+  const auto crossing = [](double gap, Vec3(&a)[4], Vec3(&b)[4]) {
+    const Vec3 up = Vec3(-2, -2, 4).normalized() * gap;
+    a[0] = Vec3(-1, 0, -0.5), a[1] = Vec3(1, 0, 0.5), a[2] = Vec3(0, -1, -1), a[3] = Vec3(0, 1, -1);
+    b[0] = Vec3(0, -1, -0.5) + up, b[1] = Vec3(0, 1, 0.5) + up, b[2] = Vec3(-1, 0, 1) + up,
+    b[3] = Vec3(1, 0, 1) + up;
+  };
+  for (const double gap : {1e-2, 1e-6, 1e-13, -1e-3}) {
+    Vec3 a[4], b[4];
+    crossing(gap, a, b);
+    TetCorners ta, tb;
+    std::copy_n(a, 4, ta.x);
+    std::copy_n(b, 4, tb.x);
+    INFO("gap " << gap);
+    CHECK(tets_may_overlap(ta, tb));
+    // Above 1e-9 of the extents (2 m along z here) only: a gap of 1e-13 is left to the kernel.
+    CHECK((clearly_separating_edge_axis(a, b) >= 0) == (gap > 1e-8));
+    CHECK(potential_contact_unculled(ta, tb, 1.0).overlapping == (gap < 0.0));
+  }
+  // Random pairs: a clear edge-axis gap never hides an overlap the exact kernel finds.
+  std::mt19937_64 rng(20261129);
+  std::uniform_real_distribution<double> u(0.0, 1.8);
+  int separated = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const TetCorners a = random_tet(rng, 0.5 + u(rng), Vec3(u(rng), u(rng), u(rng)), 0.3);
+    const TetCorners b = random_tet(rng, 0.5 + u(rng), Vec3(u(rng), u(rng), u(rng)), 0.3);
+    if (!tets_may_overlap(a, b) || clearly_separating_edge_axis(a.x, b.x) < 0) continue;
+    ++separated;
+    CHECK_FALSE(potential_contact_unculled(a, b, 1.0).overlapping);
+  }
+  CHECK(separated > 100);
+}
+
 TEST_CASE("2-tet impact with central differences conserves energy and momentum",
           "[potential_contact]") {
   // Two rigid tets (translation only: lumped node masses move together), no elasticity, head-on
