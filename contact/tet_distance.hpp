@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 
+#include "contact/tet_overlap.hpp"
 #include "core/types.hpp"
 
 namespace fdem {
@@ -87,15 +88,8 @@ constexpr int edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 // Whether the projections of the two corner sets on `axis` are apart (a gap > 0).
 inline bool separated_along(const Vec3& axis, const Vec3 (&a)[4], const Vec3 (&b)[4]) {
   if (!(axis.squaredNorm() > 0.0)) return false;
-  double a_lo = axis.dot(a[0]), a_hi = a_lo, b_lo = axis.dot(b[0]), b_hi = b_lo;
-  for (int c = 1; c < 4; ++c) {
-    const double pa = axis.dot(a[c]), pb = axis.dot(b[c]);
-    a_lo = std::min(a_lo, pa);
-    a_hi = std::max(a_hi, pa);
-    b_lo = std::min(b_lo, pb);
-    b_hi = std::max(b_hi, pb);
-  }
-  return a_hi < b_lo || b_hi < a_lo;
+  const ProjectedExtent on_a = projected_extent(axis, a), on_b = projected_extent(axis, b);
+  return on_a.hi < on_b.lo || on_b.hi < on_a.lo;
 }
 }  // namespace tet_distance_detail
 

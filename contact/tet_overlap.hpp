@@ -114,6 +114,20 @@ inline bool separated_by_face_plane(const double (&lambda)[4][4]) {
   return separated;
 }
 
+// The interval [lo, hi] that the four corners project to on `axis`.
+struct ProjectedExtent {
+  double lo, hi;
+};
+inline ProjectedExtent projected_extent(const Vec3& axis, const Vec3 (&corners)[4]) {
+  ProjectedExtent e{axis.dot(corners[0]), axis.dot(corners[0])};
+  for (int v = 1; v < 4; ++v) {
+    const double p = axis.dot(corners[v]);
+    e.lo = std::min(e.lo, p);
+    e.hi = std::max(e.hi, p);
+  }
+  return e;
+}
+
 // Separating-axis test on the 36 edge-edge cross products (the face normals are covered by
 // separated_by_face_plane).  Exact SAT for convex polyhedra needs both sets.
 inline bool separated_by_edge_axis(const TetCorners& a, const TetCorners& b) {
@@ -129,16 +143,8 @@ inline bool separated_by_edge_axis(const TetCorners& a, const TetCorners& b) {
     for (const auto& eb : kEdge) {
       const Vec3 axis = da.cross(pb[eb[1]] - pb[eb[0]]);
       if (!(axis.squaredNorm() > 0.0)) continue;  // parallel edges: covered by face planes
-      double amin = axis.dot(pa[0]), amax = amin, bmin = axis.dot(pb[0]), bmax = bmin;
-      for (int v = 1; v < 4; ++v) {
-        const double sa = axis.dot(pa[v]);
-        const double sb = axis.dot(pb[v]);
-        amin = std::min(amin, sa);
-        amax = std::max(amax, sa);
-        bmin = std::min(bmin, sb);
-        bmax = std::max(bmax, sb);
-      }
-      if (amax < bmin || bmax < amin) return true;
+      const ProjectedExtent on_a = projected_extent(axis, pa), on_b = projected_extent(axis, pb);
+      if (on_a.hi < on_b.lo || on_b.hi < on_a.lo) return true;
     }
   }
   return false;
@@ -155,17 +161,9 @@ inline int clearly_separating_edge_axis(const Vec3 (&a)[4], const Vec3 (&b)[4], 
     const int* ea = kEdge[axis_index / 6];
     const int* eb = kEdge[axis_index % 6];
     const Vec3 axis = (a[ea[1]] - a[ea[0]]).cross(b[eb[1]] - b[eb[0]]);
-    double amin = axis.dot(a[0]), amax = amin, bmin = axis.dot(b[0]), bmax = bmin;
-    for (int v = 1; v < 4; ++v) {
-      const double sa = axis.dot(a[v]);
-      const double sb = axis.dot(b[v]);
-      amin = std::min(amin, sa);
-      amax = std::max(amax, sa);
-      bmin = std::min(bmin, sb);
-      bmax = std::max(bmax, sb);
-    }
-    const double margin = 1e-9 * ((amax - amin) + (bmax - bmin));
-    return bmin - amax > margin || amin - bmax > margin;
+    const ProjectedExtent on_a = projected_extent(axis, a), on_b = projected_extent(axis, b);
+    const double margin = 1e-9 * ((on_a.hi - on_a.lo) + (on_b.hi - on_b.lo));
+    return on_b.lo - on_a.hi > margin || on_a.lo - on_b.hi > margin;
   };
   if (first >= 0 && first < 36 && separates(first)) return first;
   for (int axis_index = 0; axis_index < 36; ++axis_index)
