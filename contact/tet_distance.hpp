@@ -83,8 +83,6 @@ inline double segment_segment_distance_sq(const Vec3& p1, const Vec3& q1, const 
 }
 
 namespace tet_distance_detail {
-constexpr int edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-
 // Whether the projections of the two corner sets on `axis` are apart (a gap > 0).
 inline bool separated_along(const Vec3& axis, const Vec3 (&a)[4], const Vec3 (&b)[4]) {
   if (!(axis.squaredNorm() > 0.0)) return false;
@@ -95,22 +93,17 @@ inline bool separated_along(const Vec3& axis, const Vec3 (&a)[4], const Vec3 (&b
 
 // Whether some plane separates the two tetrahedra (touching counts as not separated).
 inline bool tets_disjoint(const Vec3 (&a)[4], const Vec3 (&b)[4]) {
-  using tet_distance_detail::edge;
   using tet_distance_detail::separated_along;
   for (int k = 0; k < 4; ++k) {  // face normals (unnormalised: only the sign of the gap counts)
     const int i = (k + 1) % 4, j = (k + 2) % 4, l = (k + 3) % 4;
     if (separated_along((a[j] - a[i]).cross(a[l] - a[i]), a, b)) return true;
     if (separated_along((b[j] - b[i]).cross(b[l] - b[i]), a, b)) return true;
   }
-  for (const auto& ea : edge)
-    for (const auto& eb : edge)
-      if (separated_along((a[ea[1]] - a[ea[0]]).cross(b[eb[1]] - b[eb[0]]), a, b)) return true;
-  return false;
+  return separating_edge_axis(a, b, 0.0) >= 0;
 }
 
 // Distance (m) between the two tetrahedra: 0 when they intersect or touch.
 inline double tet_distance(const Vec3 (&a)[4], const Vec3 (&b)[4]) {
-  using tet_distance_detail::edge;
   if (!tets_disjoint(a, b)) return 0.0;
   double nearest = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 4; ++k) {  // corners against the faces opposite corner k
@@ -120,8 +113,8 @@ inline double tet_distance(const Vec3 (&a)[4], const Vec3 (&b)[4]) {
       nearest = std::min(nearest, point_triangle_distance_sq(b[c], a[i], a[j], a[l]));
     }
   }
-  for (const auto& ea : edge)
-    for (const auto& eb : edge)
+  for (const auto& ea : kTetEdges)
+    for (const auto& eb : kTetEdges)
       nearest =
           std::min(nearest, segment_segment_distance_sq(a[ea[0]], a[ea[1]], b[eb[0]], b[eb[1]]));
   return std::sqrt(nearest);
@@ -134,7 +127,6 @@ inline double tet_distance(const Vec3 (&a)[4], const Vec3 (&b)[4]) {
 // when none is within reach must the separating-axis test tell disjoint tets (farther) from
 // intersecting ones (distance 0, e.g. one inside the other).
 inline bool tets_within(const Vec3 (&a)[4], const Vec3 (&b)[4], double distance) {
-  using tet_distance_detail::edge;
   const double reach_sq = distance * distance;
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
@@ -146,8 +138,8 @@ inline bool tets_within(const Vec3 (&a)[4], const Vec3 (&b)[4], double distance)
           point_triangle_distance_sq(b[c], a[i], a[j], a[l]) <= reach_sq)
         return true;
   }
-  for (const auto& ea : edge)
-    for (const auto& eb : edge)
+  for (const auto& ea : kTetEdges)
+    for (const auto& eb : kTetEdges)
       if (segment_segment_distance_sq(a[ea[0]], a[ea[1]], b[eb[0]], b[eb[1]]) <= reach_sq)
         return true;
   return !tets_disjoint(a, b);

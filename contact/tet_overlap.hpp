@@ -104,13 +104,17 @@ inline void barycentric_at_corners(const BarycentricMap& map, const Vec3 (&other
   }
 }
 
+// True when all four corners of the other tet lie strictly outside face a of the map's tet
+// (lambda_a < 0 at every corner).  Bitwise, as boxes_intersect.
+inline bool outside_face_plane(const double (&lambda)[4][4], int a) {
+  return (lambda[0][a] < 0.0) & (lambda[1][a] < 0.0) & (lambda[2][a] < 0.0) & (lambda[3][a] < 0.0);
+}
+
 // True when some face plane of the map's tet has all four corners of the other tet strictly
-// outside (lambda < 0 at every corner).  Bitwise, as boxes_intersect.
+// outside.  Bitwise, as boxes_intersect.
 inline bool separated_by_face_plane(const double (&lambda)[4][4]) {
   bool separated = false;
-  for (int a = 0; a < 4; ++a)
-    separated |=
-        (lambda[0][a] < 0.0) & (lambda[1][a] < 0.0) & (lambda[2][a] < 0.0) & (lambda[3][a] < 0.0);
+  for (int a = 0; a < 4; ++a) separated |= outside_face_plane(lambda, a);
   return separated;
 }
 
@@ -128,47 +132,45 @@ inline ProjectedExtent projected_extent(const Vec3& axis, const Vec3 (&corners)[
   return e;
 }
 
-// Separating-axis test on the 36 edge-edge cross products (the face normals are covered by
-// separated_by_face_plane).  Exact SAT for convex polyhedra needs both sets.
-inline bool separated_by_edge_axis(const TetCorners& a, const TetCorners& b) {
-  static constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  const Vec3 origin = a.x[0];
-  Vec3 pa[4], pb[4];
-  for (int v = 0; v < 4; ++v) {
-    pa[v] = a.x[v] - origin;
-    pb[v] = b.x[v] - origin;
-  }
-  for (const auto& ea : kEdge) {
-    const Vec3 da = pa[ea[1]] - pa[ea[0]];
-    for (const auto& eb : kEdge) {
-      const Vec3 axis = da.cross(pb[eb[1]] - pb[eb[0]]);
-      if (!(axis.squaredNorm() > 0.0)) continue;  // parallel edges: covered by face planes
-      const ProjectedExtent on_a = projected_extent(axis, pa), on_b = projected_extent(axis, pb);
-      if (on_a.hi < on_b.lo || on_b.hi < on_a.lo) return true;
-    }
-  }
-  return false;
-}
+// A tet's six edges, as pairs of its corners.
+constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
-// The edge–edge axis (6 × edge of a + edge of b, 0..35) that separates the two tets (corners in
-// one frame) by a gap above 1e-9 of their two extents along it, or -1.  That gap is far above the
-// round-off of the exact kernel's clip, which therefore finds no overlap either: skipping such a
-// pair changes no result.  Axis `first` (0..35), e.g. the one that separated them at the step
-// before, is tried first.
-inline int clearly_separating_edge_axis(const Vec3 (&a)[4], const Vec3 (&b)[4], int first = -1) {
-  static constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+// The edge–edge axis (6 × edge of a + edge of b, 0..35: the cross product of the two edges) along
+// which the two tets (corners in one frame) lie apart by a gap above `relative_margin` of their
+// two extents along it (0: any gap; parallel edges give no axis), or -1.  Axis `first` (0..35),
+// e.g. the one that separated them at the step before, is tried first.  The face normals are
+// separated_by_face_plane's: exact SAT for convex polyhedra needs both sets.
+inline int separating_edge_axis(const Vec3 (&a)[4], const Vec3 (&b)[4], double relative_margin,
+                                int first = -1) {
   const auto separates = [&](int axis_index) {
-    const int* ea = kEdge[axis_index / 6];
-    const int* eb = kEdge[axis_index % 6];
+    const int* ea = kTetEdges[axis_index / 6];
+    const int* eb = kTetEdges[axis_index % 6];
     const Vec3 axis = (a[ea[1]] - a[ea[0]]).cross(b[eb[1]] - b[eb[0]]);
     const ProjectedExtent on_a = projected_extent(axis, a), on_b = projected_extent(axis, b);
-    const double margin = 1e-9 * ((on_a.hi - on_a.lo) + (on_b.hi - on_b.lo));
+    const double margin = relative_margin * ((on_a.hi - on_a.lo) + (on_b.hi - on_b.lo));
     return on_b.lo - on_a.hi > margin || on_a.lo - on_b.hi > margin;
   };
   if (first >= 0 && first < 36 && separates(first)) return first;
   for (int axis_index = 0; axis_index < 36; ++axis_index)
     if (axis_index != first && separates(axis_index)) return axis_index;
   return -1;
+}
+
+// Whether an edge–edge axis separates the two tets (any gap), about the first tet's corner 0.
+inline bool separated_by_edge_axis(const TetCorners& a, const TetCorners& b) {
+  Vec3 pa[4], pb[4];
+  for (int v = 0; v < 4; ++v) {
+    pa[v] = a.x[v] - a.x[0];
+    pb[v] = b.x[v] - a.x[0];
+  }
+  return separating_edge_axis(pa, pb, 0.0) >= 0;
+}
+
+// The edge–edge axis that separates the two tets by a gap above 1e-9 of their extents, or -1.
+// That gap is far above the round-off of the exact kernel's clip, which therefore finds no
+// overlap either: skipping such a pair changes no result.
+inline int clearly_separating_edge_axis(const Vec3 (&a)[4], const Vec3 (&b)[4], int first = -1) {
+  return separating_edge_axis(a, b, 1e-9, first);
 }
 
 // Everything the exact kernel needs about a pair once it has passed the cheap rejection.
@@ -263,9 +265,7 @@ inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetGeomet
     if (!separated_by_face_plane(lambda)) return false;
     if (separating_plane)
       for (int a = 0; a < 4 && *separating_plane < 0; ++a)
-        if ((lambda[0][a] < 0.0) & (lambda[1][a] < 0.0) & (lambda[2][a] < 0.0) &
-            (lambda[3][a] < 0.0))
-          *separating_plane = 4 * T + a;
+        if (outside_face_plane(lambda, a)) *separating_plane = 4 * T + a;
     return true;
   };
   barycentric_at_corners(frame.map[1], frame.local[0], frame.lambda_other[0]);
