@@ -42,6 +42,9 @@ struct ClipMemo {
                                 kApartAtPlane = kApartAtAxis + 36;
   std::uint8_t apart_before = kNotApart;
   std::uint8_t apart_now = kNotApart;
+  // Out: where a face plane or an edge–edge axis found the pair apart, the gap (m) it is sure to
+  // keep open while its tets move less in all (apart_pairs.hpp); else 0.
+  double apart_gap = 0.0;
 };
 
 // One pair's records from one evaluation to the next, for code that follows single pairs (tests,

@@ -263,13 +263,18 @@ void ContactStage::index_pair_tets() {
 }
 
 void ContactStage::update_tet_geometry(const Model& model) {
-  if (pair_slots_.size() != 2 * pairs_.size()) index_pair_tets();
+  const bool indexed = pair_slots_.size() != 2 * pairs_.size();
+  if (indexed) {
+    index_pair_tets();
+    apart_pairs_.reset(pair_tets_.size());
+  }
   tet_boxes_.resize(pair_tets_.size());
   tet_geometry_.resize(pair_tets_.size());
   for (std::size_t i = 0; i < pair_tets_.size(); ++i) {
     TetCorners corners;
     for (int c = 0; c < 4; ++c)
       corners.x[c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * pair_tets_[i] + c]);
+    if (!indexed) apart_pairs_.moved(i, tet_geometry_[i].corners, corners);
     tet_boxes_[i] = tet_box(corners);
     compute_tet_geometry(corners, tet_geometry_[i]);
   }
@@ -282,6 +287,7 @@ void ContactStage::release_until_rebind() {
   release(friction_of_pair_);
   release(clip_record_at_);
   release(apart_at_);
+  apart_pairs_.release();
   release(clip_records_[0]);
   release(clip_records_[1]);
   release(pair_tets_);
@@ -364,12 +370,17 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   clip_written.clear();
   clip_parity_ ^= 1;
   for (std::size_t index = 0; index < pairs_.size(); ++index) {
+    const std::int32_t slot_a = pair_slots_[2 * index], slot_b = pair_slots_[2 * index + 1];
+    // Apart by more than its tets have moved since (apart_pairs.hpp): as it was, with no record.
+    if (apart_pairs_.still_apart(index, slot_a, slot_b)) {
+      ++pair_steps_kept_apart_;
+      continue;
+    }
     std::uint32_t clip_read_at = kNoClipRecord;
     if (!clip_record_at_.empty()) std::swap(clip_read_at, clip_record_at_[index]);
     std::uint8_t apart_before = ClipMemo::kNotApart;  // renewed below where the kernel runs
     if (!apart_at_.empty()) std::swap(apart_before, apart_at_[index]);
     const CandidatePair& pair = pairs_[index];
-    const std::int32_t slot_a = pair_slots_[2 * index], slot_b = pair_slots_[2 * index + 1];
     const auto lost = [&] {  // not overlapping: a stick spring is released
       if (!may_hold_friction_[index]) return;
       if (friction_of(pair) > 0.0) {
@@ -379,6 +390,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       may_hold_friction_[index] = 0;
     };
     if (!boxes_intersect(tet_boxes_[slot_a], tet_boxes_[slot_b])) {  // most candidates and steps
+      if (clip_replay_)
+        apart_pairs_.found(index, pairs_.size(), slot_a, slot_b,
+                           box_gap(tet_boxes_[slot_a], tet_boxes_[slot_b]));
       lost();
       continue;
     }
@@ -422,6 +436,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       pieces_replayed_ += memo.replayed;
       pieces_clipped_ += memo.clipped;
       apart_at_[index] = memo.apart_now;
+      apart_pairs_.found(index, pairs_.size(), slot_a, slot_b, memo.apart_gap);
       pairs_apart_by_edge_axis_ +=
           memo.apart_now >= ClipMemo::kApartAtAxis && memo.apart_now < ClipMemo::kApartAtPlane;
     }

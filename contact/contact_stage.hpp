@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "contact/apart_pairs.hpp"
 #include "contact/broad_phase.hpp"
 #include "contact/friction_kernels.hpp"
 #include "contact/nbs.hpp"
@@ -183,6 +184,8 @@ class ContactStage {
   std::uint64_t pieces_clipped() const { return pieces_clipped_; }
   // Pairs apart at the step before that an edge-edge axis showed still apart (clip_replay.hpp).
   std::uint64_t pairs_apart_by_edge_axis() const { return pairs_apart_by_edge_axis_; }
+  // Pair evaluations skipped over the run: apart by more than their tets had moved since.
+  std::uint64_t pair_steps_kept_apart() const { return pair_steps_kept_apart_; }
   const std::vector<CandidatePair>& candidates() const { return pairs_; }
   // Per candidate pair: whether it overlapped at the last add_forces (it then costs the full
   // overlap integration, ~60× a tet's internal force; a separated pair is rejected early).
@@ -285,8 +288,11 @@ class ContactStage {
   // Per candidate pair, how it came out apart at the step before (ClipMemo::apart_before); with
   // clip_record_at_.
   std::vector<std::uint8_t> apart_at_;
+  // Pairs found apart by a gap their tets have not yet travelled (with clip_replay), skipped.
+  ApartPairs apart_pairs_;
   int clip_parity_ = 0;
-  std::uint64_t pieces_replayed_ = 0, pieces_clipped_ = 0, pairs_apart_by_edge_axis_ = 0;
+  std::uint64_t pieces_replayed_ = 0, pieces_clipped_ = 0, pairs_apart_by_edge_axis_ = 0,
+                pair_steps_kept_apart_ = 0;
   std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;

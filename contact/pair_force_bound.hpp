@@ -167,23 +167,31 @@ inline void piece_force_bounds(const TetPairFrame& frame, const double (&mu)[8],
     const double least_volume =
         std::min(pair.volume, thinnest_own * thinnest_own * pair.length / (largest * largest));
     if (!(4.0 * largest * least_volume <= above)) continue;
-    double cross[4][4];
+    // The prism of slabs a, b for piece i: its slab of face i thinned to m_T.  Pieces other than
+    // a and b share one prism, so each slab pair has three: [0] neither thinned, [1] a, [2] b.
+    double volume[4], surface[4];
+    for (int i = 0; i < 4; ++i) volume[i] = pair.volume, surface[i] = pair.surface;
     for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) cross[a][b] = gradient[a].cross(gradient[b]).norm();
-    for (int i = 0; i < 4; ++i) {
-      double nu[4];
-      for (int a = 0; a < 4; ++a) nu[a] = a == i ? thinnest_own : own[a];
-      double volume = pair.volume, surface = pair.surface;
-      for (int a = 0; a < 4; ++a)
-        for (int b = a + 1; b < 4; ++b) {
-          if (!(cross[a][b] > 0.0)) continue;
-          const double section = nu[a] * nu[b] / cross[a][b];
-          const double perimeter = 2.0 * (nu[a] * norm[b] + nu[b] * norm[a]) / cross[a][b];
-          volume = std::min(volume, section * pair.length);
-          surface = std::min(surface, 2.0 * section + perimeter * pair.length);
+      for (int b = a + 1; b < 4; ++b) {
+        const double cross = gradient[a].cross(gradient[b]).norm();
+        if (!(cross > 0.0)) continue;
+        const double inverse_cross = 1.0 / cross;  // one division for the three prisms
+        const double nu[3][2] = {{own[a], own[b]}, {thinnest_own, own[b]}, {own[a], thinnest_own}};
+        double prism_volume[3], prism_surface[3];
+        for (int q = 0; q < 3; ++q) {
+          const double section = nu[q][0] * nu[q][1] * inverse_cross;
+          const double perimeter = 2.0 * (nu[q][0] * norm[b] + nu[q][1] * norm[a]) * inverse_cross;
+          prism_volume[q] = section * pair.length;
+          prism_surface[q] = 2.0 * section + perimeter * pair.length;
         }
-      bound[4 * T + i] = 4.0 * largest * volume + 4.0 * thinnest_own * surface;
-    }
+        for (int i = 0; i < 4; ++i) {
+          const int q = i == a ? 1 : i == b ? 2 : 0;
+          volume[i] = std::min(volume[i], prism_volume[q]);
+          surface[i] = std::min(surface[i], prism_surface[q]);
+        }
+      }
+    for (int i = 0; i < 4; ++i)
+      bound[4 * T + i] = 4.0 * largest * volume[i] + 4.0 * thinnest_own * surface[i];
   }
 }
 

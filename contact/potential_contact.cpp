@@ -122,11 +122,15 @@ const std::uint8_t* find_recorded_piece(ClipMemo& memo, unsigned key) {
   return at && memo.previous_end - at >= 2 && at[0] == key ? at : nullptr;
 }
 
+// The inward unit normals of the pair's faces: [0] contactor, [1] target (as TetGeometry's).
+struct PairNormals {
+  const Vec3* of[2];
+};
+
 // Integrates the four pieces (sub-tet i of `own`) ∩ other.
-void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned left_out,
-                    ClipMemo* memo, SideIntegrals& out) {
+void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int own, int moments,
+                    unsigned left_out, ClipMemo* memo, SideIntegrals& out) {
   const BarycentricMap& own_map = frame.map[own];
-  const BarycentricMap& other_map = frame.map[1 - own];
   const double(&other_at_corner)[4][4] = frame.lambda_other[own];
   const double(&own_at_other_corner)[4][4] = frame.lambda_other[1 - own];
   // Other tet's barycentrics at the own centroid: the corner average (so that a corner set
@@ -140,7 +144,7 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
   // value keeps "outward" outward for either orientation); rows of D^-1 are grad lambda_1..3.
   double area_weight[4][3];
   for (int j = 0; j < 4; ++j) {
-    const Vec3 normal = -other_map.gradient[j].normalized();
+    const Vec3 normal = -normals.of[1 - own][j];
     for (int k = 0; k < 3; ++k)
       area_weight[j][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
   }
@@ -148,27 +152,35 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
   // lambda_i = lambda_s it shares with a left-out sub-tet s (SideIntegrals::flux); side_weight[s]
   // maps the fan's area to that plane's, whose unit normal points out of sub-tet i.
   const unsigned flux_slots = (left_out >> (4 * own)) & 0xFu;
+  // Quick rejection of a piece: its four vertices strictly outside one plane of the other tet, or
+  // the other tet's four corners strictly outside one side plane of the sub-tet (lambda_i <=
+  // lambda_k inside it).  Either way the piece has no volume.  corner_outside[b]: bit s where own
+  // corner s lies outside the other tet's plane b; sub-tet i's vertices are the corners s != i
+  // and the centroid.
+  unsigned corner_outside[4], centroid_outside = 0;
+  for (int b = 0; b < 4; ++b) {
+    corner_outside[b] = 0;
+    for (int s = 0; s < 4; ++s)
+      corner_outside[b] |= static_cast<unsigned>(other_at_corner[s][b] < 0.0) << s;
+    centroid_outside |= static_cast<unsigned>(other_at_centroid[b] < 0.0) << b;
+  }
   Piece piece;
   for (int i = 0; i < 4; ++i) {
-    // Sub-tet i = own corners k != i plus the centroid in slot i.  In lambda_1..3 coordinates
-    // the own tet is the unit simplex (positive), and replacing corner i by the centroid keeps
-    // the orientation, so kTetNeighbours applies unchanged.
-    const double* slot_other[4];
-    for (int s = 0; s < 4; ++s) slot_other[s] = (s == i) ? other_at_centroid : other_at_corner[s];
-    // Quick rejection: the four vertices strictly outside one plane of the other tet, or the
-    // other tet's four corners strictly outside one side plane of the sub-tet (lambda_i <=
-    // lambda_k inside it).  Either way the piece has no volume.  Bitwise, not short-circuit:
-    // which test decides is data-dependent.
+    if ((left_out >> (4 * own + i)) & 1u) continue;
     bool empty = false;
     for (int b = 0; b < 4; ++b)
-      empty |= (slot_other[0][b] < 0.0) & (slot_other[1][b] < 0.0) & (slot_other[2][b] < 0.0) &
-               (slot_other[3][b] < 0.0);
+      empty |= ((corner_outside[b] | (1u << i)) == 0xFu) & ((centroid_outside >> b) & 1u);
     for (int k = 0; k < 4; ++k)
       empty |= (k != i) & (own_at_other_corner[0][i] > own_at_other_corner[0][k]) &
                (own_at_other_corner[1][i] > own_at_other_corner[1][k]) &
                (own_at_other_corner[2][i] > own_at_other_corner[2][k]) &
                (own_at_other_corner[3][i] > own_at_other_corner[3][k]);
-    if (empty || (left_out >> (4 * own + i)) & 1u) continue;
+    if (empty) continue;
+    // Sub-tet i = own corners k != i plus the centroid in slot i.  In lambda_1..3 coordinates
+    // the own tet is the unit simplex (positive), and replacing corner i by the centroid keeps
+    // the orientation, so kTetNeighbours applies unchanged.
+    const double* slot_other[4];
+    for (int s = 0; s < 4; ++s) slot_other[s] = (s == i) ? other_at_centroid : other_at_corner[s];
     piece.count = 4;
     for (int s = 0; s < 4; ++s) {
       PieceVertex& v = piece.v[s];
@@ -238,14 +250,21 @@ void integrate_side(const TetPairFrame& frame, int own, int moments, unsigned le
   }
 }
 
-ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned left_out = 0,
-                           ClipMemo* memo = nullptr) {
+// The inward unit normals computed from the frame's gradients (paths without TetGeometry).
+PairNormals unit_normals(const TetPairFrame& frame, Vec3 (&normals)[2][4]) {
+  for (int s = 0; s < 2; ++s)
+    for (int a = 0; a < 4; ++a) normals[s][a] = frame.map[s].gradient[a].normalized();
+  return PairNormals{{normals[0], normals[1]}};
+}
+
+ContactPairResult assemble(const TetPairFrame& frame, const PairNormals& normals, double penalty,
+                           unsigned left_out = 0, ClipMemo* memo = nullptr) {
   ContactPairResult r = zero_result();
 
   SideIntegrals side[2];
   // (side 0 carries the other tet's moments too: they give the centroid's weights)
-  integrate_side(frame, 0, 8, left_out, memo, side[0]);
-  integrate_side(frame, 1, 4, left_out, memo, side[1]);
+  integrate_side(frame, normals, 0, 8, left_out, memo, side[0]);
+  integrate_side(frame, normals, 1, 4, left_out, memo, side[1]);
 
   // Physical volume integrals: ∫_{piece i} lam_c dV = |det| * moment / 24 (moment includes the
   // apex term vol6 * lam_c(apex)).
@@ -266,8 +285,7 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned l
     const BarycentricMap& own = frame.map[s];
     const SideIntegrals& other_side = side[1 - s];  // its surfaces lie on this tet's faces
     for (int i = 0; i < 4; ++i) energy += vol_integral[s][i][i];
-    Vec3 inward_normal[4];  // of own face i: grad lambda_i / |grad lambda_i|
-    for (int i = 0; i < 4; ++i) inward_normal[i] = own.gradient[i].normalized();
+    const Vec3* inward_normal = normals.of[s];  // of own face i: grad lambda_i / |grad lambda_i|
     for (int a = 0; a < 4; ++a) {
       Vec3 f = Vec3::Zero();
       for (int i = 0; i < 4; ++i) {
@@ -303,14 +321,27 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty, unsigned l
 
 }  // namespace
 
-ContactPairResult potential_contact(const PreparedContactor& contactor, const TetGeometry& target,
-                                    double penalty, double sliver_tolerance, ClipMemo* memo) {
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+// Built for AVX2 and for the x86-64 baseline, chosen when the program loads; flatten: the whole
+// kernel is inlined into each clone.  Without FMA contraction (-ffp-contract=off) and without
+// reassociation both round alike: the same results bit for bit.
+#define FDEM_CONTACT_CLONES __attribute__((target_clones("avx2", "default"), flatten))
+#else
+#define FDEM_CONTACT_CLONES
+#endif
+
+FDEM_CONTACT_CLONES ContactPairResult potential_contact(const PreparedContactor& contactor,
+                                                        const TetGeometry& target, double penalty,
+                                                        double sliver_tolerance, ClipMemo* memo) {
   TetPairFrame frame;
   int plane = -1;
   if (!prepare_tet_pair(contactor, target, frame,
                         memo ? memo->apart_before - ClipMemo::kApartAtPlane : -1,
                         memo ? &plane : nullptr)) {
-    if (plane >= 0) memo->apart_now = static_cast<std::uint8_t>(ClipMemo::kApartAtPlane + plane);
+    if (plane >= 0) {
+      memo->apart_now = static_cast<std::uint8_t>(ClipMemo::kApartAtPlane + plane);
+      memo->apart_gap = face_plane_gap(contactor, target, plane / 4, plane % 4);
+    }
     return zero_result();
   }
   const unsigned left_out = sliver_tolerance > 0.0 ? negligible_parts(frame, sliver_tolerance) : 0u;
@@ -319,13 +350,15 @@ ContactPairResult potential_contact(const PreparedContactor& contactor, const Te
   if (memo && memo->apart_before != ClipMemo::kNotApart &&
       memo->apart_before < ClipMemo::kApartAtPlane) {
     const int hint = memo->apart_before - ClipMemo::kApartAtAxis;  // negative: none
-    const int axis = clearly_separating_edge_axis(frame.local[0], frame.local[1], hint);
+    const int axis =
+        clearly_separating_edge_axis(frame.local[0], frame.local[1], hint, &memo->apart_gap);
     if (axis >= 0) {
       memo->apart_now = static_cast<std::uint8_t>(ClipMemo::kApartAtAxis + axis);
       return zero_result();
     }
   }
-  ContactPairResult result = assemble(frame, penalty, left_out, memo);
+  ContactPairResult result = assemble(
+      frame, PairNormals{{contactor.inward_normal, target.inward_normal}}, penalty, left_out, memo);
   if (memo && !result.overlapping) memo->apart_now = ClipMemo::kClippedEmpty;
   return result;
 }
@@ -344,7 +377,9 @@ ContactPairResult potential_contact_without(const TetCorners& contactor, const T
                                             double penalty, unsigned left_out) {
   TetPairFrame frame;
   if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
-  return assemble(frame, penalty, left_out);
+  Vec3 normals[2][4];
+  const PairNormals pair_normals = unit_normals(frame, normals);
+  return assemble(frame, pair_normals, penalty, left_out);
 }
 
 ContactPairResult potential_contact_unculled(const TetCorners& contactor, const TetCorners& target,
@@ -360,7 +395,9 @@ ContactPairResult potential_contact_unculled(const TetCorners& contactor, const 
     return zero_result();
   barycentric_at_corners(frame.map[1], frame.local[0], frame.lambda_other[0]);
   barycentric_at_corners(frame.map[0], frame.local[1], frame.lambda_other[1]);
-  return assemble(frame, penalty);
+  Vec3 normals[2][4];
+  const PairNormals pair_normals = unit_normals(frame, normals);
+  return assemble(frame, pair_normals, penalty);
 }
 
 }  // namespace fdem

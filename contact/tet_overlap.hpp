@@ -141,14 +141,17 @@ constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}
 // e.g. the one that separated them at the step before, is tried first.  The face normals are
 // separated_by_face_plane's: exact SAT for convex polyhedra needs both sets.
 inline int separating_edge_axis(const Vec3 (&a)[4], const Vec3 (&b)[4], double relative_margin,
-                                int first = -1) {
+                                int first = -1, double* gap = nullptr) {
   const auto separates = [&](int axis_index) {
     const int* ea = kTetEdges[axis_index / 6];
     const int* eb = kTetEdges[axis_index % 6];
     const Vec3 axis = (a[ea[1]] - a[ea[0]]).cross(b[eb[1]] - b[eb[0]]);
     const ProjectedExtent on_a = projected_extent(axis, a), on_b = projected_extent(axis, b);
     const double margin = relative_margin * ((on_a.hi - on_a.lo) + (on_b.hi - on_b.lo));
-    return on_b.lo - on_a.hi > margin || on_a.lo - on_b.hi > margin;
+    const double separation = std::max(on_b.lo - on_a.hi, on_a.lo - on_b.hi);
+    if (!(separation > margin)) return false;
+    if (gap) *gap = (separation - margin) / axis.norm();  // m, the margin left out
+    return true;
   };
   if (first >= 0 && first < 36 && separates(first)) return first;
   for (int axis_index = 0; axis_index < 36; ++axis_index)
@@ -168,9 +171,11 @@ inline bool separated_by_edge_axis(const TetCorners& a, const TetCorners& b) {
 
 // The edge–edge axis that separates the two tets by a gap above 1e-9 of their extents, or -1.
 // That gap is far above the round-off of the exact kernel's clip, which therefore finds no
-// overlap either: skipping such a pair changes no result.
-inline int clearly_separating_edge_axis(const Vec3 (&a)[4], const Vec3 (&b)[4], int first = -1) {
-  return separating_edge_axis(a, b, 1e-9, first);
+// overlap either: skipping such a pair changes no result.  `gap` (optional) gets the gap beyond
+// that margin (m).
+inline int clearly_separating_edge_axis(const Vec3 (&a)[4], const Vec3 (&b)[4], int first = -1,
+                                        double* gap = nullptr) {
+  return separating_edge_axis(a, b, 1e-9, first, gap);
 }
 
 // Everything the exact kernel needs about a pair once it has passed the cheap rejection.
@@ -188,6 +193,7 @@ struct TetPairFrame {
 struct TetGeometry {
   TetCorners corners;
   Vec3 gradient[4];       // of the barycentric coordinates (1/m)
+  Vec3 inward_normal[4];  // of face a, unit: gradient[a] / |gradient[a]|
   double edge_det = 0.0;  // m^3
   bool valid = false;     // false: degenerate (flat or non-finite), overlaps nothing
 };
@@ -199,6 +205,7 @@ inline void compute_tet_geometry(const TetCorners& corners, TetGeometry& out) {
     for (Vec3& g : out.gradient) g.setZero();
     out.edge_det = 0.0;
   }
+  for (int a = 0; a < 4; ++a) out.inward_normal[a] = out.gradient[a].normalized();
 }
 
 // The tet's map about `origin` (its gradients and the offsets for that origin): the map
@@ -216,12 +223,14 @@ struct PreparedContactor {
   Vec3 origin;    // the centroid (m)
   Vec3 local[4];  // corners - origin (m)
   BarycentricMap map{};
-  bool valid = false;  // false: degenerate, overlaps nothing
+  Vec3 inward_normal[4];  // as TetGeometry's
+  bool valid = false;     // false: degenerate, overlaps nothing
 };
 
 inline void prepare_contactor(const TetGeometry& contactor, PreparedContactor& out) {
   out.origin = tet_centroid(contactor.corners);
   for (int v = 0; v < 4; ++v) out.local[v] = contactor.corners.x[v] - out.origin;
+  std::copy_n(contactor.inward_normal, 4, out.inward_normal);
   out.valid = barycentric_map_about(contactor, out.origin, out.map);
 }
 
@@ -229,6 +238,43 @@ inline void prepare_contactor(const TetCorners& contactor, PreparedContactor& ou
   TetGeometry geometry;
   compute_tet_geometry(contactor, geometry);
   prepare_contactor(geometry, out);
+}
+
+// Lambda_a of tet T (0 contactor, 1 target) at the other tet's four corners, with the arithmetic
+// prepare_tet_pair's frame uses (the same values, so the same decisions), before the frame is
+// built: most pairs apart stay apart at the plane that separated them at the step before, and
+// only these four values are needed to see it.  False where the target's offsets are not finite.
+inline bool plane_values_at_other(const PreparedContactor& contactor, const TetGeometry& target,
+                                  int T, int a, double (&value)[4]) {
+  if (T == 0) {
+    for (int v = 0; v < 4; ++v)
+      value[v] = contactor.map.value(a, target.corners.x[v] - contactor.origin);
+    return true;
+  }
+  BarycentricMap map;  // the target's offsets about the contactor's centroid, as the frame's
+  std::copy_n(target.gradient, 4, map.gradient);
+  if (!barycentric_offsets(target.corners.x[0], contactor.origin, map)) return false;
+  for (int v = 0; v < 4; ++v) value[v] = map.value(a, contactor.local[v]);
+  return true;
+}
+
+inline bool outside_first_plane(const PreparedContactor& contactor, const TetGeometry& target,
+                                int T, int a) {
+  double value[4];
+  if (!plane_values_at_other(contactor, target, T, a, value)) return false;
+  return (value[0] < 0.0) & (value[1] < 0.0) & (value[2] < 0.0) & (value[3] < 0.0);
+}
+
+// The distance (m) by which the other tet's corners lie outside face a of tet T, less 1e-9 (of
+// the barycentric coordinate, far above its round-off); 0 where that leaves nothing.
+inline double face_plane_gap(const PreparedContactor& contactor, const TetGeometry& target, int T,
+                             int a) {
+  constexpr double kMargin = 1e-9;
+  double value[4];
+  if (!plane_values_at_other(contactor, target, T, a, value)) return 0.0;
+  const double peak = std::max(std::max(value[0], value[1]), std::max(value[2], value[3]));
+  const Vec3& gradient = T == 0 ? contactor.map.gradient[a] : target.gradient[a];
+  return peak < -kMargin ? (-peak - kMargin) / gradient.norm() : 0.0;
 }
 
 // The 4+4 face planes (the caller has tested the boxes: a pair whose boxes are apart ends the same,
@@ -242,7 +288,12 @@ inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetGeomet
                              TetPairFrame& frame, int first_plane = -1,
                              int* separating_plane = nullptr) {
   if (separating_plane) *separating_plane = -1;
-  if (!contactor.valid) return false;
+  if (!contactor.valid || !target.valid) return false;
+  if (first_plane >= 0 && first_plane < 8 &&
+      outside_first_plane(contactor, target, first_plane / 4, first_plane % 4)) {
+    if (separating_plane) *separating_plane = first_plane;
+    return false;
+  }
   frame.origin = contactor.origin;
   for (int v = 0; v < 4; ++v) {
     frame.local[0][v] = contactor.local[v];
@@ -250,16 +301,6 @@ inline bool prepare_tet_pair(const PreparedContactor& contactor, const TetGeomet
   }
   frame.map[0] = contactor.map;
   if (!barycentric_map_about(target, frame.origin, frame.map[1])) return false;
-  if (first_plane >= 0 && first_plane < 8) {  // lambda_a^T at the other tet's corners
-    const BarycentricMap& map = frame.map[first_plane / 4];
-    const Vec3(&corners)[4] = frame.local[1 - first_plane / 4];
-    bool outside = true;
-    for (int v = 0; v < 4; ++v) outside &= map.value(first_plane % 4, corners[v]) < 0.0;
-    if (outside) {
-      if (separating_plane) *separating_plane = first_plane;
-      return false;
-    }
-  }
   // The separating plane among those of tet T whose values at the other's corners are `lambda`.
   const auto separated = [&](const double(&lambda)[4][4], int T) {
     if (!separated_by_face_plane(lambda)) return false;

@@ -21,6 +21,7 @@ tolerances):
              (5 courses of 4 touching units, 240 tets, quasi-static mode)
   arch       the 20-voussoir arch (t/R 0.15) under 0.13 g horizontal, 0.02 s (516 tets)
   tower      the default example (tower and projectile), first 0.1 s: the projectile hits at 14 ms
+  tower_full the whole default example (1 s): the impact, then the blocks settling
   dry_wall   examples/dry-stone-wall-seismic.yaml, first 0.2 s (2 mm mortar gaps: the stones land)
   pile       bench_contact_pile's dense pile of 64 blocks (3,558 tets) as a scene, first 4 ms
   wall55     a dry running-bond wall of 55 blocks (10 courses of 5 units, E 5 GPa, penalty auto,
@@ -52,6 +53,8 @@ def case_scene(name, workdir):
         return path, []
     if name == "tower":
         return os.path.join(root, "examples", "tower-projectile.yaml"), ["time.end=0.1"]
+    if name == "tower_full":
+        return os.path.join(root, "examples", "tower-projectile.yaml"), []
     if name == "dry_wall":
         return os.path.join(root, "examples", "dry-stone-wall-seismic.yaml"), ["time.end=0.2"]
     if name == "wall55":
@@ -64,7 +67,8 @@ def case_scene(name, workdir):
         with open(path, "w") as f:
             f.write(pile_scene(4, 0.004))
         return path, []
-    raise SystemExit(f"unknown case {name}: wall_tilt, arch, tower, dry_wall, pile or wall55")
+    raise SystemExit(
+        f"unknown case {name}: wall_tilt, arch, tower, tower_full, dry_wall, pile or wall55")
 
 
 def wall55_scene(end):

@@ -353,13 +353,14 @@ TEST_CASE("the buffer rule misses nothing: same state bit for bit as detection e
   CHECK(lazy.first == eager.first);
 }
 
-TEST_CASE("clips replayed and pairs apart at an edge axis leave the state bit for bit",
+TEST_CASE("clips replayed and pairs kept apart leave the state bit for bit",
           "[verification][contact]") {
   // contact.clip_replay (clip_replay.hpp): the same operations in the same order whether a piece
   // is replayed or clipped afresh; tumbling blocks make both happen.  With it, pairs apart at the
-  // step before try an edge-edge axis first (clearly_separating_edge_axis): a pair it skips
-  // would have come out of the kernel with no overlap.
-  std::uint64_t apart_by_edge_axis = 0;
+  // step before try an edge-edge axis first (clearly_separating_edge_axis), and pairs apart by
+  // more than their tets have moved since are not evaluated (apart_pairs.hpp): a pair either
+  // skips would have come out of the kernel with no overlap.
+  std::uint64_t apart_by_edge_axis = 0, kept_apart = 0;
   auto run = [&](bool replay, std::uint64_t& replayed, std::uint64_t& clipped) {
     Scene scene = tumbling_blocks_scene();
     scene.contact_clip_replay = replay;
@@ -368,15 +369,18 @@ TEST_CASE("clips replayed and pairs apart at an edge axis leave the state bit fo
     replayed = sim->contact_stage()->pieces_replayed();
     clipped = sim->contact_stage()->pieces_clipped();
     apart_by_edge_axis += sim->contact_stage()->pairs_apart_by_edge_axis();
+    kept_apart += sim->contact_stage()->pair_steps_kept_apart();
     return sim->report().state_hash;
   };
   std::uint64_t replayed = 0, clipped = 0, replayed_off = 0, clipped_off = 0;
   const auto with_replay = run(true, replayed, clipped);
   const auto without = run(false, replayed_off, clipped_off);
   INFO(replayed << " pieces replayed, " << clipped << " clipped afresh, " << apart_by_edge_axis
-                << " pairs apart at an edge axis");
+                << " pairs apart at an edge axis, " << kept_apart
+                << " pair evaluations skipped as kept apart");
   CHECK(with_replay == without);
   CHECK(apart_by_edge_axis > 0);
+  CHECK(kept_apart > 0);
   CHECK(replayed > 5 * clipped);
   CHECK(clipped > 0);
   CHECK(replayed_off + clipped_off == 0);  // not counted when the replay is off
