@@ -249,7 +249,7 @@ int main(int argc, char** argv) {
       PreparedContactor prepared;
       prepare_contactor(p.a, prepared);
       TetGeometry geometry;
-      compute_tet_geometry(p.b, geometry);
+      compute_tet_geometry(p.b, geometry, false);
       if (!replay) return potential_contact(prepared, geometry, penalty).energy;
       ClipMemo memo = records[i].next();
       return potential_contact(prepared, geometry, penalty, 0.0, &memo).energy;

@@ -126,8 +126,8 @@ inline bool spring_point(const FrictionHistory& history, const TetGeometry& cont
 inline bool spring_point(const FrictionHistory& history, const TetCorners& contactor,
                          const TetCorners& target, FrictionPoint& point) {
   TetGeometry geometry_c, geometry_t;
-  compute_tet_geometry(contactor, geometry_c);
-  compute_tet_geometry(target, geometry_t);
+  compute_tet_geometry(contactor, geometry_c, false);
+  compute_tet_geometry(target, geometry_t, false);
   return spring_point(history, geometry_c, geometry_t, point);
 }
 

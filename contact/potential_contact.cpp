@@ -257,8 +257,19 @@ PairNormals unit_normals(const TetPairFrame& frame, Vec3 (&normals)[2][4]) {
   return PairNormals{{normals[0], normals[1]}};
 }
 
-ContactPairResult assemble(const TetPairFrame& frame, const PairNormals& normals, double penalty,
-                           unsigned left_out = 0, ClipMemo* memo = nullptr) {
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+// The integration built for AVX2 and for the x86-64 baseline, chosen when the program loads;
+// flatten: all of it is inlined into each clone (the rejections before it stay lean).  Without FMA
+// contraction (-ffp-contract=off) and without reassociation both round alike: the same results bit
+// for bit.
+#define FDEM_CONTACT_CLONES __attribute__((target_clones("avx2", "default"), flatten))
+#else
+#define FDEM_CONTACT_CLONES
+#endif
+
+FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
+                                               const PairNormals& normals, double penalty,
+                                               unsigned left_out = 0, ClipMemo* memo = nullptr) {
   ContactPairResult r = zero_result();
 
   SideIntegrals side[2];
@@ -321,18 +332,8 @@ ContactPairResult assemble(const TetPairFrame& frame, const PairNormals& normals
 
 }  // namespace
 
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-// Built for AVX2 and for the x86-64 baseline, chosen when the program loads; flatten: the whole
-// kernel is inlined into each clone.  Without FMA contraction (-ffp-contract=off) and without
-// reassociation both round alike: the same results bit for bit.
-#define FDEM_CONTACT_CLONES __attribute__((target_clones("avx2", "default"), flatten))
-#else
-#define FDEM_CONTACT_CLONES
-#endif
-
-FDEM_CONTACT_CLONES ContactPairResult potential_contact(const PreparedContactor& contactor,
-                                                        const TetGeometry& target, double penalty,
-                                                        double sliver_tolerance, ClipMemo* memo) {
+ContactPairResult potential_contact(const PreparedContactor& contactor, const TetGeometry& target,
+                                    double penalty, double sliver_tolerance, ClipMemo* memo) {
   TetPairFrame frame;
   int plane = -1;
   if (!prepare_tet_pair(contactor, target, frame,
@@ -357,8 +358,11 @@ FDEM_CONTACT_CLONES ContactPairResult potential_contact(const PreparedContactor&
       return zero_result();
     }
   }
-  ContactPairResult result = assemble(
-      frame, PairNormals{{contactor.inward_normal, target.inward_normal}}, penalty, left_out, memo);
+  Vec3 normals[2][4];  // where a tet came without its own
+  if (!contactor.has_normals || !target.has_normals) unit_normals(frame, normals);
+  const PairNormals pair_normals{{contactor.has_normals ? contactor.inward_normal : normals[0],
+                                  target.has_normals ? target.inward_normal : normals[1]}};
+  ContactPairResult result = assemble(frame, pair_normals, penalty, left_out, memo);
   if (memo && !result.overlapping) memo->apart_now = ClipMemo::kClippedEmpty;
   return result;
 }
@@ -369,7 +373,7 @@ ContactPairResult potential_contact(const TetCorners& contactor, const TetCorner
   PreparedContactor prepared;
   prepare_contactor(contactor, prepared);
   TetGeometry geometry;
-  compute_tet_geometry(target, geometry);
+  compute_tet_geometry(target, geometry, false);
   return potential_contact(prepared, geometry, penalty, sliver_tolerance);
 }
 

@@ -192,20 +192,26 @@ struct TetPairFrame {
 // corners, bit for bit.
 struct TetGeometry {
   TetCorners corners;
-  Vec3 gradient[4];       // of the barycentric coordinates (1/m)
-  Vec3 inward_normal[4];  // of face a, unit: gradient[a] / |gradient[a]|
+  Vec3 gradient[4];  // of the barycentric coordinates (1/m)
+  // Of face a, unit: gradient[a] / |gradient[a]|, where has_normals (the contact stage's tets,
+  // whose normals serve all their pairs; a single pair computes them only if it overlaps).
+  Vec3 inward_normal[4];
   double edge_det = 0.0;  // m^3
   bool valid = false;     // false: degenerate (flat or non-finite), overlaps nothing
+  bool has_normals = false;
 };
 
-inline void compute_tet_geometry(const TetCorners& corners, TetGeometry& out) {
+inline void compute_tet_geometry(const TetCorners& corners, TetGeometry& out,
+                                 bool with_normals = true) {
   out.corners = corners;
   out.valid = barycentric_gradients(corners, out.gradient, out.edge_det);
   if (!out.valid) {  // no map: zeros rather than whatever was there
     for (Vec3& g : out.gradient) g.setZero();
     out.edge_det = 0.0;
   }
-  for (int a = 0; a < 4; ++a) out.inward_normal[a] = out.gradient[a].normalized();
+  out.has_normals = with_normals;
+  if (with_normals)
+    for (int a = 0; a < 4; ++a) out.inward_normal[a] = out.gradient[a].normalized();
 }
 
 // The tet's map about `origin` (its gradients and the offsets for that origin): the map
@@ -224,19 +230,21 @@ struct PreparedContactor {
   Vec3 local[4];  // corners - origin (m)
   BarycentricMap map{};
   Vec3 inward_normal[4];  // as TetGeometry's
-  bool valid = false;     // false: degenerate, overlaps nothing
+  bool has_normals = false;
+  bool valid = false;  // false: degenerate, overlaps nothing
 };
 
 inline void prepare_contactor(const TetGeometry& contactor, PreparedContactor& out) {
   out.origin = tet_centroid(contactor.corners);
   for (int v = 0; v < 4; ++v) out.local[v] = contactor.corners.x[v] - out.origin;
-  std::copy_n(contactor.inward_normal, 4, out.inward_normal);
+  out.has_normals = contactor.has_normals;
+  if (contactor.has_normals) std::copy_n(contactor.inward_normal, 4, out.inward_normal);
   out.valid = barycentric_map_about(contactor, out.origin, out.map);
 }
 
 inline void prepare_contactor(const TetCorners& contactor, PreparedContactor& out) {
   TetGeometry geometry;
-  compute_tet_geometry(contactor, geometry);
+  compute_tet_geometry(contactor, geometry, false);
   prepare_contactor(geometry, out);
 }
 
@@ -322,7 +330,7 @@ inline bool prepare_tet_pair(const TetCorners& contactor, const TetCorners& targ
   PreparedContactor prepared;
   prepare_contactor(contactor, prepared);
   TetGeometry geometry;
-  compute_tet_geometry(target, geometry);
+  compute_tet_geometry(target, geometry, false);
   return prepare_tet_pair(prepared, geometry, frame);
 }
 
