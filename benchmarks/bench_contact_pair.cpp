@@ -9,7 +9,8 @@
 // per-pair cost distribution of both, plus the rejection test alone (with and without edge-edge
 // axes) on the mixed set.  Then the overlapping, shallow and face-on-face pairs as lasting
 // contacts: each pair evaluated again and again with its record of the evaluation before (its
-// pieces' clips replayed, contact/clip_replay.hpp) against fresh clips of the same pairs.
+// pieces' clips replayed, contact/clip_replay.hpp) against fresh clips of the same pairs, and
+// replayed at the default contact.sliver_tolerance, as the contact stage runs them.
 // Usage: bench_contact_pair [out.csv] [cpu_seconds_per_case]  (default bench_contact_pair.csv, 1 s)
 // Rates are per second of thread CPU time.
 #include <Eigen/Geometry>
@@ -24,6 +25,7 @@
 #include <vector>
 
 #include "contact/clip_replay.hpp"
+#include "contact/contact_stage.hpp"
 #include "contact/potential_contact_kernels.hpp"
 #include "contact/tet_overlap.hpp"
 
@@ -244,7 +246,7 @@ int main(int argc, char** argv) {
         {"shallow_overlapping_pairs", &shallow},
         {"face_on_face_pairs", &face_on_face}}) {
     std::vector<PairClipRecords> records(set->size());
-    auto lasting = [&](const Pair& p, bool replay) {
+    auto lasting = [&](const Pair& p, bool replay, double tolerance = 0.0) {
       const std::size_t i = static_cast<std::size_t>(&p - set->data());
       PreparedContactor prepared;
       prepare_contactor(p.a, prepared);
@@ -252,7 +254,7 @@ int main(int argc, char** argv) {
       compute_tet_geometry(p.b, geometry, false);
       if (!replay) return potential_contact(prepared, geometry, penalty).energy;
       ClipMemo memo = records[i].next();
-      return potential_contact(prepared, geometry, penalty, 0.0, &memo).energy;
+      return potential_contact(prepared, geometry, penalty, tolerance, &memo).energy;
     };
     rows.push_back({std::string(name) + "_lasting_replayed", set->size(),
                     throughput(
@@ -260,6 +262,14 @@ int main(int argc, char** argv) {
     rows.push_back({std::string(name) + "_lasting_fresh", set->size(),
                     throughput(
                         *set, seconds, [&](const Pair& p) { return lasting(p, false); }, sink)});
+    // As the contact stage runs them: replayed, and with the default contact.sliver_tolerance
+    // (pieces proven below 1/1000 of a face pressed as deep left out, with their flux).
+    for (PairClipRecords& r : records) r = PairClipRecords();
+    const double tolerance = ContactSettings{}.sliver_tolerance;
+    rows.push_back(
+        {std::string(name) + "_lasting_replayed_default_tolerance", set->size(),
+         throughput(
+             *set, seconds, [&](const Pair& p) { return lasting(p, true, tolerance); }, sink)});
   }
 
   std::printf("bench_contact_pair: potential contact kernel, penalty %.1e Pa\n", penalty);
