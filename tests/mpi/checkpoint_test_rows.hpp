@@ -25,39 +25,11 @@
 #include "parallel/checkpoint_fields.hpp"
 #include "parallel/checkpoint_seal.hpp"
 #include "parallel/communicator.hpp"
+#include "shared_temp_dir.hpp"
 
 namespace fdem::checkpoint_test {
 
 namespace fs = std::filesystem;
-
-// A directory under /tmp that rank 0 creates and removes; every rank gets its name.
-class SharedTempDir {
- public:
-  explicit SharedTempDir(const Communicator& comm) : comm_(comm) {
-    std::string name;
-    if (comm.is_root()) {
-      static int counter = 0;
-      name = (fs::temp_directory_path() / ("fdem-checkpoint-test-" + std::to_string(::getpid()) +
-                                           "-" + std::to_string(counter++)))
-                 .string();
-      fs::remove_all(name);
-      fs::create_directories(name);
-    }
-    path_ = comm.broadcast(name, 0);
-  }
-  ~SharedTempDir() {
-    comm_.barrier();
-    if (comm_.is_root()) {
-      std::error_code ignored;
-      fs::remove_all(path_, ignored);
-    }
-  }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  Communicator comm_;
-  std::string path_;
-};
 
 // Distinct values with special cases (signed zero, infinity, NaN, subnormal) so that the
 // comparison really is bit for bit.

@@ -13,7 +13,7 @@ TEST_CASE("checkpoint: interleaved rows of every rank round-trip bit-exactly",
           "[mpi][checkpoint]") {
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());
-  const SharedTempDir dir(comm);
+  const SharedTempDir dir(comm, "checkpoint");
   const FileScene scene;
   const std::string path = dir.file("state.h5");
   const CheckpointHeader header = make_header(scene);
@@ -40,7 +40,7 @@ TEST_CASE("checkpoint: a rank without rows takes part, empty joint and friction 
           "[mpi][checkpoint]") {
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());
-  const SharedTempDir dir(comm);
+  const SharedTempDir dir(comm, "checkpoint");
   const int last = comm.size() - 1;
 
   SECTION("the last rank owns nothing (on one rank: it owns everything)") {
@@ -113,7 +113,7 @@ TEST_CASE("checkpoint: a file written by one rank reads the same on all ranks",
           "[mpi][checkpoint]") {
   const Communicator world = Communicator::world();
   INFO("rank " << world.rank() << " of " << world.size());
-  const SharedTempDir dir(world);
+  const SharedTempDir dir(world, "checkpoint");
   const FileScene scene;
   const CheckpointHeader header = make_header(scene);
   const std::string by_one = dir.file("by_one.h5"), by_all = dir.file("by_all.h5");
@@ -153,7 +153,7 @@ TEST_CASE("checkpoint: written through a temporary name, other files untouched",
           "[mpi][checkpoint]") {
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());
-  const SharedTempDir dir(comm);
+  const SharedTempDir dir(comm, "checkpoint");
   FileScene scene;
   scene.n_nodes = 60;
   scene.n_joints = 20;

@@ -12,7 +12,7 @@ TEST_CASE("checkpoint: unreadable files are an InputError on every rank naming t
           "[mpi][checkpoint][failure]") {
   const Communicator comm = Communicator::world();
   INFO("rank " << comm.rank() << " of " << comm.size());
-  const SharedTempDir dir(comm);
+  const SharedTempDir dir(comm, "checkpoint");
   FileScene scene;
   scene.n_nodes = 40;
   scene.n_joints = 10;

@@ -26,40 +26,12 @@
 #include "parallel/communicator.hpp"
 #include "parallel/distribution.hpp"
 #include "parallel/xdmf_output.hpp"
+#include "shared_temp_dir.hpp"
 
 using namespace fdem;
 namespace fs = std::filesystem;
 
 namespace {
-
-// A directory under /tmp that rank 0 creates and removes; every rank gets its name.
-class SharedDir {
- public:
-  explicit SharedDir(const Communicator& comm) : comm_(comm) {
-    std::string name;
-    if (comm.is_root()) {
-      static int counter = 0;
-      name = (fs::temp_directory_path() /
-              ("fdem-xdmf-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++)))
-                 .string();
-      fs::remove_all(name);
-      fs::create_directories(name);
-    }
-    path_ = comm.broadcast(name, 0);
-  }
-  ~SharedDir() {
-    comm_.barrier();
-    if (comm_.is_root()) {
-      std::error_code ignored;
-      fs::remove_all(path_, ignored);
-    }
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  Communicator comm_;
-  std::string path_;
-};
 
 // Two bodies of two materials, moved and spun a little so that positions, velocities and stresses
 // differ from node to node and tet to tet (the same on every rank).
@@ -285,7 +257,7 @@ TEST_CASE("xdmf frames: every node and tet of a distributed model, exactly, in o
   const GlobalId offset = GENERATE(GlobalId{0}, (GlobalId{1} << 32) + 12345);
   INFO("gid offset " << offset);
   const Communicator comm = Communicator::world();
-  const SharedDir dir(comm);
+  const SharedTempDir dir(comm, "xdmf");
   Model global = test_model(offset);
   CHECK(global.nodes.gid.front() == offset);
 
