@@ -28,6 +28,7 @@
 #include "contact/contact_stage.hpp"
 #include "contact/potential_contact_kernels.hpp"
 #include "contact/tet_overlap.hpp"
+#include "pair_timing.hpp"
 
 using namespace fdem;
 
@@ -82,7 +83,6 @@ double throughput(const std::vector<Pair>& pairs, double seconds, Body body, dou
 void print_cost_distribution(
     const std::vector<std::pair<const char*, const std::vector<Pair>*>>& sets, double penalty,
     const std::string& csv_path) {
-  using clock = std::chrono::steady_clock;
   std::ofstream csv(csv_path + ".distribution.csv");
   csv << "case,kernel,p10_ns,p50_ns,p90_ns,p99_ns,mean_ns\n";
   std::printf("per-pair cost (ns)                 p10      p50      p90      p99     mean\n");
@@ -90,18 +90,10 @@ void print_cost_distribution(
   for (const auto& [name, set] : sets) {
     std::vector<double> cost[2];
     for (const Pair& p : *set) {
-      for (int k = 0; k < 2; ++k) {
-        double best = 1e30;
-        for (int batch = 0; batch < 3; ++batch) {
-          const auto start = clock::now();
-          for (int rep = 0; rep < 8; ++rep)
-            sink += (k == 0 ? potential_contact(p.a, p.b, penalty)
-                            : potential_contact_baseline(p.a, p.b, penalty))
-                        .energy;
-          best = std::min(best, std::chrono::duration<double>(clock::now() - start).count() / 8);
-        }
-        cost[k].push_back(1e9 * best);
-      }
+      cost[0].push_back(bench::best_of_batches_ns(
+          [&] { return potential_contact(p.a, p.b, penalty).energy; }, sink));
+      cost[1].push_back(bench::best_of_batches_ns(
+          [&] { return potential_contact_baseline(p.a, p.b, penalty).energy; }, sink));
     }
     for (int k = 0; k < 2; ++k) {
       std::vector<double>& c = cost[k];

@@ -19,7 +19,6 @@
 // results are checked against the exact kernel (tolerance 0, fresh clips): the largest nodal
 // force difference relative to the step's largest pair force.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -32,31 +31,17 @@
 #include "contact/tet_overlap.hpp"
 #include "drivers/simulation.hpp"
 #include "io/scene_reader.hpp"
+#include "pair_timing.hpp"
 
 using namespace fdem;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
+// Every tet's corners at the model's current positions.
 std::vector<TetCorners> corners_of(const Model& model) {
   std::vector<TetCorners> out(model.tets.size());
-  for (std::size_t t = 0; t < out.size(); ++t)
-    for (int c = 0; c < 4; ++c)
-      out[t].x[c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * t + c]);
+  for (LocalIndex t = 0; t < model.tets.size(); ++t) out[t] = tet_corners(model, t);
   return out;
-}
-
-// Best of 3 batches of 8 calls of `body`, in ns per call.
-template <class Body>
-double best_ns(Body body, double& sink) {
-  double best = 1e30;
-  for (int batch = 0; batch < 3; ++batch) {
-    const auto start = Clock::now();
-    for (int rep = 0; rep < 8; ++rep) sink += body();
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count() / 8);
-  }
-  return 1e9 * best;
 }
 
 struct Stats {
@@ -72,21 +57,6 @@ Stats stats_of(std::vector<double> v) {
   const auto at = [&](double q) { return v[static_cast<std::size_t>(q * (v.size() - 1))]; };
   s.p10 = at(0.1), s.p50 = at(0.5), s.p90 = at(0.9), s.p99 = at(0.99);
   return s;
-}
-
-double largest_force(const ContactPairResult& r) {
-  double f = 0.0;
-  for (int a = 0; a < 4; ++a)
-    f = std::max({f, r.force_contactor[a].norm(), r.force_target[a].norm()});
-  return f;
-}
-
-double force_difference(const ContactPairResult& x, const ContactPairResult& y) {
-  double d = 0.0;
-  for (int a = 0; a < 4; ++a)
-    d = std::max({d, (x.force_contactor[a] - y.force_contactor[a]).norm(),
-                  (x.force_target[a] - y.force_target[a]).norm()});
-  return d;
 }
 
 }  // namespace
@@ -138,7 +108,7 @@ int main(int argc, char** argv) {
     if (contactor[t]) prepare_contactor(geometry0[t], prepared0[t]);
   }
   double sink = 0.0;
-  const double per_tet_ns = best_ns(
+  const double per_tet_ns = bench::best_of_batches_ns(
       [&] {
         for (std::size_t t = 0; t < x1.size(); ++t) {
           if (!in_pair[t]) continue;
@@ -185,11 +155,11 @@ int main(int argc, char** argv) {
     boxes_meet += boxes_intersect(box1[p.a], box1[p.b]);
     overlapping += base.overlapping;
     stage_overlapping += now.overlapping;
-    largest_pair_force = std::max(largest_pair_force, largest_force(exact));
-    worst_difference = std::max(worst_difference, force_difference(now, exact));
-    const double b =
-        best_ns([&] { return potential_contact_baseline(x1[p.a], x1[p.b], penalty).energy; }, sink);
-    const double s = best_ns([&] { return stage_pair(i).energy; }, sink);
+    largest_pair_force = std::max(largest_pair_force, largest_nodal_force(exact));
+    worst_difference = std::max(worst_difference, largest_nodal_force_difference(now, exact));
+    const double b = bench::best_of_batches_ns(
+        [&] { return potential_contact_baseline(x1[p.a], x1[p.b], penalty).energy; }, sink);
+    const double s = bench::best_of_batches_ns([&] { return stage_pair(i).energy; }, sink);
     cost[0][0].push_back(b);
     cost[0][1].push_back(s);
     if (base.overlapping) {

@@ -89,9 +89,7 @@ double ContactStage::critical_time_step(const Model& model) const {
   double dt = std::numeric_limits<double>::infinity();
   for (LocalIndex t = 0; t < tets.size(); ++t) {
     if (!tets.is_owned(t)) continue;  // each tet counts once, on its owner
-    Vec3 x[4];
-    for (int c = 0; c < 4; ++c) x[c] = vec3_at(model.nodes.x.data(), tets.nodes[4 * t + c]);
-    const double h = smallest_altitude(x);
+    const double h = smallest_altitude(tet_corners(model, t).x);
     const double omega2 =
         96.0 * penalty_[tets.material[t]] / (model.materials[tets.material[t]].density * h * h);
     const double xi = damping_ratio_[tets.material[t]];
@@ -271,9 +269,7 @@ void ContactStage::update_tet_geometry(const Model& model) {
   tet_boxes_.resize(pair_tets_.size());
   tet_geometry_.resize(pair_tets_.size());
   for (std::size_t i = 0; i < pair_tets_.size(); ++i) {
-    TetCorners corners;
-    for (int c = 0; c < 4; ++c)
-      corners.x[c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * pair_tets_[i] + c]);
+    const TetCorners corners = tet_corners(model, pair_tets_[i]);
     if (!indexed) apart_pairs_.moved(i, tet_geometry_[i].corners, corners);
     tet_boxes_[i] = tet_box(corners);
     compute_tet_geometry(corners, tet_geometry_[i]);

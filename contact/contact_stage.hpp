@@ -18,6 +18,14 @@
 
 namespace fdem {
 
+// Tet t's corners at the model's current positions (m).
+inline TetCorners tet_corners(const Model& model, LocalIndex t) {
+  TetCorners corners;
+  for (int c = 0; c < 4; ++c)
+    corners.x[c] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * t + c]);
+  return corners;
+}
+
 struct ContactSettings {
   double buffer = -1.0;  // m; < 0: automatic (0.25 × median tet box size)
   // Leave enclosed tets out of contact while their body's joints hold (scene key

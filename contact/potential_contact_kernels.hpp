@@ -22,6 +22,8 @@
 // piece's own barycentric coordinates (the sub-tets are fixed shapes there) and mapped once.
 #pragma once
 
+#include <algorithm>
+
 #include "contact/tet_overlap.hpp"
 #include "core/types.hpp"
 
@@ -42,6 +44,23 @@ struct ContactPairResult {
   double centroid_weights_contactor[4] = {0, 0, 0, 0};  // barycentric coords of centroid in c
   double centroid_weights_target[4] = {0, 0, 0, 0};     // barycentric coords of centroid in t
 };
+
+// The largest nodal force of a pair result (N), and the largest difference between the nodal
+// forces of two results of the same pair (N): for comparing kernels and tolerances.
+inline double largest_nodal_force(const ContactPairResult& r) {
+  double largest = 0.0;
+  for (int v = 0; v < 4; ++v)
+    largest = std::max({largest, r.force_contactor[v].norm(), r.force_target[v].norm()});
+  return largest;
+}
+inline double largest_nodal_force_difference(const ContactPairResult& a,
+                                             const ContactPairResult& b) {
+  double largest = 0.0;
+  for (int v = 0; v < 4; ++v)
+    largest = std::max({largest, (a.force_contactor[v] - b.force_contactor[v]).norm(),
+                        (a.force_target[v] - b.force_target[v]).norm()});
+  return largest;
+}
 
 // Cheap rejection (boxes, face planes), then the exact integration.  penalty in Pa.  With
 // sliver_tolerance > 0, a pair whose nodal forces are proven below sliver_tolerance · p · ℓ²

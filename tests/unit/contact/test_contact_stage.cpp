@@ -175,12 +175,6 @@ void move_block(Model& model, const Vec3& by) {
   }
 }
 
-TetCorners corners_of(const Model& model, LocalIndex t) {
-  TetCorners c;
-  for (int k = 0; k < 4; ++k) c.x[k] = vec3_at(model.nodes.x.data(), model.tets.nodes[4 * t + k]);
-  return c;
-}
-
 }  // namespace
 
 // The stage computes each tet's geometry once per step and finds it through per-pair slots that
@@ -196,7 +190,7 @@ TEST_CASE("contact forces equal the kernel's pair by pair while the candidate li
     std::vector<double> f(model.nodes.f.size(), 0.0);
     for (const CandidatePair& p : stage.candidates()) {
       const ContactPairResult r =
-          potential_contact(corners_of(model, p.a), corners_of(model, p.b), penalty, tolerance);
+          potential_contact(tet_corners(model, p.a), tet_corners(model, p.b), penalty, tolerance);
       if (!r.overlapping) continue;
       for (int c = 0; c < 4; ++c) {
         vec3_at(f.data(), model.tets.nodes[4 * p.a + c]) += r.force_contactor[c];

@@ -36,14 +36,6 @@ std::vector<TetCorners> cube_layer(int n, double h, const Vec3& origin) {
   return tets;
 }
 
-double max_force_difference(const ContactPairResult& a, const ContactPairResult& b) {
-  double largest = 0.0;
-  for (int v = 0; v < 4; ++v)
-    largest = std::max({largest, (a.force_contactor[v] - b.force_contactor[v]).norm(),
-                        (a.force_target[v] - b.force_target[v]).norm()});
-  return largest;
-}
-
 // Two layers of 3 × 3 cubes of 0.05 m, the upper sunk `depth` of the edge into the lower: with
 // matched meshes, then shifted across the interface.
 template <class Body>
@@ -69,9 +61,10 @@ void check_bound(const TetCorners& c, const TetCorners& t, double penalty, PairC
   const ContactPairResult exact = potential_contact(c, t, penalty);
   const double l = bound.length;
   ++check.pairs;
-  const bool holds = max_force(exact) <= bound.nodal_force * (1 + 1e-9) + 1e-14 * penalty * l * l &&
-                     exact.energy <= bound.energy * (1 + 1e-9) + 1e-14 * penalty * l * l * l &&
-                     exact.overlap_volume <= bound.volume * (1 + 1e-9) + 1e-14 * l * l * l;
+  const bool holds =
+      largest_nodal_force(exact) <= bound.nodal_force * (1 + 1e-9) + 1e-14 * penalty * l * l &&
+      exact.energy <= bound.energy * (1 + 1e-9) + 1e-14 * penalty * l * l * l &&
+      exact.overlap_volume <= bound.volume * (1 + 1e-9) + 1e-14 * l * l * l;
   if (!holds) ++check.violations;
 }
 
@@ -114,7 +107,7 @@ TEST_CASE("matched interface pressed 1e-6 deep: the slivers are skipped and no p
   double largest = 0.0;
   for (const TetCorners& c : upper)
     for (const TetCorners& t : lower)
-      largest = std::max(largest, max_force(potential_contact(c, t, penalty)));
+      largest = std::max(largest, largest_nodal_force(potential_contact(c, t, penalty)));
   int pressed = 0, slivers = 0, slivers_skipped = 0, pressed_skipped = 0, differ = 0;
   int pieces_left_out = 0;
   double loosest = 0.0;  // bound / exact force over the slivers
@@ -122,7 +115,7 @@ TEST_CASE("matched interface pressed 1e-6 deep: the slivers are skipped and no p
     for (const TetCorners& t : lower) {
       const ContactPairResult exact = potential_contact(c, t, penalty);
       const ContactPairResult skipping = potential_contact(c, t, penalty, tolerance);
-      const double force = max_force(exact);
+      const double force = largest_nodal_force(exact);
       const bool skipped = exact.overlapping && !skipping.overlapping;
       if (exact.overlapping &&
           !skipped) {  // an evaluated pair is the exact kernel's to within its left-out pieces
@@ -139,7 +132,8 @@ TEST_CASE("matched interface pressed 1e-6 deep: the slivers are skipped and no p
             allowed += penalty * piece[k];
             ++pieces_left_out;
           }
-        differ += max_force_difference(exact, skipping) > allowed * (1 + 1e-9) + 1e-15 * largest;
+        differ += largest_nodal_force_difference(exact, skipping) >
+                  allowed * (1 + 1e-9) + 1e-15 * largest;
       }
       if (force > 1e-3 * largest) {
         ++pressed;
@@ -188,7 +182,7 @@ TEST_CASE("a corner poking into a corner is bounded by the cube of its depth and
     CHECK(exact.overlap_volume < depth * depth * depth);
     CHECK(exact.overlap_volume <= bound.volume * (1 + 1e-9));
     CHECK(bound.volume < 100.0 * exact.overlap_volume);
-    CHECK(max_force(exact) <= bound.nodal_force * (1 + 1e-9));
+    CHECK(largest_nodal_force(exact) <= bound.nodal_force * (1 + 1e-9));
     // 1e-4 deep and less it is skipped at the default tolerance (its limit 1e-3 · mu p ℓ², mu the
     // thinnest slab, ~1e-7 p ℓ² there): the bound's nodal force is 0.74 d² p (with two slabs
     // only it was 1.3 d p, measured).
@@ -223,12 +217,12 @@ TEST_CASE("a pressed face is never skipped, from round-off depth to deep, at the
     double largest = 0.0;
     for (const TetCorners& c : upper)
       for (const TetCorners& t : lower)
-        largest = std::max(largest, max_force(potential_contact(c, t, penalty)));
+        largest = std::max(largest, largest_nodal_force(potential_contact(c, t, penalty)));
     int pressed = 0, kept = 0;
     for (const TetCorners& c : upper)
       for (const TetCorners& t : lower) {
         const ContactPairResult exact = potential_contact(c, t, penalty);
-        if (max_force(exact) <= 1e-3 * largest) continue;
+        if (largest_nodal_force(exact) <= 1e-3 * largest) continue;
         ++pressed;
         kept += potential_contact(c, t, penalty, 1e-6).overlapping;
       }
@@ -265,7 +259,7 @@ void check_pieces(const TetCorners& c, const TetCorners& t, double penalty, Piec
       largest_gradient = std::max(largest_gradient, frame.map[T].gradient[a].norm());
     const ContactPairResult without = potential_contact_without(c, t, penalty, 1u << k);
     ++check.pieces;
-    const bool holds = max_force_difference(exact, without) <=
+    const bool holds = largest_nodal_force_difference(exact, without) <=
                            penalty * piece[k] * (1 + 1e-9) + 1e-14 * penalty * l * l &&
                        std::abs(exact.energy - without.energy) <=
                            penalty * thinnest_own * piece[k] / largest_gradient * (1 + 1e-9) +
@@ -327,8 +321,8 @@ TEST_CASE("with pieces left out the forces are the exact gradient of the kept pi
             const Vec3& f = side == 0 ? r.force_contactor[v] : r.force_target[v];
             err = std::max(err, std::abs(numerical - f[k]));
           }
-      worst = std::max(worst, err / max_force(r));
-      failed += err > 1e-6 * max_force(r);
+      worst = std::max(worst, err / largest_nodal_force(r));
+      failed += err > 1e-6 * largest_nodal_force(r);
       ++checked;
     }
   }

@@ -69,7 +69,7 @@ TEST_CASE("coincident identical tets: U = 2 p int(phi) = p V / 2, zero resultant
       CHECK(tet_potential_integral(volume) == Approx(0.25 * volume));
       Vec3 resultant = Vec3::Zero();
       for (int v = 0; v < 4; ++v) resultant += r.force_contactor[v];
-      CHECK(resultant.norm() <= 1e-12 * max_force(r));
+      CHECK(resultant.norm() <= 1e-12 * largest_nodal_force(r));
       CHECK((r.centroid - tet_centroid(t)).norm() <= 1e-12 * std::cbrt(volume));
     }
   }
@@ -89,7 +89,7 @@ TEST_CASE("forces are the exact negative gradient of U (finite differences)",
     REQUIRE(r.overlapping);
     Vec3 fc[4], ft[4];
     numerical_forces(c, t, penalty, 1e-6, fc, ft);
-    const double scale = max_force(r);
+    const double scale = largest_nodal_force(r);
     double err = 0.0;
     for (int v = 0; v < 4; ++v) {
       err = std::max(err, (fc[v] - r.force_contactor[v]).cwiseAbs().maxCoeff());
@@ -118,7 +118,7 @@ TEST_CASE("linear and angular momentum are conserved to round-off", "[potential_
       sum_f += r.force_contactor[v] + r.force_target[v];
       sum_m += (c.x[v] - ref).cross(r.force_contactor[v]) + (t.x[v] - ref).cross(r.force_target[v]);
     }
-    const double scale = max_force(r);
+    const double scale = largest_nodal_force(r);
     worst_f = std::max(worst_f, sum_f.norm() / scale);
     worst_m = std::max(worst_m, sum_m.norm() / scale);
     CHECK(sum_f.norm() <= 1e-12 * scale);
@@ -139,7 +139,7 @@ TEST_CASE("swapping contactor and target swaps the forces and keeps U", "[potent
     REQUIRE(b.overlapping);
     CHECK(b.energy == Approx(a.energy).epsilon(1e-12));
     CHECK(b.overlap_volume == Approx(a.overlap_volume).epsilon(1e-12));
-    const double scale = max_force(a);
+    const double scale = largest_nodal_force(a);
     for (int v = 0; v < 4; ++v) {
       CHECK((b.force_target[v] - a.force_contactor[v]).norm() <= 1e-12 * scale);
       CHECK((b.force_contactor[v] - a.force_target[v]).norm() <= 1e-12 * scale);
@@ -232,7 +232,7 @@ TEST_CASE("separated and touching tets give zero, and contact starts continuousl
     ContactPairResult r = potential_contact(far, tt, penalty);
     CHECK_FALSE(r.overlapping);
     CHECK(r.energy == 0.0);
-    CHECK(max_force(r) == 0.0);
+    CHECK(largest_nodal_force(r) == 0.0);
     CHECK_FALSE(tets_may_overlap(far, tt));
 
     // Shared face (two halves of a crack): mirror the apex through face (1,2,3).
@@ -242,7 +242,7 @@ TEST_CASE("separated and touching tets give zero, and contact starts continuousl
     mirror.x[0] = tt.x[0] + 2.0 * dist * n;
     r = potential_contact(mirror, tt, penalty);
     CHECK(std::abs(r.energy) <= 1e-14 * penalty * volume);
-    CHECK(max_force(r) <= 1e-13 * penalty);
+    CHECK(largest_nodal_force(r) <= 1e-13 * penalty);
     CHECK(std::isfinite(r.energy));
 
     // Vertex on the middle of a face.
@@ -253,7 +253,7 @@ TEST_CASE("separated and touching tets give zero, and contact starts continuousl
     vertex_touch.x[0] = face_mid;
     r = potential_contact(vertex_touch, tt, penalty);
     CHECK(std::abs(r.energy) <= 1e-14 * penalty * volume);
-    CHECK(max_force(r) <= 1e-13 * penalty);
+    CHECK(largest_nodal_force(r) <= 1e-13 * penalty);
 
     // Onset through the shared face: mirror pushed in by eps.
     double previous_u = 0.0, previous_f = 0.0;

@@ -29,7 +29,7 @@ void compare(const TetCorners& c, const TetCorners& t, double penalty, Agreement
   REQUIRE(now.overlapping == before.overlapping);
   if (!now.overlapping) return;
   ++a.overlapping;
-  const double scale = std::max(max_force(before), 1e-300);
+  const double scale = std::max(largest_nodal_force(before), 1e-300);
   for (int v = 0; v < 4; ++v) {
     a.worst_force = std::max(a.worst_force,
                              (now.force_contactor[v] - before.force_contactor[v]).norm() / scale);

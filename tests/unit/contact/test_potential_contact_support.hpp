@@ -75,13 +75,4 @@ inline void face_on_face(std::mt19937_64& rng, double depth, TetCorners& lower, 
   upper.x[3] = spin * Vec3(0.3 + 0.4 * u(rng), 0.3 + 0.4 * u(rng), 0.5 + 0.5 * u(rng)) + shift;
 }
 
-inline double max_force(const ContactPairResult& r) {
-  double m = 0.0;
-  for (int v = 0; v < 4; ++v) {
-    m = std::max(m, r.force_contactor[v].norm());
-    m = std::max(m, r.force_target[v].norm());
-  }
-  return m;
-}
-
 }  // namespace fdem::test_contact
