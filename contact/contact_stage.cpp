@@ -270,7 +270,8 @@ void ContactStage::update_tet_geometry(const Model& model) {
   tet_geometry_.resize(pair_tets_.size());
   for (std::size_t i = 0; i < pair_tets_.size(); ++i) {
     const TetCorners corners = tet_corners(model, pair_tets_[i]);
-    if (!indexed) apart_pairs_.moved(i, tet_geometry_[i].corners, corners);
+    // (the travel sums serve the skip of pairs kept apart, which goes with clip_replay)
+    if (clip_replay_ && !indexed) apart_pairs_.moved(i, tet_geometry_[i].corners, corners);
     tet_boxes_[i] = tet_box(corners);
     compute_tet_geometry(corners, tet_geometry_[i]);
   }
