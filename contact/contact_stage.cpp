@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "contact/clip_replay.hpp"
+#include "contact/corner_contact.hpp"
 #include "contact/dashpot_kernels.hpp"
 #include "contact/detection.hpp"
 #include "contact/potential_contact_kernels.hpp"
@@ -43,6 +44,12 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   FDEM_VERIFY(settings.sliver_tolerance >= 0.0, "sliver tolerance >= 0");
   sliver_tolerance_ = settings.sliver_tolerance;
   clip_replay_ = settings.clip_replay;
+  corners_ = settings.corners;
+  if (corners_) {
+    FDEM_VERIFY(model.tets.contact_faces.size() == 2 * static_cast<std::size_t>(model.tets.size()),
+                "corner contact has the tets' contact faces (core/contact_faces.hpp)");
+    clip_replay_ = false;  // the replay records potential contact's clips
+  }
   body_cracked_.assign(static_cast<std::size_t>(std::max(model.pieces.bodies(), 0)), 0);
   buffer_ = settings.buffer;
   if (buffer_ < 0) {
@@ -275,6 +282,11 @@ void ContactStage::update_tet_geometry(const Model& model) {
     tet_boxes_[i] = tet_box(corners);
     compute_tet_geometry(corners, tet_geometry_[i]);
   }
+  if (corners_ && (indexed || corner_tets_.size() != pair_tets_.size())) {
+    corner_tets_.resize(pair_tets_.size());
+    for (std::size_t i = 0; i < pair_tets_.size(); ++i)
+      corner_tets_[i] = corner_tet(model, pair_tets_[i]);
+  }
 }
 
 void ContactStage::release_until_rebind() {
@@ -386,7 +398,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       }
       may_hold_friction_[index] = 0;
     };
-    if (!boxes_intersect(tet_boxes_[slot_a], tet_boxes_[slot_b])) {  // most candidates and steps
+    // (a corner may hold just outside its face's tet, beside a fold: corners_ tests every pair)
+    if (!corners_ && !boxes_intersect(tet_boxes_[slot_a], tet_boxes_[slot_b])) {
       if (clip_replay_)
         apart_pairs_.found(index, pairs_.size(), slot_a, slot_b,
                            box_gap(tet_boxes_[slot_a], tet_boxes_[slot_b]));
@@ -397,7 +410,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     const TetGeometry& geometry_b = tet_geometry_[slot_b];
     const int ma = tets.material[pair.a], mb = tets.material[pair.b];
     const double mu = friction_of(pair);
-    if (pair.a != prepared) {
+    if (!corners_ && pair.a != prepared) {
       prepare_contactor(geometry_a, contactor);
       prepared = pair.a;
     }
@@ -419,8 +432,11 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       clip_written.resize(record_start + 2);  // the pair's length, once known
       memo.record = &clip_written;
     }
-    const ContactPairResult r = potential_contact(contactor, geometry_b, penalty, sliver_tolerance_,
-                                                  clip_replay_ ? &memo : nullptr);
+    const ContactPairResult r =
+        corners_ ? corner_contact(geometry_a, corner_tets_[slot_a], geometry_b,
+                                  corner_tets_[slot_b], penalty)
+                 : potential_contact(contactor, geometry_b, penalty, sliver_tolerance_,
+                                     clip_replay_ ? &memo : nullptr);
     if (clip_replay_) {
       const std::size_t length = clip_written.size() - record_start - 2;
       if (length == 0 || length > 0xFFFFu || record_start >= kNoClipRecord) {
@@ -563,37 +579,6 @@ ContactWork ContactStage::work_against(const Model& model, double dt) const {
   if (damping_written_)
     for (std::size_t i = 0; i < n; ++i) w.damping -= 0.5 * dt * damping_force_[i] * v[i];
   return w;
-}
-
-std::vector<PairRecord> friction_records(const std::vector<FrictionEntry>& entries) {
-  std::vector<PairRecord> records(entries.size());
-  for (std::size_t i = 0; i < entries.size(); ++i) {
-    const FrictionEntry& e = entries[i];
-    PairRecord& r = records[i];
-    r.a = e.a;
-    r.b = e.b;
-    r.value[0] = e.spring.x();
-    r.value[1] = e.spring.y();
-    r.value[2] = e.spring.z();
-    r.value[3] = e.stiffness;
-    std::copy_n(e.anchor_a, 4, r.value + 4);
-    std::copy_n(e.anchor_b, 4, r.value + 8);
-  }
-  return records;
-}
-
-std::vector<FrictionEntry> friction_entries(const std::vector<PairRecord>& records) {
-  std::vector<FrictionEntry> entries(records.size());
-  for (std::size_t i = 0; i < records.size(); ++i) {
-    const PairRecord& r = records[i];
-    entries[i].a = r.a;
-    entries[i].b = r.b;
-    entries[i].spring = Vec3(r.value[0], r.value[1], r.value[2]);
-    entries[i].stiffness = r.value[3];
-    std::copy_n(r.value + 4, 4, entries[i].anchor_a);
-    std::copy_n(r.value + 8, 4, entries[i].anchor_b);
-  }
-  return entries;
 }
 
 }  // namespace fdem

@@ -11,6 +11,7 @@
 
 #include "contact/apart_pairs.hpp"
 #include "contact/broad_phase.hpp"
+#include "contact/corner_contact.hpp"
 #include "contact/friction_kernels.hpp"
 #include "contact/nbs.hpp"
 #include "core/model.hpp"
@@ -50,6 +51,9 @@ struct ContactSettings {
   // (scene key contact.clip_replay; clip_replay.hpp): the same results bit for bit, without the
   // clipper's graph work.  false clips every piece afresh (the previous algorithm, for benchmarks).
   bool clip_replay = true;
+  // Corner contact (scene key contact.formulation: corners; corner_contact.hpp) in place of
+  // potential contact: a hinge's thrust stays at its edge.  Needs TetArrays::contact_faces.
+  bool corners = false;
 };
 
 // Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with
@@ -240,6 +244,10 @@ class ContactStage {
   std::vector<std::int32_t> pair_slots_;
   std::vector<TetBox> tet_boxes_;
   std::vector<TetGeometry> tet_geometry_;
+  // Corner contact (ContactSettings::corners): per tet of pair_tets_, what corner_contact reads
+  // besides its geometry (static; made again when the list changes).
+  bool corners_ = ContactSettings{}.corners;
+  std::vector<CornerTet> corner_tets_;
   // Fills pair_tets_ and pair_slots_ for the current pairs_.
   void index_pair_tets();
   // tet_boxes_ and tet_geometry_ at the current positions (indexing the pairs' tets first when

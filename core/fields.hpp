@@ -137,7 +137,7 @@ inline const std::array<Field<NodeArrays>, 8> node_fields = {{
 
 // Tets (besides gid, nodes, n_owned and the roles owned / active, which the distribution sets,
 // and `enclosed`, read once at start-up and carried by the contact stage's joint state).
-inline const std::array<Field<TetArrays>, 7> tet_fields = {{
+inline const std::array<Field<TetArrays>, 8> tet_fields = {{
     {"dm_inv", &TetArrays::dm_inv, 9, FieldUse::migrates},
     {"volume0", &TetArrays::volume0, 1, FieldUse::migrates},
     {"material", &TetArrays::material, 1, FieldUse::migrates},
@@ -146,6 +146,7 @@ inline const std::array<Field<TetArrays>, 7> tet_fields = {{
     {"dashpot_mass", &TetArrays::dashpot_mass, 1, FieldUse::migrates},
     {"contact_group", &TetArrays::contact_group, 1, FieldUse::migrates, 0.0, true,
      &TetArrays::piece},
+    {"contact_faces", &TetArrays::contact_faces, 2, FieldUse::migrates, 0.0, true},
 }};
 
 // Joints (besides gid, nodes and tets, their identity).

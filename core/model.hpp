@@ -89,6 +89,9 @@ struct TetArrays {
   // held by joints, and become contact partners when those break).  Empty: the piece is the group
   // (models assembled by hand); resize() keeps it empty.
   std::vector<std::int32_t> contact_group;
+  // Corner contact (contact.formulation: corners) only, else empty: 2 per tet, which faces of the
+  // tet lie on its contact group's surface, their folds and fold vertices (core/contact_faces.hpp).
+  std::vector<std::int32_t> contact_faces;
   // Start-up only (build_model): 1 for a tet of a `joints: all` body none of whose corners lies on
   // the body mesh's boundary — while that body's joints hold nothing can reach it, so the contact
   // stage leaves it out (docs/contact-detection.md, "Enclosed tets").  The contact stage's joint

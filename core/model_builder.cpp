@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/checked_cast.hpp"
+#include "core/contact_faces.hpp"
 #include "core/error.hpp"
 #include "core/joint_placement.hpp"
 #include "core/tet_kernels.hpp"
@@ -332,6 +333,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
 
   build_tet_force_order(tets, model.tet_force_order);
   apply_constraints(scene, model);
+  if (scene.contact_corners) compute_contact_faces(model);  // corner contact reads them
   return model;
 }
 

@@ -326,6 +326,7 @@ struct Scene {
   bool contact_body_dashpot = true;           // contact.dashpot (ContactSettings::body_dashpot)
   double contact_sliver_tolerance = 1e-6;     // contact.sliver_tolerance (ContactSettings)
   bool contact_clip_replay = true;            // contact.clip_replay (ContactSettings)
+  bool contact_corners = false;               // contact.formulation: corners (ContactSettings)
   ParallelSpec parallel;
   LimitsSpec limits;
 

@@ -38,6 +38,7 @@
 #include "fracture/joint_stage.hpp"
 #include "parallel/checkpoint.hpp"
 #include "parallel/communicator.hpp"
+#include "parallel/contact_faces_exchange.hpp"
 #include "parallel/distribution.hpp"
 #include "parallel/file_mesh_chunks.hpp"
 #include "parallel/piece_directory.hpp"
@@ -128,7 +129,8 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
         model_, ContactSettings{distributed ? contact_buffer : scene_.contact_buffer,
                                 scene_.contact_skip_enclosed, scene_.contact_exact_narrowing,
                                 scene_.contact_friction_anchor_lag, scene_.contact_body_dashpot,
-                                scene_.contact_sliver_tolerance, scene_.contact_clip_replay});
+                                scene_.contact_sliver_tolerance, scene_.contact_clip_replay,
+                                scene_.contact_corners});
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
     const double dt_contact = global_min(contact_->critical_time_step(model_));
     // Tunnelling guard (check_tunnelling): the thinnest element a node could cross unseen.
@@ -549,6 +551,8 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
     if (size.tets > estimate_generated_size(scene).tets) check_memory(size, "the meshes");
     DistributedModel start = build_distributed_model(scene, chunks, *comm);
     chunks.clear();
+    if (scene.contact_corners)  // what build_model sets on one rank
+      comm->run_collectively([&] { compute_contact_faces(start.model, *comm); });
     double buffer = 0.0;  // contact buffer (m): as the contact stage sets it on one rank
     if (ContactStage::needed(start.model)) {
       buffer = scene.contact_buffer;

@@ -508,7 +508,7 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
   if (const YAML::Node contact = root["contact"]) {
     r.check_keys(contact, "contact",
                  {"buffer", "skip_enclosed", "narrowing", "friction_anchor_lag", "dashpot",
-                  "sliver_tolerance", "clip_replay"});
+                  "sliver_tolerance", "clip_replay", "formulation"});
     if (contact["sliver_tolerance"]) {
       const double tolerance = r.number(contact["sliver_tolerance"], "contact.sliver_tolerance");
       if (!(tolerance >= 0.0 && tolerance <= 1e-6))
@@ -526,6 +526,9 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
       scene.contact_friction_anchor_lag =
           r.positive(contact["friction_anchor_lag"], "contact.friction_anchor_lag",
                      "time (s) with which stick springs' anchors follow the contact");
+    if (contact["formulation"])
+      scene.contact_corners = r.choice(contact["formulation"], "contact.formulation",
+                                       {"potential", "corners"}) == "corners";
     if (contact["clip_replay"])
       scene.contact_clip_replay = r.boolean(contact["clip_replay"], "contact.clip_replay");
     if (contact["skip_enclosed"])
