@@ -33,15 +33,17 @@ double side_of(const Vec3& n, const Vec3& edge, const Vec3& from_line, const Vec
 }
 
 // Whether p, seen along n, lies over face T = (w0, w1, w2) of `target`; `reach` (m): how far
-// beyond a fold p may lie.
-//  - Near a fold vertex of T's side of the surface (within 2·reach, across n), only the owner of
-//    the vertex's zone holds p: every face at the vertex sees the same disc.
+// beyond a fold p may lie if it is `shallow` (less than reach under T's plane).
+//  - Shallow and near a fold vertex of T's side of the surface (within 2·reach, across n), only
+//    the owner of the vertex's zone holds p: every face at the vertex sees the same disc.
 //  - Inside T's folds, by the sides of its three edges: each edge (u, v) is taken from its smaller
 //    node gid, so the faces on its two sides compute the same side of p.
-//  - Beyond a fold edge (by less than reach), where p lies along it: between its ends.
+//  - Shallow and beyond a fold edge (by less than reach), where p lies along it: between its
+//    ends.  A deeper corner beyond a fold lies beside the other body, not in it.
 bool over_face(const Vec3& p, const Vec3& n, const Vec3& d1, const Vec3& d2, double reach,
-               const TetGeometry& target, const CornerTet& corner, int face, const int w[3]) {
-  for (int c = 0; c < 3; ++c) {
+               bool shallow, const TetGeometry& target, const CornerTet& corner, int face,
+               const int w[3]) {
+  for (int c = 0; c < 3 && shallow; ++c) {
     if (!(corner.faces & contact_face_bits::fold_vertex(face, c))) continue;
     const Vec3 r = p - target.corners.x[w[c]];
     if ((r - r.dot(n) * n).squaredNorm() <= 4.0 * reach * reach)
@@ -63,7 +65,7 @@ bool over_face(const Vec3& p, const Vec3& n, const Vec3& d1, const Vec3& d2, dou
       continue;
     }
     const double outside = std::abs(n.dot(edge.cross(p - xu)));  // |edge| × distance (m²)
-    if (!(outside < reach * std::sqrt(edge.squaredNorm()))) return false;
+    if (!shallow || !(outside < reach * std::sqrt(edge.squaredNorm()))) return false;
     beyond |= 1 << e;
   }
   if (!beyond) return inside;
@@ -75,6 +77,21 @@ bool over_face(const Vec3& p, const Vec3& n, const Vec3& d1, const Vec3& d2, dou
     if (!(along >= 0.0 && along <= edge.squaredNorm())) return false;
   }
   return true;
+}
+
+// Whether a corner deeper than the reach under face T (its foot's weights mu) lies nearer to a
+// fold edge of T than under T: it went in through the face beyond that fold, where its depth is
+// less (blocks meeting at right angles: a corner beside a block's edge is not pressed into the
+// face it passes by).
+bool entered_beside(double g, const double mu[3], double twice_area, const TetGeometry& target,
+                    const CornerTet& corner, int face, const int w[3]) {
+  for (int e = 0; e < 3; ++e) {
+    if (!(corner.faces & contact_face_bits::fold(face, e))) continue;
+    const double edge =
+        (target.corners.x[w[(e + 2) % 3]] - target.corners.x[w[(e + 1) % 3]]).norm();
+    if (-g > mu[e] * twice_area / edge) return true;  // depth against distance to the edge (m)
+  }
+  return false;
 }
 
 // The corners of `side`'s surface faces against `other`'s surface faces; `side_is_first`: the
@@ -103,7 +120,7 @@ void corners_against_faces(const TetGeometry& side, const CornerTet& corner_side
       // Half a pressed face's stiffness per area (each tet takes each role) times A_S/3 (N/m).
       const double k = 2.0 * penalty *
                        (corner_side.inverse_height0[s] + corner_other.inverse_height0[t]) *
-                       corner_side.area0[s] / 3.0;
+                       std::min(corner_side.area0[s], corner_other.area0[t]) / 3.0;
       const double deepest =
           0.5 / std::max(corner_side.inverse_height0[s], corner_other.inverse_height0[t]);
       const Vec3 e1 = other.corners.x[w[1]] - x0, e2 = other.corners.x[w[2]] - x0;
@@ -112,11 +129,12 @@ void corners_against_faces(const TetGeometry& side, const CornerTet& corner_side
         const Vec3& p = side.corners.x[cs[q]];
         const double g = (p - x0).dot(n_t);
         if (!(g < 0.0 && g > -deepest)) continue;
-        if (!over_face(p, n_s, d1, d2, reach, other, corner_other, t, w)) continue;
+        if (!over_face(p, n_s, d1, d2, reach, -g < reach, other, corner_other, t, w)) continue;
         const Vec3 foot = p - g * n_t;
         const double mu1 = n_t.dot((foot - x0).cross(e2)) / twice_area;
         const double mu2 = n_t.dot(e1.cross(foot - x0)) / twice_area;
         const double mu[3] = {1.0 - mu1 - mu2, mu1, mu2};
+        if (!(-g < reach) && entered_beside(g, mu, twice_area, other, corner_other, t, w)) continue;
         r.energy += 0.5 * k * g * g;
         const Vec3 f = -k * g * n_t;  // on the corner, out of the other tet
         f_side[cs[q]] += f;
@@ -150,7 +168,7 @@ bool corner_over_face(const Vec3& p, const Vec3& n, double reach, const TetGeome
   tie_directions(n, d1, d2);
   int w[3];
   face_corners(face, w);
-  return over_face(p, n, d1, d2, reach, target, corner_target, face, w);
+  return over_face(p, n, d1, d2, reach, true, target, corner_target, face, w);
 }
 
 CornerTet corner_tet(const Model& model, LocalIndex t) {

@@ -20,11 +20,12 @@
 // same number and exactly one of them takes a corner on either side of it; a corner exactly on
 // an edge or vertex (conforming meshes put corners on the other block's vertices) goes where a
 // fixed infinitesimal shift in the plane of S puts it (simulation of simplicity), one face of a
-// flat patch.  Beyond a fold of T's surface (a block's edge) a corner is held up to a reach of
-// kFoldTolerance × its own tet's altitude, so that a hinge's corner sitting on the edge keeps its
-// contact as it turns: by the face whose fold edge it lies beside, and within twice the reach of
-// a fold vertex (a block's corner, or where faces meet along its edge) by the one face that owns
-// the vertex's zone (core/contact_faces.hpp), so that no two faces ever hold it.
+// flat patch.  Beyond a fold of T's surface (a block's edge) a corner less deep than a reach of
+// kFoldTolerance × its own tet's altitude is held up to that reach outside, so that a hinge's
+// corner sitting on the edge keeps its contact as it turns: by the face whose fold edge it lies
+// beside, and within twice the reach of a fold vertex (a block's corner, or where faces meet along
+// its edge) by the one face that owns the vertex's zone (core/contact_faces.hpp), so that no two
+// faces ever hold it.
 #pragma once
 
 #include <cstdint>
@@ -53,7 +54,8 @@ struct CornerTet {
 // Whether point p, seen along the unit normal n of the face it is a corner of, lies over face
 // `face` of `target` (the claim rule above; the face's surface bit is not looked at).  `reach`
 // (m): how far beyond a fold a corner is held (kFoldTolerance × the altitude of the corner's tet
-// over its face); within twice that of a fold vertex the vertex's zone owner holds it.
+// over its face), if it lies less than that under the face's plane; within twice that of a fold
+// vertex the vertex's zone owner holds it.
 bool corner_over_face(const Vec3& p, const Vec3& n, double reach, const TetGeometry& target,
                       const CornerTet& corner_target, int face);
 

@@ -213,6 +213,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
 
   // This rank's tets: its own and every tet near them (destinations(), all tets known here).
   has_joint_state_ = !global_state.tet_joint_state.empty();
+  has_contact_faces_ = !global.tets.contact_faces.empty();
   std::vector<char> rows;
   RowPacker(global, global_state, tet_owner_, node_owner_, node_first_tet_)
       .pack(destinations(global, true)[me], rows);

@@ -219,7 +219,8 @@ class Distribution {
   } cycle_traffic_;                   // this rank's, of the cycle under way
   double last_cycle_seconds_ = -1.0;  // this rank's, of the last cycle (−1: accounted)
   bool last_cycle_repartitioned_ = false;
-  bool has_joint_state_ = false;  // the scene has joints: tets carry their joint state
+  bool has_joint_state_ = false;    // the scene has joints: tets carry their joint state
+  bool has_contact_faces_ = false;  // corner contact: tets carry TetArrays::contact_faces
 };
 
 // Collective: state_hash (core/state_hash.hpp) of the owned nodes of all ranks, the value one rank

@@ -207,6 +207,7 @@ void Distribution::assemble(const std::vector<std::vector<char>*>& buffers, Mode
   TetArrays& tets = model.tets;
   const LocalIndex n_tets = local_count(tet_rows.size(), "tetrahedra");
   tets.contact_group.resize(n_tets);  // every arriving tet has its group
+  if (has_contact_faces_) tets.contact_faces.resize(2 * static_cast<std::size_t>(n_tets));
   tets.resize(n_tets);
   tets.n_owned = 0;
   tets.owned.assign(n_tets, 0);

@@ -52,6 +52,7 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   // With joints, tets carry their joint state (bonded anywhere, not only by the joints that end
   // up held with them).
   has_joint_state_ = !start.tet_joint_state.empty();
+  has_contact_faces_ = !start.model.tets.contact_faces.empty();
   state.tet_joint_state = std::move(start.tet_joint_state);
   if (start.joints.empty() && !has_joint_state_) {
     local = std::move(start.model);
