@@ -48,3 +48,16 @@ TEST_CASE("contact.clip_replay: true by default, false clips every piece afresh"
   CHECK_THAT(msg, StartsWith("scene.yaml:10:"));
   CHECK_THAT(msg, Contains("contact.clip_replay"));
 }
+
+TEST_CASE("contact.formulation: potential by default, or corners", "[io]") {
+  CHECK_FALSE(fdem::parse_scene(minimal_plus(""), "scene.yaml").contact_corners);
+  CHECK_FALSE(fdem::parse_scene(minimal_plus("contact: {formulation: potential}\n"), "scene.yaml")
+                  .contact_corners);
+  CHECK(fdem::parse_scene(minimal_plus("contact: {formulation: corners}\n"), "scene.yaml")
+            .contact_corners);
+  const std::string msg = input_error(minimal_plus("contact: {formulation: nodes}\n"));
+  CHECK_THAT(msg, StartsWith("scene.yaml:10:"));
+  CHECK_THAT(msg, Contains("contact.formulation"));
+  CHECK_THAT(msg, Contains("potential"));
+  CHECK_THAT(msg, Contains("corners"));
+}
