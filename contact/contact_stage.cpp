@@ -29,7 +29,7 @@ ContactStage::ContactStage(const Model& model, ContactSettings settings) {
   for (const MaterialProperties& m : model.materials) {
     penalty_.push_back(m.contact.auto_penalty ? auto_penalty_factor * m.young : m.contact.penalty);
     friction_coefficient_.push_back(m.contact.friction);
-    damping_ratio_.push_back(m.contact.damping);
+    damping_ratio_.push_back(std::max(m.contact.damping, settings.least_damping_ratio));
   }
   skip_enclosed_ = settings.skip_enclosed;
   exact_narrowing_ = settings.exact_narrowing;

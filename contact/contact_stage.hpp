@@ -54,6 +54,9 @@ struct ContactSettings {
   // Corner contact (scene key contact.formulation: corners; corner_contact.hpp) in place of
   // potential contact: a hinge's thrust stays at its edge.  Needs TetArrays::contact_faces.
   bool corners = false;
+  // The least ratio of the contact dashpot, whatever the materials say (kCornerDampingRatio for
+  // corner contact under quasi-static local damping, else 0).
+  double least_damping_ratio = 0.0;
 };
 
 // Friction history of one pair, keyed by the two tets' global ids (a < b): what travels with

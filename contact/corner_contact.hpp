@@ -41,6 +41,13 @@ namespace fdem {
 // How far beyond a fold a corner is held, as a fraction of its tet's altitude over its face.
 constexpr double kFoldTolerance = 0.02;
 
+// The least ratio of the contact dashpot under corner contact in a quasi-static run.  A contact
+// held at a few corners rings at their springs' frequency where an overlap's integral does not,
+// and under local damping (f − α|f| sign v) a ringing node acts as dry friction on the slow
+// motion: the tilting-table wall stood at 1.02 of its collapse angle with no dashpot, and turned
+// at 1.01 with this one (docs/verification.md, "Corner contact").
+constexpr double kCornerDampingRatio = 0.1;
+
 // What the kernel needs of one tet besides its current geometry: its contact_faces bits, its
 // nodes' global ids (to orient edges alike on every rank), and per face the reference area
 // (m²) and 1/altitude (1/m).

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "contact/contact_stage.hpp"
+#include "contact/corner_contact.hpp"
 #include "contact/detection.hpp"
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
@@ -125,12 +126,17 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
                        std::abs(model_.tets.volume0[t]);
   energy_floor_ = global_sum(energy_floor_);
   if (plan_.contact) {
-    contact_ = std::make_unique<ContactStage>(
-        model_, ContactSettings{distributed ? contact_buffer : scene_.contact_buffer,
-                                scene_.contact_skip_enclosed, scene_.contact_exact_narrowing,
-                                scene_.contact_friction_anchor_lag, scene_.contact_body_dashpot,
-                                scene_.contact_sliver_tolerance, scene_.contact_clip_replay,
-                                scene_.contact_corners});
+    ContactSettings settings{distributed ? contact_buffer : scene_.contact_buffer,
+                             scene_.contact_skip_enclosed,
+                             scene_.contact_exact_narrowing,
+                             scene_.contact_friction_anchor_lag,
+                             scene_.contact_body_dashpot,
+                             scene_.contact_sliver_tolerance,
+                             scene_.contact_clip_replay,
+                             scene_.contact_corners};
+    if (scene_.contact_corners && scene_.quasi_static.local_damping > 0.0)
+      settings.least_damping_ratio = kCornerDampingRatio;
+    contact_ = std::make_unique<ContactStage>(model_, settings);
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
     const double dt_contact = global_min(contact_->critical_time_step(model_));
     // Tunnelling guard (check_tunnelling): the thinnest element a node could cross unseen.
