@@ -19,6 +19,7 @@
 #include "drivers/scene_builders.hpp"
 #include "model_compare.hpp"
 #include "parallel/communicator.hpp"
+#include "parallel/contact_faces_exchange.hpp"
 #include "parallel/distributed_build.hpp"
 
 using namespace fdem;
@@ -188,6 +189,30 @@ TEST_CASE("distributed start-up: each rank's block is the serial builder's model
   const DistributedModel block =
       build_distributed_model(scene, chunks_of(scene, comm.size()), comm);
   testing::check_block_is_serial_model(block, serial, comm);
+}
+
+TEST_CASE(
+    "distributed start-up: corner contact's surface, fold and fold-vertex bits are the "
+    "serial builder's, tet by tet",
+    "[mpi][distributed_build][corner_contact]") {
+  const Communicator comm = Communicator::world();
+  Scene scene = mixed_scene();
+  scene.contact_corners = true;
+  const Model serial = build_model(scene, load_body_meshes(scene));
+  REQUIRE(serial.tets.contact_faces.size() == 2 * static_cast<std::size_t>(serial.tets.size()));
+  DistributedModel block = build_distributed_model(scene, chunks_of(scene, comm.size()), comm);
+  compute_contact_faces(block.model, comm);
+  const Model& local = block.model;
+  REQUIRE(local.tets.contact_faces.size() == 2 * static_cast<std::size_t>(local.tets.size()));
+  long mismatches = 0, surface = 0;
+  for (LocalIndex t = 0; t < local.tets.size(); ++t) {
+    const auto g = static_cast<std::size_t>(local.tets.gid[t] - serial.gid_offset);
+    for (int k = 0; k < 2; ++k)
+      mismatches += local.tets.contact_faces[2 * t + k] != serial.tets.contact_faces[2 * g + k];
+    surface += (local.tets.contact_faces[2 * t] & 0xF) != 0;
+  }
+  CHECK(comm.sum(mismatches) == 0);
+  CHECK(comm.sum(surface) > 0);
 }
 
 TEST_CASE("distributed start-up: an inverted tet on one rank's chunk stops every rank",

@@ -109,8 +109,13 @@ TEST_CASE(
   tets.resize(2);
   CHECK(tets.contact_group.empty());
   tets.piece = {5, 9};
-  const Field<TetArrays>& group = tet_fields.back();
-  REQUIRE(std::string(group.name) == "contact_group");
+  const auto named = [](const char* name) -> const Field<TetArrays>& {
+    for (const Field<TetArrays>& field : tet_fields)
+      if (std::string(field.name) == name) return field;
+    FAIL("no tet field " << name);
+    return tet_fields.front();
+  };
+  const Field<TetArrays>& group = named("contact_group");
   std::int32_t value = 0;
   group.copy_out(tets, 1, reinterpret_cast<unsigned char*>(&value));
   CHECK(value == 9);
@@ -118,6 +123,13 @@ TEST_CASE(
   group.copy_in(tets, 0, reinterpret_cast<const unsigned char*>(&value));
   group.reset(tets, 0);
   CHECK(tets.contact_group.empty());
+  // contact_faces absent (potential contact): reads its fill, two values per tet.
+  CHECK(tets.contact_faces.empty());
+  const Field<TetArrays>& faces = named("contact_faces");
+  std::int32_t bits[2] = {7, 7};
+  faces.copy_out(tets, 1, reinterpret_cast<unsigned char*>(bits));
+  CHECK(bits[0] == 0);
+  CHECK(bits[1] == 0);
 
   TravellingState state;  // no joints: no joint states
   const auto& joint_state = travelling_tet_fields.front();
