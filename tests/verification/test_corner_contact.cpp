@@ -6,48 +6,45 @@
 
 #include "core/dynamics.hpp"
 #include "core/piece_moments.hpp"
-#include "scene_helpers.hpp"
+#include "impact_scenes.hpp"
 
 using namespace fdem;
 using namespace fdem::testing;
 
 namespace {
 
-struct ImpactRun {
-  double worst_balance = 0.0;  // largest balance error over the run
-  double peak_contact = 0.0;   // J
-  double kinetic_start = 0.0;  // J, after the first step
-  double momentum_drift = 0.0;
-  EnergyTerms end;
-};
-
-ImpactRun run_impact(const Scene& scene) {
-  ImpactRun out;
-  auto sim = quiet_simulation(scene);
-  sim->step();
-  out.kinetic_start = sim->energy().current().kinetic;
-  const NodeArrays& nodes = sim->model().nodes;
-  const Vec3 p0 = linear_momentum(nodes);
-  double scale = 0.0;
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n)
-    scale += nodes.mass[n] * vec3_at(nodes.v.data(), n).norm();
-  while (sim->time() < scene.time.end) {
-    sim->step();
-    out.worst_balance = std::max(out.worst_balance, sim->energy().balance_error());
-    out.peak_contact = std::max(out.peak_contact, sim->energy().current().contact);
-    out.momentum_drift = std::max(out.momentum_drift, (linear_momentum(nodes) - p0).norm() / scale);
-  }
-  out.end = sim->energy().current();
-  return out;
-}
-
-// The top corner's tilt (m along x) of a 0.1 × 0.1 × 0.4 m block (1 × 1 × 4 cells, E = 1 GPa,
-// penalty auto, μ 0.8) on a fixed base, held for 0.3 s under local damping 0.8 at a horizontal
-// acceleration `ratio` × g·b/h, the rigid block's uplift threshold; and over the hold's last
-// fifth.
+// How far a node moved in a hold (m), and in the hold's last fifth; the run's balance error.
 struct Tilt {
   double total = 0.0, last_fifth = 0.0, balance = 0.0;
 };
+
+// Runs `scene` to its end and watches the node that starts at `corner`.
+Tilt watch_hold(const Scene& scene, const Vec3& corner) {
+  auto sim = quiet_simulation(scene);
+  const Model& model = sim->model();
+  LocalIndex node = -1;
+  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
+    if ((model.nodes.x0(n) - corner).norm() < 1e-9) node = n;
+  REQUIRE(node >= 0);
+  const auto moved = [&] {
+    return (vec3_at(model.nodes.x.data(), node) - model.nodes.x0(node)).norm();
+  };
+  const double end = scene.time.end;
+  double at_four_fifths = -1.0;
+  while (sim->time() < end - 1e-12) {
+    sim->step();
+    if (at_four_fifths < 0.0 && sim->time() >= 0.8 * end) at_four_fifths = moved();
+  }
+  Tilt t;
+  t.total = moved();
+  t.last_fifth = t.total - at_four_fifths;
+  t.balance = sim->energy().balance_error();
+  return t;
+}
+
+// The top corner (heel side) of a 0.1 × 0.1 × 0.4 m block (1 × 1 × 4 cells, E = 1 GPa, penalty
+// auto, μ 0.8) on a fixed base, held for 0.3 s under local damping 0.8 at a horizontal
+// acceleration `ratio` × g·b/h, the rigid block's uplift threshold.
 
 Tilt rocking_hold(double ratio, bool corners) {
   const double g = 9.81, b = 0.1, h = 0.4, end = 0.3;
@@ -62,41 +59,16 @@ Tilt rocking_hold(double ratio, bool corners) {
   scene.bodies[0].fixed = true;
   scene.bodies.push_back(
       box_body("block", Vec3(-0.5 * b, -0.5 * b, 0), Vec3(0.5 * b, 0.5 * b, h), 1, 1, 4));
-  auto sim = quiet_simulation(scene);
-  const Model& model = sim->model();
-  LocalIndex top = -1;  // the block's top corner on the heel side
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if ((model.nodes.x0(n) - Vec3(-0.5 * b, -0.5 * b, h)).norm() < 1e-9) top = n;
-  REQUIRE(top >= 0);
-  const auto tilt = [&] { return model.nodes.x[3 * top] - model.nodes.x0(top).x(); };
-  double at_four_fifths = 0.0;
-  while (sim->time() < end - 1e-12) {
-    sim->step();
-    if (at_four_fifths == 0.0 && sim->time() >= 0.8 * end) at_four_fifths = tilt();
-  }
-  Tilt t;
-  t.total = tilt();
-  t.last_fifth = t.total - at_four_fifths;
-  t.balance = sim->energy().balance_error();
-  return t;
+  return watch_hold(scene, Vec3(-0.5 * b, -0.5 * b, h));
 }
 
 }  // namespace
 
 TEST_CASE("corner contact: elastic block–block collision keeps its energy within 0.1 %",
           "[verification][contact][corner_contact]") {
-  // issue 15's two offset cubes meeting at ±2 m/s (test_impact_energy.cpp): faces, edges and
-  // corners come into contact and leave it.
-  Scene scene = basic_scene(0.01);
+  // The two offset cubes of test_impact_energy.cpp: faces, edges and corners come into contact.
+  Scene scene = colliding_cubes();
   scene.contact_corners = true;
-  scene.materials.push_back(elastic_material(2500, 1e8, 0.2));
-  scene.time.safety = 0.2;
-  scene.bodies.push_back(
-      box_body("left", Vec3(-0.201, -0.1, -0.1), Vec3(-0.001, 0.1, 0.1), 2, 2, 2));
-  scene.bodies.push_back(
-      box_body("right", Vec3(0.001, -0.05, -0.12), Vec3(0.201, 0.15, 0.08), 2, 2, 2));
-  scene.bodies[0].velocity = Vec3(2, 0, 0);
-  scene.bodies[1].velocity = Vec3(-2, 0, 0);
   const ImpactRun r = run_impact(scene);
   INFO("worst balance error " << r.worst_balance << ", peak contact energy " << r.peak_contact
                               << " J of " << r.kinetic_start << " J, kinetic at the end "
@@ -110,19 +82,8 @@ TEST_CASE("corner contact: elastic block–block collision keeps its energy with
 TEST_CASE("corner contact: with friction and contact damping the balance closes within 0.1 %",
           "[verification][contact][corner_contact]") {
   // The spinning cube thrown onto a fixed base of test_impact_energy.cpp.
-  Scene scene = basic_scene(0.03);
+  Scene scene = thrown_cube();
   scene.contact_corners = true;
-  scene.gravity = Vec3(0, 0, -9.81);
-  scene.materials.push_back(elastic_material(2500, 1e8, 0.2));
-  scene.materials[0].contact.friction = 0.3;
-  scene.materials[0].contact.damping = 0.2;
-  scene.time.safety = 0.5;
-  scene.bodies.push_back(box_body("base", Vec3(-0.5, -0.5, -0.1), Vec3(0.5, 0.5, 0), 5, 5, 1));
-  scene.bodies[0].fixed = true;
-  scene.bodies.push_back(
-      box_body("block", Vec3(-0.1, -0.1, 0.002), Vec3(0.1, 0.1, 0.202), 2, 2, 2));
-  scene.bodies[1].velocity = Vec3(3, 0, -2);
-  scene.bodies[1].angular_velocity = Vec3(0, 5, 0);
   const ImpactRun r = run_impact(scene);
   INFO("worst balance error " << r.worst_balance << "; of " << r.kinetic_start
                               << " J: friction dissipated " << r.end.dissipated_friction
@@ -172,25 +133,7 @@ Tilt wall_hold(double ratio, double hold) {
   scene.materials[0].contact.friction = 0.8;
   scene.bodies.push_back(running_bond_wall(Vec3(0.2, 0.1, 0.1), 5, 4));
   scene.loads.push_back(load_on_region(Vec3(-1, -1, -0.001), Vec3(2, 1, 0.001), Vec3::Zero()));
-  auto sim = quiet_simulation(scene);
-  const Model& model = sim->model();
-  LocalIndex top = -1;  // the top course's corner at the wall's start, x = 0
-  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
-    if ((model.nodes.x0(n) - Vec3(0, 0, 0.5)).norm() < 1e-9) top = n;
-  REQUIRE(top >= 0);
-  const auto moved = [&] {
-    return (vec3_at(model.nodes.x.data(), top) - model.nodes.x0(top)).norm();
-  };
-  double at_four_fifths = -1.0;
-  while (sim->time() < hold - 1e-12) {
-    sim->step();
-    if (at_four_fifths < 0.0 && sim->time() >= 0.8 * hold) at_four_fifths = moved();
-  }
-  Tilt t;
-  t.total = moved();
-  t.last_fifth = t.total - at_four_fifths;
-  t.balance = sim->energy().balance_error();
-  return t;
+  return watch_hold(scene, Vec3(0, 0, 0.5));  // the top course's corner at x = 0
 }
 
 }  // namespace

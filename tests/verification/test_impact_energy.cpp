@@ -6,42 +6,10 @@
 #include <cmath>
 
 #include "core/dynamics.hpp"
-#include "scene_helpers.hpp"
+#include "impact_scenes.hpp"
 
 using namespace fdem;
 using namespace fdem::testing;
-
-namespace {
-
-struct ImpactRun {
-  double worst_balance = 0.0;   // largest balance error over the run
-  double peak_contact = 0.0;    // J
-  double kinetic_start = 0.0;   // J, after the first step
-  double momentum_drift = 0.0;  // |p − p0| / Σ m|v| at the start
-  EnergyTerms end;
-};
-
-ImpactRun run_impact(const Scene& scene) {
-  ImpactRun out;
-  auto sim = quiet_simulation(scene);
-  sim->step();
-  out.kinetic_start = sim->energy().current().kinetic;
-  const NodeArrays& nodes = sim->model().nodes;
-  const Vec3 p0 = linear_momentum(nodes);
-  double scale = 0.0;  // kg m/s: the bodies' momenta may cancel
-  for (LocalIndex n = 0; n < nodes.n_owned; ++n)
-    scale += nodes.mass[n] * vec3_at(nodes.v.data(), n).norm();
-  while (sim->time() < scene.time.end) {
-    sim->step();
-    out.worst_balance = std::max(out.worst_balance, sim->energy().balance_error());
-    out.peak_contact = std::max(out.peak_contact, sim->energy().current().contact);
-    out.momentum_drift = std::max(out.momentum_drift, (linear_momentum(nodes) - p0).norm() / scale);
-  }
-  out.end = sim->energy().current();
-  return out;
-}
-
-}  // namespace
 
 TEST_CASE("elastic block–block collision: energy within 0.1 %, momentum exact",
           "[verification][contact][impact]") {
@@ -51,16 +19,7 @@ TEST_CASE("elastic block–block collision: energy within 0.1 %, momentum exact"
   // measured worst 0.39 / 0.27 / 0.10 / 0.066 / 0.015 / 0.003 % at time.safety 0.5 / 0.4 / 0.25 /
   // 0.2 / 0.1 / 0.05 (the same with the ledger before and after the trapezoid contact work: no
   // friction, no dashpot).
-  Scene scene = basic_scene(0.01);
-  scene.materials.push_back(elastic_material(2500, 1e8, 0.2));
-  scene.time.safety = 0.2;
-  scene.bodies.push_back(
-      box_body("left", Vec3(-0.201, -0.1, -0.1), Vec3(-0.001, 0.1, 0.1), 2, 2, 2));
-  scene.bodies.push_back(
-      box_body("right", Vec3(0.001, -0.05, -0.12), Vec3(0.201, 0.15, 0.08), 2, 2, 2));
-  scene.bodies[0].velocity = Vec3(2, 0, 0);
-  scene.bodies[1].velocity = Vec3(-2, 0, 0);
-  const ImpactRun r = run_impact(scene);
+  const ImpactRun r = run_impact(colliding_cubes());
   INFO("worst balance error " << r.worst_balance << ", peak contact energy " << r.peak_contact
                               << " J of " << r.kinetic_start << " J, kinetic at the end "
                               << r.end.kinetic << " J, momentum drift " << r.momentum_drift);
@@ -77,19 +36,7 @@ TEST_CASE("friction and contact damping: the energy balance closes within 0.1 %"
   // dissipation are the work of those forces with the trapezoid rule of the integrator.
   // Measured worst balance error: 0.21 % when they were counted from the velocities before the
   // step alone (slip work of the return map, dashpot −F·v_n−½·Δt), 0.026 % with the trapezoid.
-  Scene scene = basic_scene(0.03);
-  scene.gravity = Vec3(0, 0, -9.81);
-  scene.materials.push_back(elastic_material(2500, 1e8, 0.2));
-  scene.materials[0].contact.friction = 0.3;
-  scene.materials[0].contact.damping = 0.2;
-  scene.time.safety = 0.5;
-  scene.bodies.push_back(box_body("base", Vec3(-0.5, -0.5, -0.1), Vec3(0.5, 0.5, 0), 5, 5, 1));
-  scene.bodies[0].fixed = true;
-  scene.bodies.push_back(
-      box_body("block", Vec3(-0.1, -0.1, 0.002), Vec3(0.1, 0.1, 0.202), 2, 2, 2));
-  scene.bodies[1].velocity = Vec3(3, 0, -2);
-  scene.bodies[1].angular_velocity = Vec3(0, 5, 0);
-  const ImpactRun r = run_impact(scene);
+  const ImpactRun r = run_impact(thrown_cube());
   INFO("worst balance error " << r.worst_balance << "; of " << r.kinetic_start
                               << " J: friction dissipated " << r.end.dissipated_friction
                               << " J, dashpots " << r.end.dissipated_damping << " J");
