@@ -90,9 +90,17 @@ int check(const fdem::Scene& scene) {
     std::printf("\n");
   }
   // Local damping for the whole run damps every vibration, the friction-induced one too.
-  if (sim->contact_stage() && !scene.quasi_static.active_until(scene.time.end))
+  if (sim->contact_stage() && !scene.quasi_static.active_until(scene.time.end)) {
     for (const std::string& line : sliding_advice(scene))
       std::printf("  advice: %s\n", line.c_str());
+    if (scene.contact_corners)
+      std::printf(
+          "  advice: contact.formulation: corners is made for quasi-static holds and for blocks "
+          "that stay face to face; in a dynamic run where blocks tumble across each other, a "
+          "corner caught beside another block's edge can put energy in (the default example "
+          "stops at t = 0.057 s): use potential there (docs/verification.md, \"Corner "
+          "contact\")\n");
+  }
   if (model.joints.size() > 0)
     std::printf("  joints: %d cohesive joints, %zu laws\n", model.joints.size(),
                 sim->joint_stage() ? sim->joint_stage()->laws().size() : std::size_t{0});

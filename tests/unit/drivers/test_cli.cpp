@@ -280,6 +280,20 @@ output:
   every: 0.01
 )";
 
+TEST_CASE("fdem check advises potential contact for dynamic runs under corner contact", "[cli]") {
+  TempDir dir;
+  write_text(dir / "scene.yaml", block_on_base);
+  const std::string advice = "advice: contact.formulation: corners is made for quasi-static holds";
+  const Outcome o = run_fdem(dir, "check scene.yaml --set contact.formulation=corners");
+  CHECK(o.exit_code == 0);
+  CHECK_THAT(o.out, Contains(advice));
+  CHECK_THAT(run_fdem(dir, "check scene.yaml").out, !Contains(advice));
+  write_text(dir / "qs.yaml", std::string(block_on_base) +
+                                  "quasi_static: {local_damping: 0.8}\ncontact: {formulation: "
+                                  "corners}\n");
+  CHECK_THAT(run_fdem(dir, "check qs.yaml").out, !Contains(advice));
+}
+
 TEST_CASE("fdem check advises element damping for sliding bodies with friction", "[cli]") {
   TempDir dir;
   write_text(dir / "scene.yaml", block_on_base);
