@@ -7,8 +7,10 @@
 //
 // Corner p of face S (tet s, outward normal n_S) against face T (tet t, outward normal n_T, n_S ·
 // n_T < −½): depth g = (p − x_T)·n_T; for −½ min(h_S, h_T) < g < 0 and p over T it stores
-//     U = ½ k g²,   k = ½ · 4p(1/h_S + 1/h_T) · A_S/3          (N/m; p the penalty, Pa)
-// with h the tets' reference altitudes over the faces and A_S the reference area of S.  Both
+//     U = ½ k g²,   k = ½ · 4p(1/h_S + 1/h_T) · min(A_S, A_T)/3   (N/m; p the penalty, Pa)
+// with h the tets' reference altitudes over the faces and A the faces' reference areas (the
+// smaller, so that a large face's corner on a small face loads its nodes no more than their own
+// area would).  Both
 // tets take both roles, hence the ½: a joint pressed face on face has potential contact's
 // stiffness per area, 4p(1/h_S + 1/h_T).  The forces are U's exact gradient: −k g n_T on p, and
 // +k g μ_j n_T on T's corners, μ the barycentric weights of p's foot on T (a plane turning about
