@@ -283,6 +283,8 @@ void ContactStage::update_tet_geometry(const Model& model) {
     compute_tet_geometry(corners, tet_geometry_[i]);
   }
   if (corners_ && (indexed || corner_tets_.size() != pair_tets_.size())) {
+    FDEM_VERIFY(model.tets.contact_faces.size() == 2 * static_cast<std::size_t>(model.tets.size()),
+                "every local tet carries its contact faces (migration, halo)");
     corner_tets_.resize(pair_tets_.size());
     for (std::size_t i = 0; i < pair_tets_.size(); ++i)
       corner_tets_[i] = corner_tet(model, pair_tets_[i]);
@@ -301,6 +303,7 @@ void ContactStage::release_until_rebind() {
   release(clip_records_[1]);
   release(pair_tets_);
   release(pair_slots_);
+  release(corner_tets_);
   release(tet_boxes_);
   release(tet_geometry_);
   release(records_);
