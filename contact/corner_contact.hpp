@@ -11,9 +11,9 @@
 // with h the tets' reference altitudes over the faces and A the faces' reference areas (the
 // smaller, so that a large face's corner on a small face loads its nodes no more than their own
 // area would).  Both tets take both roles, hence the ½: a joint pressed face on face has
-// potential contact's stiffness per area, 4p(1/h_S + 1/h_T).  The forces are U's exact gradient: −k g n_T on p, and
-// +k g μ_j n_T on T's corners, μ the barycentric weights of p's foot on T (a plane turning about
-// the foot does not change g to first order).
+// potential contact's stiffness per area, 4p(1/h_S + 1/h_T).  The forces are U's exact
+// gradient: −k g n_T on p, and +k g μ_j n_T on T's corners, μ the barycentric weights of p's foot
+// on T (a plane turning about the foot does not change g to first order).
 //
 // Which face holds a corner is decided from the pair alone, the same way on every rank and in
 // any order of the pairs: p lies over T when it is inside each of T's edges seen along n_S.  An
