@@ -25,6 +25,23 @@ void sort_faces(std::vector<FaceRecord>& records) {
   });
 }
 
+// The local tet of a surface face's record (held where the record came from).
+LocalIndex surface_tet(const Model& model, const FaceRecord& s) {
+  const LocalIndex t = model.tets.find(s.tet);
+  FDEM_VERIFY(t >= 0, "a surface face's tet is held where its record came from");
+  return t;
+}
+
+// Face f's unit normal in the reference mesh, pointing away from the opposite corner f.
+Vec3 reference_outward_normal(const Model& model, LocalIndex t, int f) {
+  Vec3 x[4];
+  for (int c = 0; c < 4; ++c) x[c] = model.nodes.x0(model.tets.nodes[4 * t + c]);
+  int w[3];
+  face_corners(f, w);
+  const Vec3 normal = (x[w[1]] - x[w[0]]).cross(x[w[2]] - x[w[0]]).normalized();
+  return normal.dot(x[f] - x[w[0]]) > 0.0 ? Vec3(-normal) : normal;
+}
+
 }  // namespace
 
 std::vector<FaceRecord> face_records(const Model& model, int source) {
@@ -65,16 +82,11 @@ std::vector<EdgeRecord> edge_records(const Model& model, const std::vector<FaceR
   std::vector<EdgeRecord> records;
   records.reserve(3 * surface.size());
   for (const FaceRecord& s : surface) {
-    const LocalIndex t = tets.find(s.tet);
-    FDEM_VERIFY(t >= 0, "a surface face's tet is held where its record came from");
-    Vec3 x[4];
-    for (int c = 0; c < 4; ++c) x[c] = model.nodes.x0(tets.nodes[4 * t + c]);
+    const LocalIndex t = surface_tet(model, s);
     const int f = static_cast<int>(s.face);
     int w[3];
     face_corners(f, w);
-    // Outward: away from the opposite corner f.
-    Vec3 normal = (x[w[1]] - x[w[0]]).cross(x[w[2]] - x[w[0]]).normalized();
-    if (normal.dot(x[f] - x[w[0]]) > 0.0) normal = -normal;
+    const Vec3 normal = reference_outward_normal(model, t, f);
     for (int e = 0; e < 3; ++e) {
       EdgeRecord r{};
       r.group = s.group;
@@ -123,15 +135,11 @@ std::vector<VertexRecord> vertex_records(const Model& model, const std::vector<F
   std::vector<VertexRecord> records;
   records.reserve(3 * surface.size());
   for (const FaceRecord& s : surface) {
-    const LocalIndex t = tets.find(s.tet);
-    FDEM_VERIFY(t >= 0, "a surface face's tet is held where its record came from");
+    const LocalIndex t = surface_tet(model, s);
     const int f = static_cast<int>(s.face);
     int w[3];
     face_corners(f, w);
-    Vec3 x[4];
-    for (int c = 0; c < 4; ++c) x[c] = model.nodes.x0(tets.nodes[4 * t + c]);
-    Vec3 normal = (x[w[1]] - x[w[0]]).cross(x[w[2]] - x[w[0]]).normalized();
-    if (normal.dot(x[f] - x[w[0]]) > 0.0) normal = -normal;
+    const Vec3 normal = reference_outward_normal(model, t, f);
     bool fold[3];
     for (int e = 0; e < 3; ++e)
       fold[e] = std::binary_search(fold_of.begin(), fold_of.end(),
