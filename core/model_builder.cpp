@@ -333,7 +333,7 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
 
   build_tet_force_order(tets, model.tet_force_order);
   apply_constraints(scene, model);
-  if (scene.contact_corners) compute_contact_faces(model);  // corner contact reads them
+  if (uses_corner_contact(scene)) compute_contact_faces(model);  // corner contact reads them
   return model;
 }
 

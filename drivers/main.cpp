@@ -87,13 +87,17 @@ int check(const fdem::Scene& scene) {
     for (std::size_t m = 0; m < model.materials.size(); ++m)
       std::printf(" %s %g Pa%s", model.materials[m].name.c_str(), contact->material_penalty()[m],
                   m + 1 < model.materials.size() ? "," : "");
-    std::printf("\n");
+    const bool corners = fdem::uses_corner_contact(scene);
+    std::printf("; formulation %s%s\n", corners ? "corners" : "potential",
+                scene.contact_formulation != fdem::ContactFormulation::automatic ? ""
+                : corners ? " (auto: quasi-static throughout, no joints)"
+                          : " (auto: potential unless quasi-static throughout without joints)");
   }
   // Local damping for the whole run damps every vibration, the friction-induced one too.
   if (sim->contact_stage() && !scene.quasi_static.active_until(scene.time.end)) {
     for (const std::string& line : sliding_advice(scene))
       std::printf("  advice: %s\n", line.c_str());
-    if (scene.contact_corners)
+    if (fdem::uses_corner_contact(scene))
       std::printf(
           "  advice: contact.formulation: corners is made for quasi-static holds and for blocks "
           "that stay face to face; in a dynamic run where blocks tumble across each other, a "

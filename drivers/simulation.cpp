@@ -133,8 +133,8 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
                              scene_.contact_body_dashpot,
                              scene_.contact_sliver_tolerance,
                              scene_.contact_clip_replay,
-                             scene_.contact_corners};
-    if (scene_.contact_corners && scene_.quasi_static.local_damping > 0.0)
+                             uses_corner_contact(scene_)};
+    if (settings.corners && scene_.quasi_static.local_damping > 0.0)
       settings.least_damping_ratio = kCornerDampingRatio;
     contact_ = std::make_unique<ContactStage>(model_, settings);
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².
@@ -557,7 +557,7 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
     if (size.tets > estimate_generated_size(scene).tets) check_memory(size, "the meshes");
     DistributedModel start = build_distributed_model(scene, chunks, *comm);
     chunks.clear();
-    if (scene.contact_corners)  // what build_model sets on one rank
+    if (uses_corner_contact(scene))  // what build_model sets on one rank
       comm->run_collectively([&] { compute_contact_faces(start.model, *comm); });
     double buffer = 0.0;  // contact buffer (m): as the contact stage sets it on one rank
     if (ContactStage::needed(start.model)) {

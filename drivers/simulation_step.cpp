@@ -424,7 +424,7 @@ std::string Simulation::step_advice() const {
   else
     advice << ". Try a smaller time.safety (e.g. " << std::min(0.5, 0.5 * scene_.time.safety)
            << "), check for very distorted elements, or slow down prescribed velocities.";
-  if (scene_.contact_corners)
+  if (uses_corner_contact(scene_))
     advice << " Under contact.formulation: corners a block's corner caught beside another block's "
               "edge (blocks tumbling across each other) can put energy in: such runs need "
               "contact.formulation: potential (docs/verification.md, \"Corner contact\").";

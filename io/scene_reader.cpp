@@ -526,9 +526,13 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
       scene.contact_friction_anchor_lag =
           r.positive(contact["friction_anchor_lag"], "contact.friction_anchor_lag",
                      "time (s) with which stick springs' anchors follow the contact");
-    if (contact["formulation"])
-      scene.contact_corners = r.choice(contact["formulation"], "contact.formulation",
-                                       {"potential", "corners"}) == "corners";
+    if (contact["formulation"]) {
+      const std::string formulation =
+          r.choice(contact["formulation"], "contact.formulation", {"auto", "potential", "corners"});
+      scene.contact_formulation = formulation == "corners"     ? ContactFormulation::corners
+                                  : formulation == "potential" ? ContactFormulation::potential
+                                                               : ContactFormulation::automatic;
+    }
     if (contact["clip_replay"])
       scene.contact_clip_replay = r.boolean(contact["clip_replay"], "contact.clip_replay");
     if (contact["skip_enclosed"])

@@ -197,7 +197,7 @@ TEST_CASE(
     "[mpi][distributed_build][corner_contact]") {
   const Communicator comm = Communicator::world();
   Scene scene = mixed_scene();
-  scene.contact_corners = true;
+  scene.contact_formulation = ContactFormulation::corners;
   const Model serial = build_model(scene, load_body_meshes(scene));
   REQUIRE(serial.tets.contact_faces.size() == 2 * static_cast<std::size_t>(serial.tets.size()));
   DistributedModel block = build_distributed_model(scene, chunks_of(scene, comm.size()), comm);

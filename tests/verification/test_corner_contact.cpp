@@ -49,7 +49,7 @@ Tilt watch_hold(const Scene& scene, const Vec3& corner) {
 Tilt rocking_hold(double ratio, bool corners) {
   const double g = 9.81, b = 0.1, h = 0.4, end = 0.3;
   Scene scene = basic_scene(end);
-  scene.contact_corners = corners;
+  scene.contact_formulation = corners ? ContactFormulation::corners : ContactFormulation::potential;
   scene.gravity = Vec3(ratio * g * b / h, 0, -g);
   scene.quasi_static.local_damping = 0.8;
   scene.time.safety = 0.7;
@@ -68,7 +68,7 @@ TEST_CASE("corner contact: elastic block–block collision keeps its energy with
           "[verification][contact][corner_contact]") {
   // The two offset cubes of test_impact_energy.cpp: faces, edges and corners come into contact.
   Scene scene = colliding_cubes();
-  scene.contact_corners = true;
+  scene.contact_formulation = ContactFormulation::corners;
   const ImpactRun r = run_impact(scene);
   INFO("worst balance error " << r.worst_balance << ", peak contact energy " << r.peak_contact
                               << " J of " << r.kinetic_start << " J, kinetic at the end "
@@ -83,7 +83,7 @@ TEST_CASE("corner contact: with friction and contact damping the balance closes 
           "[verification][contact][corner_contact]") {
   // The spinning cube thrown onto a fixed base of test_impact_energy.cpp.
   Scene scene = thrown_cube();
-  scene.contact_corners = true;
+  scene.contact_formulation = ContactFormulation::corners;
   const ImpactRun r = run_impact(scene);
   INFO("worst balance error " << r.worst_balance << "; of " << r.kinetic_start
                               << " J: friction dissipated " << r.end.dissipated_friction
@@ -125,7 +125,7 @@ namespace {
 Tilt wall_hold(double ratio, double hold) {
   const double theta = ratio * std::atan(0.6), g = 9.81;
   Scene scene = basic_scene(hold);
-  scene.contact_corners = true;
+  scene.contact_formulation = ContactFormulation::corners;
   scene.gravity = Vec3(-g * std::sin(theta), 0, -g * std::cos(theta));
   scene.quasi_static.local_damping = 0.8;
   scene.time.safety = 0.7;

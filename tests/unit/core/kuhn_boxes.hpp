@@ -59,7 +59,7 @@ inline BodyMesh kuhn_box(const BoxSpec& box) {
 inline Model kuhn_boxes_model(const std::vector<BoxSpec>& boxes) {
   Scene scene;
   scene.source_path = "test.yaml";
-  scene.contact_corners = true;
+  scene.contact_formulation = ContactFormulation::corners;
   MaterialSpec stone;
   stone.name = "stone";
   stone.density = 2000;

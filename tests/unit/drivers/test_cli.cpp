@@ -294,6 +294,20 @@ TEST_CASE("fdem check advises potential contact for dynamic runs under corner co
   CHECK_THAT(run_fdem(dir, "check qs.yaml").out, !Contains(advice));
 }
 
+TEST_CASE("fdem check says which contact formulation auto chose", "[cli]") {
+  TempDir dir;
+  write_text(dir / "scene.yaml", block_on_base);
+  write_text(dir / "qs.yaml", std::string(block_on_base) + "quasi_static: {local_damping: 0.8}\n");
+  CHECK_THAT(run_fdem(dir, "check scene.yaml").out,
+             Contains("formulation potential (auto: potential unless quasi-static"));
+  CHECK_THAT(run_fdem(dir, "check qs.yaml").out,
+             Contains("formulation corners (auto: quasi-static throughout, no joints)"));
+  CHECK_THAT(run_fdem(dir, "check qs.yaml --set quasi_static.until=0.005").out,
+             Contains("formulation potential (auto"));
+  const std::string chosen = run_fdem(dir, "check qs.yaml --set contact.formulation=potential").out;
+  CHECK_THAT(chosen, Contains("formulation potential\n"));
+}
+
 TEST_CASE("fdem check advises element damping for sliding bodies with friction", "[cli]") {
   TempDir dir;
   write_text(dir / "scene.yaml", block_on_base);

@@ -49,15 +49,33 @@ TEST_CASE("contact.clip_replay: true by default, false clips every piece afresh"
   CHECK_THAT(msg, Contains("contact.clip_replay"));
 }
 
-TEST_CASE("contact.formulation: potential by default, or corners", "[io]") {
-  CHECK_FALSE(fdem::parse_scene(minimal_plus(""), "scene.yaml").contact_corners);
-  CHECK_FALSE(fdem::parse_scene(minimal_plus("contact: {formulation: potential}\n"), "scene.yaml")
-                  .contact_corners);
-  CHECK(fdem::parse_scene(minimal_plus("contact: {formulation: corners}\n"), "scene.yaml")
-            .contact_corners);
+TEST_CASE(
+    "contact.formulation: auto by default (corners in quasi-static runs without joints), "
+    "potential or corners",
+    "[io]") {
+  using fdem::ContactFormulation;
+  const auto scene = [](const std::string& extra) {
+    return fdem::parse_scene(minimal_plus(extra), "scene.yaml");
+  };
+  const std::string quasi_static = "quasi_static: {local_damping: 0.8}\n";
+  CHECK(scene("").contact_formulation == ContactFormulation::automatic);
+  CHECK(scene("contact: {formulation: auto}\n").contact_formulation ==
+        ContactFormulation::automatic);
+  CHECK_FALSE(uses_corner_contact(scene("")));  // dynamic
+  CHECK(uses_corner_contact(scene(quasi_static)));
+  CHECK_FALSE(uses_corner_contact(scene("quasi_static: {local_damping: 0.8, until: 0.05}\n")));
+  CHECK_FALSE(uses_corner_contact(scene(quasi_static + "contact: {formulation: potential}\n")));
+  CHECK(uses_corner_contact(scene("contact: {formulation: corners}\n")));
+  fdem::Scene jointed = scene(quasi_static);
+  jointed.bodies[0].joints = fdem::JointPlacement::all;
+  CHECK_FALSE(uses_corner_contact(jointed));
+  fdem::Scene interface = scene(quasi_static);
+  interface.interfaces.emplace_back();
+  CHECK_FALSE(uses_corner_contact(interface));
   const std::string msg = input_error(minimal_plus("contact: {formulation: nodes}\n"));
   CHECK_THAT(msg, StartsWith("scene.yaml:10:"));
   CHECK_THAT(msg, Contains("contact.formulation"));
+  CHECK_THAT(msg, Contains("auto"));
   CHECK_THAT(msg, Contains("potential"));
   CHECK_THAT(msg, Contains("corners"));
 }
