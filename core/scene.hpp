@@ -307,9 +307,9 @@ struct LimitsSpec {
 };
 
 // contact.formulation: the law between bodies in contact.  potential: Munjiza's potential over
-// the tets' overlap; corners: penalty springs at surface faces' corners (contact/corner_contact.hpp),
-// which keep an opening hinge's thrust on its edge; automatic: corners where they are verified
-// (uses_corner_contact), potential elsewhere.
+// the tets' overlap; corners: penalty springs at surface faces' corners
+// (contact/corner_contact.hpp), which keep an opening hinge's thrust on its edge; automatic:
+// corners where they are verified (uses_corner_contact), potential elsewhere.
 enum class ContactFormulation { automatic, potential, corners };
 
 struct Scene {

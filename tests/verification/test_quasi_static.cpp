@@ -231,11 +231,12 @@ TEST_CASE(
     "quasi-static tilting table: a dry running-bond wall stands at 0.98 θc and turns its "
     "end wedge at 1.02 θc (docs/references.md 17)",
     "[verification][quasi_static][long]") {
-  // Each angle held from the start under local damping.  Below θc the wall settles elastically
-  // (the top corner stops at ~48 µm by 0.15 s); above it the end wedge turns, accelerating at
-  // (1 − α) of its unbalanced moment.  Measured (docs/verification.md): at 0.98 θc the corner
-  // moved 52 µm, 0.49 µm of it in the last 0.04 s of 0.2 s; at 1.02 θc 164 µm, 76 µm of it in
-  // the last 0.04 s of 0.12 s.
+  // Each angle held from the start under local damping, with the default contact (corners: the
+  // run is quasi-static throughout).  Below θc the wall settles elastically; above it the end
+  // wedge turns, accelerating at (1 − α) of its unbalanced moment.  Measured
+  // (docs/verification.md): at 0.98 θc the corner moved 35 µm, 0.13 µm of it in the last 0.04 s
+  // of 0.2 s; at 1.02 θc 125 µm, 61 µm of it in the last 0.04 s of 0.12 s (under potential
+  // contact: 52 / 0.49 µm and 164 / 76 µm).
   const double critical = std::atan(0.2 / (4 * 0.1) * (4 * 4 + 2) / (4 * 4 - 1));  // 30.96°
   const WallHold stands = hold_wall(tilting_table_wall(0.98 * critical, 0.2), 0.16);
   const WallHold turns = hold_wall(tilting_table_wall(1.02 * critical, 0.12), 0.08);
@@ -255,10 +256,9 @@ TEST_CASE(
     "settled, at 1.02 θc it runs its hold and the end wedge turns (docs/references.md 17)",
     "[verification][quasi_static][long]") {
   // The holds of the test above, each ended by quasi_static.equilibrium_ratio = 1e-4 instead of
-  // running its fixed time.  Measured (docs/verification.md): 0.98 θc stops at step 26,056
-  // (0.117 s, the corner settled at 45 µm of the 48 µm a 0.2 s hold reaches) with every contact
-  // pair integrated, at step 32,885 (0.148 s) with the slivers left out (contact.sliver_tolerance,
-  // the default); 1.02 θc never comes below 1e-3 and turns.
+  // running its fixed time.  Measured (docs/verification.md): 0.98 θc stops at step 28,885
+  // (0.118 s) under the default contact (corners); under potential contact at step 32,885
+  // (0.148 s); 1.02 θc never comes below 1e-3 and turns.
   const double critical = std::atan(0.2 / (4 * 0.1) * (4 * 4 + 2) / (4 * 4 - 1));  // 30.96°
   const auto run = [](double angle, double end) {
     Scene scene = tilting_table_wall(angle, end);
