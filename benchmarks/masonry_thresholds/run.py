@@ -26,6 +26,9 @@ d1 = |u(T)| − |u(T − w)|, d0 = |u(T − w)| − |u(T − 2w)|:
   stands     d1 < `still` (the problem's tolerance: the structure has stopped or turns back)
   turns      d1 > `moving` and d1 ≥ d0 (a mechanism accelerating)
   undecided  otherwise (still creeping: a longer hold would decide)
+The holds are quasi-static throughout on bodies without joints, so the default contact
+(contact.formulation: auto) is corner contact; --set contact.formulation=potential gives potential
+contact's thresholds (docs/verification.md, "Corner contact").
 With --penalty-factor F the contact penalty is F·E instead of the default (auto: 10 E): how
 the thresholds move with the hinges' contact stiffness.
 With --equilibrium-ratio R every hold also ends at equilibrium (quasi_static.equilibrium_ratio:
