@@ -424,10 +424,15 @@ std::string Simulation::step_advice() const {
   else
     advice << ". Try a smaller time.safety (e.g. " << std::min(0.5, 0.5 * scene_.time.safety)
            << "), check for very distorted elements, or slow down prescribed velocities.";
-  if (uses_corner_contact(scene_))
-    advice << " Under contact.formulation: corners a block's corner caught beside another block's "
-              "edge (blocks tumbling across each other) can put energy in: such runs need "
-              "contact.formulation: potential (docs/verification.md, \"Corner contact\").";
+  if (contact_ && uses_corner_contact(scene_))
+    advice << " Under corner contact ("
+           << (scene_.contact_formulation == ContactFormulation::automatic
+                   ? "contact.formulation: auto, as in every run quasi-static throughout without "
+                     "joints"
+                   : "contact.formulation: corners")
+           << ") a block's corner caught beside another block's edge (blocks tumbling across "
+              "each other) can put energy in: such runs need contact.formulation: potential "
+              "(docs/verification.md, \"Corner contact\").";
   return advice.str();
 }
 

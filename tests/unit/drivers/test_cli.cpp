@@ -308,6 +308,22 @@ TEST_CASE("fdem check says which contact formulation auto chose", "[cli]") {
   CHECK_THAT(chosen, Contains("formulation potential\n"));
 }
 
+TEST_CASE("a numerical failure under corner contact says how auto chose it", "[cli]") {
+  TempDir dir;
+  write_text(dir / "qs.yaml", std::string(block_on_base) + "quasi_static: {local_damping: 0.8}\n");
+  const double critical = critical_step_from_check(run_fdem(dir, "check qs.yaml").out);
+  REQUIRE(critical > 0.0);
+  const std::string step = " --set time.step=" + format_g(3.0 * critical);
+  const Outcome automatic = run_fdem(dir, "run qs.yaml -q -o out" + step);
+  CHECK(automatic.exit_code == 3);
+  CHECK_THAT(automatic.err, Contains("Under corner contact (contact.formulation: auto, as in every "
+                                     "run quasi-static throughout without joints)"));
+  const Outcome potential =
+      run_fdem(dir, "run qs.yaml -q -o out2 --set contact.formulation=potential" + step);
+  CHECK(potential.exit_code == 3);
+  CHECK_THAT(potential.err, !Contains("corner contact"));
+}
+
 TEST_CASE("fdem check advises element damping for sliding bodies with friction", "[cli]") {
   TempDir dir;
   write_text(dir / "scene.yaml", block_on_base);
