@@ -6,9 +6,11 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -69,6 +71,21 @@ inline Outcome run_fdem(const TempDir& dir, const std::string& args,
   o.out = read_text(out);
   o.err = read_text(err);
   return o;
+}
+
+// The critical step (s) that `fdem check` prints ("critical X s"); 0 if it prints none.
+inline double critical_step_from_check(const std::string& check_output) {
+  std::smatch m;
+  const std::regex critical(R"(critical ([0-9.eE+-]+) s)");
+  if (!std::regex_search(check_output, m, critical)) return 0.0;
+  return std::stod(m[1]);
+}
+
+// x as printf's %g writes it: what a --set value on the command line looks like.
+inline std::string format_g(double x) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%g", x);
+  return buffer;
 }
 
 }  // namespace fdem_test

@@ -28,6 +28,8 @@
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
 using Catch::Matchers::StartsWith;
+using fdem_test::critical_step_from_check;
+using fdem_test::format_g;
 using fdem_test::Json;
 using fdem_test::Outcome;
 using fdem_test::read_text;
@@ -145,20 +147,6 @@ output:
   every: 0.01
 )";
 
-// The critical step (s) that `fdem check` prints ("critical X s").
-double critical_step_from_check(const std::string& check_output) {
-  std::smatch m;
-  const std::regex critical(R"(critical ([0-9.eE+-]+) s)");
-  if (!std::regex_search(check_output, m, critical)) return 0.0;
-  return std::stod(m[1]);
-}
-
-std::string format_g(double x) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%g", x);
-  return buffer;
-}
-
 }  // namespace
 
 TEST_CASE("fdem --version prints the version and exits 0", "[cli]") {
@@ -256,100 +244,6 @@ TEST_CASE("fdem check prints the scene contents and stages without stepping", "[
     CHECK(s.exit_code == 0);
     CHECK_THAT(s.out, Contains("step 0.001 s (fixed; critical"));
     CHECK_THAT(s.out, Contains("50 steps"));
-  }
-}
-
-// A block resting on a fixed base, with friction and no element damping.
-const char* block_on_base = R"(name: block-on-base
-time: {end: 0.05}
-gravity: [0, 0, -9.81]
-materials:
-  soft:
-    density: 1000
-    elastic: {young: 1.0e6, poisson: 0.25}
-    contact: {friction: 0.5}
-bodies:
-  - name: base
-    mesh: {box: {min: [-1, -1, -0.2], max: [1, 1, 0], cells: [2, 2, 1]}}
-    material: soft
-    fixed: true
-  - name: block
-    mesh: {box: {min: [-0.2, -0.2, 0], max: [0.2, 0.2, 0.2], cells: [1, 1, 1]}}
-    material: soft
-output:
-  every: 0.01
-)";
-
-TEST_CASE("fdem check advises potential contact for dynamic runs under corner contact", "[cli]") {
-  TempDir dir;
-  write_text(dir / "scene.yaml", block_on_base);
-  const std::string advice = "advice: contact.formulation: corners is made for quasi-static holds";
-  const Outcome o = run_fdem(dir, "check scene.yaml --set contact.formulation=corners");
-  CHECK(o.exit_code == 0);
-  CHECK_THAT(o.out, Contains(advice));
-  CHECK_THAT(run_fdem(dir, "check scene.yaml").out, !Contains(advice));
-  write_text(dir / "qs.yaml", std::string(block_on_base) +
-                                  "quasi_static: {local_damping: 0.8}\ncontact: {formulation: "
-                                  "corners}\n");
-  CHECK_THAT(run_fdem(dir, "check qs.yaml").out, !Contains(advice));
-}
-
-TEST_CASE("fdem check says which contact formulation auto chose", "[cli]") {
-  TempDir dir;
-  write_text(dir / "scene.yaml", block_on_base);
-  write_text(dir / "qs.yaml", std::string(block_on_base) + "quasi_static: {local_damping: 0.8}\n");
-  CHECK_THAT(run_fdem(dir, "check scene.yaml").out,
-             Contains("formulation potential (auto: potential unless quasi-static"));
-  CHECK_THAT(run_fdem(dir, "check qs.yaml").out,
-             Contains("formulation corners (auto: quasi-static throughout, no joints)"));
-  CHECK_THAT(run_fdem(dir, "check qs.yaml --set quasi_static.until=0.005").out,
-             Contains("formulation potential (auto"));
-  const std::string chosen = run_fdem(dir, "check qs.yaml --set contact.formulation=potential").out;
-  CHECK_THAT(chosen, Contains("formulation potential\n"));
-}
-
-TEST_CASE("a numerical failure under corner contact says how auto chose it", "[cli]") {
-  TempDir dir;
-  write_text(dir / "qs.yaml", std::string(block_on_base) + "quasi_static: {local_damping: 0.8}\n");
-  const double critical = critical_step_from_check(run_fdem(dir, "check qs.yaml").out);
-  REQUIRE(critical > 0.0);
-  const std::string step = " --set time.step=" + format_g(3.0 * critical);
-  const Outcome automatic = run_fdem(dir, "run qs.yaml -q -o out" + step);
-  CHECK(automatic.exit_code == 3);
-  CHECK_THAT(automatic.err, Contains("Under corner contact (contact.formulation: auto, as in every "
-                                     "run quasi-static throughout without joints)"));
-  const Outcome potential =
-      run_fdem(dir, "run qs.yaml -q -o out2 --set contact.formulation=potential" + step);
-  CHECK(potential.exit_code == 3);
-  CHECK_THAT(potential.err, !Contains("corner contact"));
-}
-
-TEST_CASE("fdem check advises element damping for sliding bodies with friction", "[cli]") {
-  TempDir dir;
-  write_text(dir / "scene.yaml", block_on_base);
-  const std::string advice =
-      "advice: material 'soft' has friction and no element damping: a body of it that slides";
-  const Outcome o = run_fdem(dir, "check scene.yaml");
-  CHECK(o.exit_code == 0);
-  CHECK_THAT(o.out, Contains(advice));
-  CHECK_THAT(o.out, Contains("docs/verification.md, \"Sliding too fast\""));
-  SECTION("not with element damping") {
-    const Outcome d = run_fdem(dir, "check scene.yaml --set materials.soft.damping=0.3");
-    CHECK(d.exit_code == 0);
-    CHECK_THAT(d.out, !Contains("advice:"));
-  }
-  SECTION("not without friction") {
-    const Outcome f = run_fdem(dir, "check scene.yaml --set materials.soft.contact.friction=0");
-    CHECK(f.exit_code == 0);
-    CHECK_THAT(f.out, !Contains("advice:"));
-  }
-  SECTION("not under local damping for the whole run, but when it ends before") {
-    write_text(dir / "qs.yaml",
-               std::string(block_on_base) + "quasi_static: {local_damping: 0.8}\n");
-    CHECK_THAT(run_fdem(dir, "check qs.yaml").out, !Contains("advice:"));
-    write_text(dir / "settle.yaml",
-               std::string(block_on_base) + "quasi_static: {local_damping: 0.8, until: 0.01}\n");
-    CHECK_THAT(run_fdem(dir, "check settle.yaml").out, Contains(advice));
   }
 }
 
