@@ -164,6 +164,9 @@ std::vector<std::pair<std::string, double>> restart_scene_values(const Scene& sc
   values.emplace_back("time.safety", scene.time.safety);
   add_vec3(values, "gravity", scene.gravity);
   for (const MaterialSpec& m : scene.materials) add_material(values, m);
+  // The contact law the run uses (contact.formulation, auto resolved), listed only under corner
+  // contact, so that a checkpoint of potential contact restarts without a key it never had.
+  if (uses_corner_contact(scene)) values.emplace_back("contact.corners", 1.0);
   for (const BodySpec& body : scene.bodies) {
     const std::string key = "bodies." + key_name(body.name);
     values.emplace_back(key + ".material", body.material);

@@ -94,6 +94,24 @@ TEST_CASE("a restart lists other changes as warnings by key and continues", "[cl
   CHECK_THAT(changed.err, Contains("gravity.z changed from -9.81 to -5"));
 }
 
+TEST_CASE("a restart warns when the contact law changes, auto's choice included",
+          "[cli][restart]") {
+  TempDir dir;
+  const std::string checkpoint = first_checkpoint(dir);  // dynamic: potential contact
+  const std::string restart = " -q --restart " + checkpoint;
+  const Outcome corners =
+      run_fdem(dir, "run scene.yaml -o corners" + restart + " --set contact.formulation=corners");
+  INFO(corners.err);
+  CHECK(corners.exit_code == 0);
+  CHECK_THAT(corners.err, Contains("contact.corners (new, 1) applies from the checkpoint's time"));
+  // Quasi-static from the restart on: auto turns to corner contact, and says so.
+  const Outcome quasi_static = run_fdem(
+      dir, "run scene.yaml -o quasi_static" + restart + " --set quasi_static.local_damping=0.8");
+  INFO(quasi_static.err);
+  CHECK(quasi_static.exit_code == 0);
+  CHECK_THAT(quasi_static.err, Contains("contact.corners (new, 1)"));
+}
+
 TEST_CASE("a restart refuses a changed initial stress and warns of new absorbing faces",
           "[cli][restart]") {
   TempDir dir;
