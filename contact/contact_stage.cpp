@@ -81,14 +81,7 @@ std::vector<double> ContactStage::tet_sizes(const Model& model) {
 }
 
 bool ContactStage::needed(const Model& model) {
-  std::int64_t free_pieces = 0;
-  for (std::int32_t b = 0; b < model.pieces.bodies(); ++b)
-    free_pieces += model.body_fixed[b] ? 0 : model.pieces.pieces_in_body(b);
-  // A jointed body is one piece of many contact groups: its tets meet once joints break.
-  const bool grouped =
-      model.tets.contact_group.size() > 0 &&
-      *std::max_element(model.tets.contact_group.begin(), model.tets.contact_group.end()) >= 1;
-  return (model.pieces.size() >= 2 || grouped) && free_pieces >= 1;
+  return contact_possible(model);
 }
 
 double ContactStage::critical_time_step(const Model& model) const {

@@ -222,6 +222,16 @@ struct UnionFind {
 
 }  // namespace
 
+bool contact_possible(const Model& model) {
+  std::int64_t free_pieces = 0;
+  for (std::int32_t b = 0; b < model.pieces.bodies(); ++b)
+    free_pieces += model.body_fixed[b] ? 0 : model.pieces.pieces_in_body(b);
+  const bool grouped =
+      !model.tets.contact_group.empty() &&
+      *std::max_element(model.tets.contact_group.begin(), model.tets.contact_group.end()) >= 1;
+  return (model.pieces.size() >= 2 || grouped) && free_pieces >= 1;
+}
+
 std::int32_t count_fragments(const Model& model) {
   // Without joints the pieces at t = 0 are the connected components, and they stay so.
   if (model.joints.size() == 0) return static_cast<std::int32_t>(model.pieces.size());

@@ -226,6 +226,10 @@ LocalIndex local_count(std::size_t n, const char* what);
 // Builds tet_force_order from the tets' global ids (call after any change of the tet arrays).
 void build_tet_force_order(const TetArrays& tets, std::vector<LocalIndex>& order);
 
+// Whether bodies can come into contact at all: at least two pieces (or a jointed body's contact
+// groups, which meet once its joints break), not all of them fixed.
+bool contact_possible(const Model& model);
+
 // Discrete elements now: connected components of tets linked by a shared node or an intact
 // joint.  At t = 0 with intact joints this equals the number of pieces.
 std::int32_t count_fragments(const Model& model);

@@ -333,7 +333,8 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
 
   build_tet_force_order(tets, model.tet_force_order);
   apply_constraints(scene, model);
-  if (uses_corner_contact(scene)) compute_contact_faces(model);  // corner contact reads them
+  // Corner contact reads them; a model whose bodies cannot meet has no contact stage.
+  if (uses_corner_contact(scene) && contact_possible(model)) compute_contact_faces(model);
   return model;
 }
 

@@ -557,7 +557,7 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
     if (size.tets > estimate_generated_size(scene).tets) check_memory(size, "the meshes");
     DistributedModel start = build_distributed_model(scene, chunks, *comm);
     chunks.clear();
-    if (uses_corner_contact(scene))  // what build_model sets on one rank
+    if (uses_corner_contact(scene) && ContactStage::needed(start.model))  // as build_model does
       comm->run_collectively([&] { compute_contact_faces(start.model, *comm); });
     double buffer = 0.0;  // contact buffer (m): as the contact stage sets it on one rank
     if (ContactStage::needed(start.model)) {

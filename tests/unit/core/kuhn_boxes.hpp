@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/contact_faces.hpp"
 #include "core/model_builder.hpp"
 #include "core/scene.hpp"
 
@@ -74,7 +75,11 @@ inline Model kuhn_boxes_model(const std::vector<BoxSpec>& boxes) {
     scene.bodies.push_back(body);
     meshes.push_back(kuhn_box(boxes[b]));
   }
-  return build_model(scene, meshes);
+  Model model = build_model(scene, meshes);
+  // One box cannot meet another, and build_model leaves its contact faces out: made here, for the
+  // tests of the faces themselves.
+  if (model.tets.contact_faces.empty()) compute_contact_faces(model);
+  return model;
 }
 
 }  // namespace fdem::test

@@ -108,3 +108,34 @@ TEST_CASE("contact faces: the records give the same bits in any order, as direct
   set_contact_faces(model, faces, edges, vertices);
   CHECK(model.tets.contact_faces == expected);
 }
+
+TEST_CASE("contact faces: build_model makes them under corner contact only where bodies can meet",
+          "[contact_faces]") {
+  // Corner contact set; one free box, a free box on a fixed one, and two fixed boxes.
+  const auto build = [](const std::vector<bool>& fixed) {
+    Scene scene;
+    scene.source_path = "test.yaml";
+    scene.contact_formulation = ContactFormulation::corners;
+    MaterialSpec stone;
+    stone.name = "stone";
+    stone.density = 2000;
+    stone.elastic.young = 1e9;
+    stone.elastic.poisson = 0.2;
+    scene.materials.push_back(stone);
+    std::vector<BodyMesh> meshes;
+    for (std::size_t b = 0; b < fixed.size(); ++b) {
+      BodySpec body;
+      body.name = "box" + std::to_string(b);
+      body.material = 0;
+      body.fixed = fixed[b];
+      scene.bodies.push_back(body);
+      meshes.push_back(test::kuhn_box({Vec3(0, 0, 0.5 * b), {1, 1, 1}, 0.5}));
+    }
+    return build_model(scene, meshes);
+  };
+  CHECK(build({false}).tets.contact_faces.empty());
+  CHECK(build({true, true}).tets.contact_faces.empty());
+  const Model pair = build({true, false});
+  CHECK(pair.tets.contact_faces.size() == 2 * static_cast<std::size_t>(pair.tets.size()));
+  CHECK(count_bits(pair).surface == 2 * 6 * 2);  // two cubes: 6 sides of 2 triangles each
+}

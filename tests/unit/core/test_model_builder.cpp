@@ -241,7 +241,8 @@ TEST_CASE("prescribed velocities are stored only when a load moves nodes", "[mod
   scene.loads.push_back(load);
   const Model moved = build_model(scene, {two_pieces(), two_pieces()});
   CHECK(moved.nodes.has_prescribed_velocity);
-  REQUIRE(moved.nodes.prescribed_velocity.size() == 3 * moved.nodes.size());
+  REQUIRE(moved.nodes.prescribed_velocity.size() ==
+          3 * static_cast<std::size_t>(moved.nodes.size()));
   int driven = 0;
   for (LocalIndex n = 0; n < moved.nodes.size(); ++n)
     if (moved.pieces.body_of(moved.nodes.piece[n]) == 1) {
