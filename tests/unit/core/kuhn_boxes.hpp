@@ -55,9 +55,9 @@ inline BodyMesh kuhn_box(const BoxSpec& box) {
   return mesh;
 }
 
-// A scene of one stone material (E = 1 GPa, ν 0.2, 2000 kg/m³, penalty 10 GPa) and one body per
-// box, with corner contact on.
-inline Model kuhn_boxes_model(const std::vector<BoxSpec>& boxes) {
+// A scene of one stone material (E = 1 GPa, ν 0.2, 2000 kg/m³, penalty 10 GPa) and `n_boxes`
+// bodies "box0", "box1", ... (fixed where `fixed` says), with corner contact on.
+inline Scene kuhn_boxes_scene(std::size_t n_boxes, const std::vector<bool>& fixed = {}) {
   Scene scene;
   scene.source_path = "test.yaml";
   scene.contact_formulation = ContactFormulation::corners;
@@ -67,15 +67,21 @@ inline Model kuhn_boxes_model(const std::vector<BoxSpec>& boxes) {
   stone.elastic.young = 1e9;
   stone.elastic.poisson = 0.2;
   scene.materials.push_back(stone);
-  std::vector<BodyMesh> meshes;
-  for (std::size_t b = 0; b < boxes.size(); ++b) {
+  for (std::size_t b = 0; b < n_boxes; ++b) {
     BodySpec body;
     body.name = "box" + std::to_string(b);
     body.material = 0;
+    body.fixed = b < fixed.size() && fixed[b];
     scene.bodies.push_back(body);
-    meshes.push_back(kuhn_box(boxes[b]));
   }
-  Model model = build_model(scene, meshes);
+  return scene;
+}
+
+// kuhn_boxes_scene's model of the given boxes, free, with their contact faces.
+inline Model kuhn_boxes_model(const std::vector<BoxSpec>& boxes) {
+  std::vector<BodyMesh> meshes;
+  for (const BoxSpec& box : boxes) meshes.push_back(kuhn_box(box));
+  Model model = build_model(kuhn_boxes_scene(boxes.size()), meshes);
   // One box cannot meet another, and build_model leaves its contact faces out: made here, for the
   // tests of the faces themselves.
   if (model.tets.contact_faces.empty()) compute_contact_faces(model);

@@ -113,25 +113,10 @@ TEST_CASE("contact faces: build_model makes them under corner contact only where
           "[contact_faces]") {
   // Corner contact set; one free box, a free box on a fixed one, and two fixed boxes.
   const auto build = [](const std::vector<bool>& fixed) {
-    Scene scene;
-    scene.source_path = "test.yaml";
-    scene.contact_formulation = ContactFormulation::corners;
-    MaterialSpec stone;
-    stone.name = "stone";
-    stone.density = 2000;
-    stone.elastic.young = 1e9;
-    stone.elastic.poisson = 0.2;
-    scene.materials.push_back(stone);
     std::vector<BodyMesh> meshes;
-    for (std::size_t b = 0; b < fixed.size(); ++b) {
-      BodySpec body;
-      body.name = "box" + std::to_string(b);
-      body.material = 0;
-      body.fixed = fixed[b];
-      scene.bodies.push_back(body);
+    for (std::size_t b = 0; b < fixed.size(); ++b)
       meshes.push_back(test::kuhn_box({Vec3(0, 0, 0.5 * b), {1, 1, 1}, 0.5}));
-    }
-    return build_model(scene, meshes);
+    return build_model(test::kuhn_boxes_scene(fixed.size(), fixed), meshes);
   };
   CHECK(build({false}).tets.contact_faces.empty());
   CHECK(build({true, true}).tets.contact_faces.empty());
