@@ -557,10 +557,11 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
     if (size.tets > estimate_generated_size(scene).tets) check_memory(size, "the meshes");
     DistributedModel start = build_distributed_model(scene, chunks, *comm);
     chunks.clear();
-    if (uses_corner_contact(scene) && ContactStage::needed(start.model))  // as build_model does
+    const bool contact = ContactStage::needed(start.model);
+    if (contact && uses_corner_contact(scene))  // as build_model does on one rank
       comm->run_collectively([&] { compute_contact_faces(start.model, *comm); });
     double buffer = 0.0;  // contact buffer (m): as the contact stage sets it on one rank
-    if (ContactStage::needed(start.model)) {
+    if (contact) {
       buffer = scene.contact_buffer;
       if (buffer < 0)
         buffer = ContactStage::auto_buffer(

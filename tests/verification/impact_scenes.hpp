@@ -61,10 +61,7 @@ inline Scene thrown_cube() {
   scene.materials[0].contact.friction = 0.3;
   scene.materials[0].contact.damping = 0.2;
   scene.time.safety = 0.5;
-  scene.bodies.push_back(box_body("base", Vec3(-0.5, -0.5, -0.1), Vec3(0.5, 0.5, 0), 5, 5, 1));
-  scene.bodies[0].fixed = true;
-  scene.bodies.push_back(
-      box_body("block", Vec3(-0.1, -0.1, 0.002), Vec3(0.1, 0.1, 0.202), 2, 2, 2));
+  add_cube_above_base(scene, 0.002);
   scene.bodies[1].velocity = Vec3(3, 0, -2);
   scene.bodies[1].angular_velocity = Vec3(0, 5, 0);
   return scene;

@@ -58,6 +58,15 @@ inline Scene block_on_base(double b, double h, double friction, double end_time,
   return scene;
 }
 
+// Bodies 0 and 1 of material 0: a fixed 1 × 1 × 0.1 m base (5 × 5 × 1 cells, top at z = 0) and a
+// 0.2 m cube (2 × 2 × 2 cells) centred over it, its bottom `gap` (m) above the base.
+inline void add_cube_above_base(Scene& scene, double gap) {
+  scene.bodies.push_back(box_body("base", Vec3(-0.5, -0.5, -0.1), Vec3(0.5, 0.5, 0), 5, 5, 1));
+  scene.bodies[0].fixed = true;
+  scene.bodies.push_back(
+      box_body("block", Vec3(-0.1, -0.1, gap), Vec3(0.1, 0.1, 0.2 + gap), 2, 2, 2));
+}
+
 // What a block did while a load was held: slid along x (m) and turned (rad) during the hold.
 struct HoldResult {
   double slid = 0;

@@ -297,10 +297,7 @@ TEST_CASE(
   scene.materials.push_back(elastic_material(2000, 1e8, 0.2));
   scene.materials[0].contact.friction = mu;
   scene.time.safety = 0.5;
-  scene.bodies.push_back(box_body("base", Vec3(-0.5, -0.5, -0.1), Vec3(0.5, 0.5, 0), 5, 5, 1));
-  scene.bodies[0].fixed = true;
-  scene.bodies.push_back(
-      box_body("block", Vec3(-0.1, -0.1, 0.001), Vec3(0.1, 0.1, 0.201), 2, 2, 2));
+  add_cube_above_base(scene, 0.001);
   scene.bodies[1].velocity = Vec3(1, 0, -1);
   auto sim = quiet_simulation(scene);
   while (sim->time() < scene.time.end) sim->step();
