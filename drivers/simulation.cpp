@@ -115,7 +115,10 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
                        " (faces shared by two tets or by a joint are not boundary faces)");
     }
 
-  plan_.contact = ContactStage::needed(model_);
+  // On N ranks from the distributed start a rank may hold no tet (more ranks than tets at the
+  // start, or a body's tets all elsewhere): every rank runs the contact stages when any needs them.
+  plan_.contact = distributed ? comm_->max(std::int32_t{ContactStage::needed(model_)}) > 0
+                              : ContactStage::needed(model_);
   const CriticalStep critical = fdem::critical_time_step(model_);
   dt_critical_ = global_min(critical.dt);
   // Energies below this are round-off for the model (1e-12 of Σ E·V, J): a balance "error" among
@@ -557,7 +560,8 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene, RunOptions optio
     if (size.tets > estimate_generated_size(scene).tets) check_memory(size, "the meshes");
     DistributedModel start = build_distributed_model(scene, chunks, *comm);
     chunks.clear();
-    const bool contact = ContactStage::needed(start.model);
+    // Decided alike on every rank: what follows is collective.
+    const bool contact = comm->max(std::int32_t{ContactStage::needed(start.model)}) > 0;
     if (contact && uses_corner_contact(scene))  // as build_model does on one rank
       comm->run_collectively([&] { compute_contact_faces(start.model, *comm); });
     double buffer = 0.0;  // contact buffer (m): as the contact stage sets it on one rank

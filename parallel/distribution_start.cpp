@@ -51,10 +51,12 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   state.x_at_detection = start.model.nodes.x;
   // With joints, tets carry their joint state (bonded anywhere, not only by the joints that end
   // up held with them).
-  has_joint_state_ = !start.tet_joint_state.empty();
-  has_contact_faces_ = !start.model.tets.contact_faces.empty();
+  // Decided alike on every rank (a rank may start with no tet, and receive some later), and so
+  // is the branch below: both paths are collective.
+  has_joint_state_ = comm_.max(std::int32_t{!start.tet_joint_state.empty()}) > 0;
+  has_contact_faces_ = comm_.max(std::int32_t{!start.model.tets.contact_faces.empty()}) > 0;
   state.tet_joint_state = std::move(start.tet_joint_state);
-  if (start.joints.empty() && !has_joint_state_) {
+  if (!has_joint_state_ && comm_.max(std::int32_t{!start.joints.empty()}) == 0) {
     local = std::move(start.model);
     append_halo(local, state, &start.tet_reach);
     local_state = std::move(state);
