@@ -105,11 +105,10 @@ void corners_against_faces(const TetGeometry& side, const CornerTet& corner_side
   for (int s = 0; s < 4; ++s) {
     if (!(corner_side.faces & contact_face_bits::surface(s))) continue;
     const Vec3 n_s = -side.inward_normal[s];
-    const double reach = kFoldTolerance / corner_side.inverse_height0[s];  // m, beyond a fold
-    Vec3 d1, d2;
-    tie_directions(n_s, d1, d2);
     int cs[3];
     face_corners(s, cs);
+    bool tie_ready = false;  // the tie directions, made for the first corner in reach
+    Vec3 d1, d2;
     for (int t = 0; t < 4; ++t) {
       if (!(corner_other.faces & contact_face_bits::surface(t))) continue;
       const Vec3 n_t = -other.inward_normal[t];
@@ -117,29 +116,41 @@ void corners_against_faces(const TetGeometry& side, const CornerTet& corner_side
       int w[3];
       face_corners(t, w);
       const Vec3& x0 = other.corners.x[w[0]];
+      const double deepest =
+          0.5 / std::max(corner_side.inverse_height0[s], corner_other.inverse_height0[t]);
+      double g[3];
+      bool any = false;
+      for (int q = 0; q < 3; ++q) {
+        g[q] = (side.corners.x[cs[q]] - x0).dot(n_t);
+        any |= g[q] < 0.0 && g[q] > -deepest;
+      }
+      if (!any) continue;  // no corner of S within the depth T holds
+      if (!tie_ready) {
+        tie_directions(n_s, d1, d2);
+        tie_ready = true;
+      }
+      const double reach = kFoldTolerance / corner_side.inverse_height0[s];  // m, beyond a fold
       // Half a pressed face's stiffness per area (each tet takes each role) times A_S/3 (N/m).
       const double k = 2.0 * penalty *
                        (corner_side.inverse_height0[s] + corner_other.inverse_height0[t]) *
                        std::min(corner_side.area0[s], corner_other.area0[t]) / 3.0;
-      const double deepest =
-          0.5 / std::max(corner_side.inverse_height0[s], corner_other.inverse_height0[t]);
       const Vec3 e1 = other.corners.x[w[1]] - x0, e2 = other.corners.x[w[2]] - x0;
       const double twice_area = n_t.dot(e1.cross(e2));
       for (int q = 0; q < 3; ++q) {
+        if (!(g[q] < 0.0 && g[q] > -deepest)) continue;
         const Vec3& p = side.corners.x[cs[q]];
-        const double g = (p - x0).dot(n_t);
-        if (!(g < 0.0 && g > -deepest)) continue;
-        if (!over_face(p, n_s, d1, d2, reach, -g < reach, other, corner_other, t, w)) continue;
-        const Vec3 foot = p - g * n_t;
+        if (!over_face(p, n_s, d1, d2, reach, -g[q] < reach, other, corner_other, t, w)) continue;
+        const Vec3 foot = p - g[q] * n_t;
         const double mu1 = n_t.dot((foot - x0).cross(e2)) / twice_area;
         const double mu2 = n_t.dot(e1.cross(foot - x0)) / twice_area;
         const double mu[3] = {1.0 - mu1 - mu2, mu1, mu2};
-        if (!(-g < reach) && entered_beside(g, mu, twice_area, other, corner_other, t, w)) continue;
-        r.energy += 0.5 * k * g * g;
-        const Vec3 f = -k * g * n_t;  // on the corner, out of the other tet
+        if (!(-g[q] < reach) && entered_beside(g[q], mu, twice_area, other, corner_other, t, w))
+          continue;
+        r.energy += 0.5 * k * g[q] * g[q];
+        const Vec3 f = -k * g[q] * n_t;  // on the corner, out of the other tet
         f_side[cs[q]] += f;
         for (int j = 0; j < 3; ++j) f_other[w[j]] -= mu[j] * f;
-        r.overlap_volume += corner_side.area0[s] / 3.0 * -g;
+        r.overlap_volume += corner_side.area0[s] / 3.0 * -g[q];
         const double weight = f.norm();
         acc.point_sum += weight * p;
         acc.weight_sum += weight;
