@@ -232,6 +232,9 @@ struct MonitorSpec {
   std::string name;
   Vec3 point = Vec3::Zero();  // m, reference configuration
   std::string where;          // "FILE:LINE:COLUMN: output.histories.monitors[i]", for messages
+  // m: the run ends at the first row of histories.csv where the point has moved this far (a
+  // collapse, or a pushover's target); 0: never.
+  double stop_displacement = 0.0;
 };
 
 // output.histories: rows of histories.csv (drivers/histories).  Loads: reaction and mean

@@ -137,9 +137,40 @@ std::string HistoryRecorder::header() const {
   return h + "\n";
 }
 
+bool HistoryRecorder::settle() {
+  if (!pending_) return false;
+  row_ = reduce_row();
+  settled_ = true;
+  // The first monitor (in the scene's order) at or beyond its stop: decided on rank 0, which
+  // holds the whole row, and sent to every rank with its distance (m).
+  double stop[2] = {-1.0, 0.0};  // monitor index, distance
+  const std::size_t first_monitor = 1 + 6 * (loads_.size() + bodies_.size());
+  for (std::size_t m = 0; m < monitors_.size() && stop[0] < 0.0; ++m) {
+    const double limit = monitors_[m].spec.stop_displacement;
+    const double* u = row_.data() + first_monitor + monitor_sums * m;
+    const double distance = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (limit > 0.0 && distance >= limit) stop[0] = static_cast<double>(m), stop[1] = distance;
+  }
+  if (comm_) {
+    std::vector<double> sent(stop, stop + 2);
+    if (comm_->rank() != 0) sent = {-1.0, 0.0};
+    comm_->max_in_place(sent);
+    stop[0] = sent[0], stop[1] = sent[1];
+  }
+  if (stop[0] < 0.0) return false;
+  const MonitorSpec& m = monitors_[static_cast<std::size_t>(stop[0])].spec;
+  std::ostringstream reason;
+  reason << "stopped at t = " << row_[0] << " s: monitor '" << m.name << "' has moved " << stop[1]
+         << " m, at least its stop_displacement " << m.stop_displacement << " m";
+  stop_reason_ = reason.str();
+  return true;
+}
+
 void HistoryRecorder::write(const std::string& directory) {
-  if (!pending_) return;
-  const std::vector<double> row = reduce_row();
+  settle();
+  if (!settled_) return;
+  settled_ = false;
+  const std::vector<double>& row = row_;
   const auto append = [&] {
     if (comm_ && comm_->rank() != 0) return;
     const std::string path = (std::filesystem::path(directory) / "histories.csv").string();

@@ -31,7 +31,12 @@ class HistoryRecorder {
   // sets the next row's time.
   void sample(const Model& model, double time, double dt);
   bool pending() const { return pending_; }
-  // Collective on N ranks: adds the pending row over the ranks, and rank 0 appends it to
+  // Collective on N ranks: adds the pending row over the ranks (if the step took one) and checks
+  // the monitors' stop_displacement on it.  True when a monitor has reached its stop (every rank
+  // alike); stop_reason() then says which.
+  bool settle();
+  std::string stop_reason() const { return stop_reason_; }
+  // Collective on N ranks: settles the pending row, and rank 0 appends it to
   // DIRECTORY/histories.csv (made with its header at the first row).  IoError when the file
   // cannot be written (N ranks: on every rank together).
   void write(const std::string& directory);
@@ -61,6 +66,9 @@ class HistoryRecorder {
   double next_time_ = 0.0;
   bool pending_ = false;
   double pending_time_ = 0.0;
+  bool settled_ = false;        // row_ holds the last row, not yet written
+  std::vector<double> row_;     // added over the ranks (rank 0; partial on the others)
+  std::string stop_reason_;     // of the first monitor that reached its stop_displacement
   std::vector<ExactSum> sums_;  // of the pending row: 7 per load and body, 12 per monitor
   std::ofstream file_;          // rank 0
 };

@@ -118,7 +118,13 @@ int check(const fdem::Scene& scene) {
     std::string what;
     for (const int l : h.loads) what += " load " + scene.loads[l].name + ",";
     for (const int b : h.bodies) what += " body " + scene.bodies[b].name + ",";
-    for (const auto& m : h.monitors) what += " monitor " + m.name + ",";
+    for (const auto& m : h.monitors) {
+      char stop[80] = "";
+      if (m.stop_displacement > 0.0)
+        std::snprintf(stop, sizeof stop, " (ends the run when it has moved %g m)",
+                      m.stop_displacement);
+      what += " monitor " + m.name + stop + ",";
+    }
     what.pop_back();
     std::printf("  histories.csv:%s\n", what.c_str());
   }

@@ -61,6 +61,13 @@ DistributionSettings distribution_settings(const ParallelSpec& spec) {
   return settings;
 }
 
+// A monitor ends the run at its stop_displacement: its rows are taken even without output.
+bool stops_at_a_monitor(const Scene& scene) {
+  for (const MonitorSpec& m : scene.output.histories.monitors)
+    if (m.stop_displacement > 0.0) return true;
+  return false;
+}
+
 }  // namespace
 
 std::vector<std::string> StagePlan::describe() const {
@@ -221,7 +228,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   }
   // Monitors are found by tet gid (rank-independent), so before the restart and the whole-model
   // start's distribution.
-  if (scene_.output.histories.enabled && options_.write_output)
+  if (scene_.output.histories.enabled && (options_.write_output || stops_at_a_monitor(scene_)))
     histories_ = std::make_unique<HistoryRecorder>(scene_, model_, comm_);
   // A restart overwrites the state of the model (and of the stages) with the checkpoint's.
   if (!options_.restart_path.empty()) {
@@ -445,18 +452,24 @@ RunReport Simulation::run() {
   try {
     write_outputs(true);
     const double ratio = scene_.quasi_static.equilibrium_ratio;
-    bool equilibrium = false;
-    while (steps_ < total_steps && interrupt_ == 0 && !equilibrium) {
+    bool equilibrium = false, stopped = false;
+    while (steps_ < total_steps && interrupt_ == 0 && !equilibrium && !stopped) {
       step();
       equilibrium = ratio > 0.0 && force_ratio_ < ratio;  // NaN (undamped): no
-      write_outputs(steps_ == total_steps || equilibrium);
+      stopped = histories_ && histories_->settle();       // a monitor's stop_displacement
+      const bool last = steps_ == total_steps || equilibrium || stopped;
+      write_outputs(last);
       const double wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
-      progress.after_step({steps_, total_steps, time_, dt_, ledger_.balance_error(), wall},
-                          steps_ == total_steps || equilibrium);
+      progress.after_step({steps_, total_steps, time_, dt_, ledger_.balance_error(), wall}, last);
     }
     mark_phase(CommPhase::finish);
-    if (equilibrium) {
+    if (stopped) {
+      progress.end_line();
+      result = report();
+      result.status = "completed";
+      result.reason = histories_->stop_reason() + " (step " + std::to_string(steps_) + ")";
+    } else if (equilibrium) {
       progress.end_line();
       result = report();
       result.status = "completed";

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 
 namespace fdem {
 
@@ -112,7 +113,7 @@ HistoriesSpec read_histories(const Reader& r, const YAML::Node& node, const std:
     for (std::size_t i = 0; i < monitors.size(); ++i) {
       const std::string mp = path + ".monitors[" + std::to_string(i) + "]";
       const YAML::Node m = monitors[i];
-      r.check_keys(m, mp, {"name", "point"}, {"point"});
+      r.check_keys(m, mp, {"name", "point", "stop_displacement"}, {"point"});
       MonitorSpec spec;
       spec.name = m["name"] ? r.string(m["name"], mp + ".name") : "monitor" + std::to_string(i);
       if (!column_safe(spec.name))
@@ -123,6 +124,13 @@ HistoriesSpec read_histories(const Reader& r, const YAML::Node& node, const std:
                  "monitor name '" + spec.name + "' is used twice; names must be unique");
       spec.point = r.vec3(m["point"], mp + ".point");
       spec.where = r.location(m["point"], mp + ".point");
+      if (m["stop_displacement"]) {
+        spec.stop_displacement = r.number(m["stop_displacement"], mp + ".stop_displacement");
+        if (!(spec.stop_displacement > 0.0) || !std::isfinite(spec.stop_displacement))
+          r.fail(m["stop_displacement"], mp + ".stop_displacement",
+                 "must be a positive distance in m: the run ends once the monitor's point has "
+                 "moved this far (checked at each row of histories.csv)");
+      }
       h.monitors.push_back(spec);
     }
   }

@@ -1,7 +1,7 @@
 // histories.csv (drivers/histories, core/history_sums): the reaction of a statically stretched
 // bar against E·A·ε, monitor interpolation of linear fields and the stress of a uniform stretch,
 // which tet holds a monitor, and through the fdem command: a monitor outside the model, and the
-// rows of a restarted run against the uninterrupted run's.
+// rows of a restarted run against the uninterrupted run's, and a monitor that ends the run.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -16,6 +16,7 @@
 #include "drivers/mesh_generators.hpp"
 #include "drivers/scene_builders.hpp"
 #include "drivers/simulation.hpp"
+#include "io/scene_reader.hpp"
 
 using namespace fdem;
 using Catch::Matchers::Contains;
@@ -262,4 +263,64 @@ TEST_CASE("histories: a restarted run's rows are the uninterrupted run's at the 
   const auto h = read_histories(dir / "first/histories.csv");
   CHECK(h.at("load.pusher.fx").back() > 0);
   CHECK(h.at("load.pusher.ux").back() == Approx(0.5 * h.at("time").back()).epsilon(0.01));
+}
+
+namespace {
+
+// A cube falling freely (no contact) with a monitor that ends the run once it has fallen 1 cm;
+// rows every 1 ms.  Its centre falls ½ g t² (central differences from rest under a constant force
+// give exactly ½ g t² at the steps), so 1 cm is first reached at the row taken at the first step
+// past 46 ms (45 ms: 9.93 mm, 46 ms: 10.38 mm).
+const char* falling_cube = R"(name: falling-cube
+time: {end: 1.0}
+gravity: [0, 0, -9.81]
+materials:
+  stone: {density: 2500, elastic: {young: 1.0e8, poisson: 0.2}}
+bodies:
+  - {name: cube, mesh: {box: {min: [0, 0, 0], max: [0.1, 0.1, 0.1], cells: [1, 1, 1]}},
+     material: stone}
+output:
+  every: 0
+  histories:
+    every: 0.001
+    monitors: [{name: centre, point: [0.05, 0.05, 0.05], stop_displacement: 0.01}]
+)";
+
+}  // namespace
+
+TEST_CASE("histories: a monitor's stop_displacement ends the run at the first row beyond it",
+          "[drivers][histories][cli]") {
+  TempDir dir;
+  write_text(dir / "scene.yaml", falling_cube);
+  const Outcome o = run_fdem(dir, "run scene.yaml -o out");
+  INFO(o.err);
+  REQUIRE(o.exit_code == 0);
+  CHECK_THAT(o.err, Contains("fdem: stopped at t = 0.046"));
+  CHECK_THAT(o.err, Contains("s: monitor 'centre' has moved 0.010"));
+  const std::string summary = read_text(dir / "out/summary.json");
+  CHECK_THAT(summary, Contains("\"status\": \"completed\""));
+  CHECK_THAT(summary, Contains("at least its stop_displacement 0.01 m"));
+  const auto h = read_histories(dir / "out/histories.csv");
+  REQUIRE(h.at("time").size() == 47);    // rows from 0 to 46 ms: the last one is the stop's
+  const double t = h.at("time").back();  // the first step at or after 46 ms
+  CHECK(t >= 0.046);
+  CHECK(t < 0.046 + 0.001);
+  CHECK(-h.at("monitor.centre.uz").back() == Approx(0.5 * 9.81 * t * t).epsilon(1e-6));
+  CHECK(-h.at("monitor.centre.uz")[45] < 0.01);
+  CHECK(-h.at("monitor.centre.uz").back() >= 0.01);
+
+  // Without output files (the simulation alone, as tests and scripts run it) it ends alike.
+  Scene scene = parse_scene(falling_cube, dir / "scene.yaml");
+  RunOptions options;
+  options.write_output = false;
+  auto sim = make_simulation(scene, options);
+  const RunReport report = sim->run();
+  CHECK(report.status == "completed");
+  CHECK_THAT(report.reason, Contains("monitor 'centre' has moved"));
+  CHECK(report.steps > 0);
+  CHECK(std::abs(report.time - t) <= sim->time_step() * (1 + 1e-9));  // the step after the row
+
+  // fdem check says so.
+  const Outcome check = run_fdem(dir, "check scene.yaml");
+  CHECK_THAT(check.out, Contains("monitor centre (ends the run when it has moved 0.01 m)"));
 }

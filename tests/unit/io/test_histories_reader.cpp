@@ -69,7 +69,7 @@ TEST_CASE("histories: loads by name (default: every load holding nodes), bodies,
                                    "    bodies: all\n"
                                    "    monitors:\n"
                                    "      - {name: centre, point: [0.5, 0.5, 0.5]}\n"
-                                   "      - {point: [0.1, 0.2, 0.3]}\n"),
+                                   "      - {point: [0.1, 0.2, 0.3], stop_displacement: 0.02}\n"),
                         "scene.yaml");
   const fdem::HistoriesSpec& c = chosen.output.histories;
   CHECK(c.every == 0.001);
@@ -79,6 +79,8 @@ TEST_CASE("histories: loads by name (default: every load holding nodes), bodies,
   CHECK(c.monitors[0].name == "centre");
   CHECK(c.monitors[1].name == "monitor1");
   CHECK(c.monitors[1].point.isApprox(fdem::Vec3(0.1, 0.2, 0.3)));
+  CHECK(c.monitors[0].stop_displacement == 0.0);  // never ends the run
+  CHECK(c.monitors[1].stop_displacement == 0.02);
   // Where the point is written: a monitor outside every tet is reported there.
   CHECK(c.monitors[1].where == "scene.yaml:22:17: output.histories.monitors[1].point");
 
@@ -116,6 +118,17 @@ TEST_CASE("histories: errors name the line, the key and what is valid", "[io][hi
              Contains("monitor name 'a' is used twice"));
   CHECK_THAT(input_error(scene_with("  histories: {monitors: [{name: a}]}\n")),
              Contains("missing required key 'point'"));
+  const auto stop_error = [](const std::string& value) {
+    return input_error(
+        scene_with("  histories: {monitors: [{name: a, point: [0, 0, 0], "
+                   "stop_displacement: " +
+                   value + "}]}\n"));
+  };
+  for (const char* bad : {"0", "-0.01"})
+    CHECK_THAT(stop_error(bad), Contains("scene.yaml:16:73: output.histories.monitors[0]."
+                                         "stop_displacement: must be a positive distance in m"));
+  CHECK_THAT(stop_error(".inf"),
+             Contains("monitors[0].stop_displacement: expected a finite number"));
 }
 
 TEST_CASE("load names: unique, column-safe, not on tilts", "[io][histories]") {
