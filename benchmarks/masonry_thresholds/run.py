@@ -6,7 +6,8 @@ from the start at `ratio` × the rigid-block threshold and held under local damp
 
   benchmarks/masonry_thresholds/run.py [--fdem build/drivers/fdem] [--cases all|NAME,...]
                                        [--ratios all|R,...] [--hold-scale 1]
-                                       [--equilibrium-ratio R] [--penalty-factor F]
+                                       [--equilibrium-ratio R] [--stop-displacement D]
+                                       [--penalty-factor F]
                                        [--set KEY=VALUE ...]
                                        [--csv docs/data/masonry_thresholds.csv]
   benchmarks/masonry_thresholds/run.py --references   # the rigid-block values only
@@ -33,7 +34,9 @@ With --penalty-factor F the contact penalty is F·E instead of the default (auto
 the thresholds move with the hinges' contact stiffness.
 With --equilibrium-ratio R every hold also ends at equilibrium (quasi_static.equilibrium_ratio:
 the mean unbalanced-force ratio below R); a hold that ends so `stands (equilibrium)`, before its
-full time.
+full time.  With --stop-displacement D every hold also ends once its monitor has moved D (m;
+the monitor's stop_displacement): a hold that ends so `turns (stop)`.  With both, each hold ends
+by itself whichever way it goes.
 Time is the user CPU time of the fdem process (/usr/bin/time), one core.
 """
 import argparse, csv, itertools, json, math, os, subprocess, sys, tempfile
@@ -243,7 +246,8 @@ def run(fdem, text, workdir, overrides=()):
         rows = list(csv.DictReader(f))
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)
-    return rows, cpu, summary["steps"], "equilibrium" in summary.get("reason", "")
+    reason = summary.get("reason", "")
+    return rows, cpu, summary["steps"], "equilibrium" in reason, "stop_displacement" in reason
 
 
 def main():
@@ -262,6 +266,8 @@ def main():
                         "contact.sliver_tolerance=1e-8")
     p.add_argument("--equilibrium-ratio", type=float, default=0.0,
                    help="end holds at equilibrium (quasi_static.equilibrium_ratio), e.g. 1e-4")
+    p.add_argument("--stop-displacement", type=float, default=0.0,
+                   help="end holds once the monitor has moved this far (m), e.g. 0.001")
     a = p.parse_args()
     refs = {"wall_tilt": math.degrees(math.atan(0.6)),
             "arch_min_thickness": minimum_thickness(),
@@ -286,18 +292,23 @@ def main():
             text = text.replace("quasi_static: {local_damping: 0.8}",
                                 "quasi_static: {local_damping: 0.8, equilibrium_ratio: %g}" %
                                 a.equilibrium_ratio)
+        if a.stop_displacement > 0:
+            text = text.replace("point: [", "stop_displacement: %g, point: [" % a.stop_displacement)
         if a.penalty_factor > 0:
             text = text.replace("contact: {friction: 0.8}",
                                 "contact: {friction: 0.8, penalty: %g}" % (a.penalty_factor * 1.0e9))
         with tempfile.TemporaryDirectory() as workdir:
-            rows, cpu, steps, at_equilibrium = run(a.fdem, text, workdir, a.set)
+            rows, cpu, steps, at_equilibrium, stopped = run(a.fdem, text, workdir, a.set)
         verdict, end, d1 = outcome(rows, still, moving)
         if at_equilibrium:
             verdict = "stands (equilibrium)"
+        if stopped:
+            verdict = "turns (stop)"
         print("%-20s %6.3f %6.2f %9d %8.1f %11.3e %11.3e  %s" % (name, ratio, hold, steps, cpu, end,
                                                                   d1, verdict), flush=True)
         results.append({"problem": name, "ratio": ratio, "reference": refs[name], "hold_s": hold,
                         "equilibrium_ratio": a.equilibrium_ratio,
+                        "stop_displacement_m": a.stop_displacement,
                         "penalty_factor": a.penalty_factor or 10.0,
                         "overrides": " ".join(a.set),
                         "steps": steps, "cpu_s": cpu, "displacement_m": end,
