@@ -270,8 +270,9 @@ void ContactStage::update_tet_geometry(const Model& model) {
   tet_geometry_.resize(pair_tets_.size());
   for (std::size_t i = 0; i < pair_tets_.size(); ++i) {
     const TetCorners corners = tet_corners(model, pair_tets_[i]);
-    // (the travel sums serve the skip of pairs kept apart, which goes with clip_replay)
-    if (clip_replay_ && !indexed) apart_pairs_.moved(i, tet_geometry_[i].corners, corners);
+    // (the travel sums serve the skip of pairs kept apart: with clip_replay, and under corners)
+    if ((clip_replay_ || corners_) && !indexed)
+      apart_pairs_.moved(i, tet_geometry_[i].corners, corners);
     tet_boxes_[i] = tet_box(corners);
     compute_tet_geometry(corners, tet_geometry_[i]);
   }
@@ -451,6 +452,12 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     }
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
+    if (corners_)  // a pair without contact may stay so for a known travel (corner_contact.hpp)
+      apart_pairs_.found(index, pairs_.size(), slot_a, slot_b,
+                         r.overlapping
+                             ? 0.0
+                             : corner_pair_apart_travel(geometry_a, corner_tets_[slot_a],
+                                                        geometry_b, corner_tets_[slot_b]));
     if (!r.overlapping) {
       lost();
       continue;

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace fdem {
 namespace {
+
+constexpr double kPi = 3.14159265358979323846;
 
 struct Accumulator {
   ContactPairResult& result;
@@ -207,6 +210,37 @@ CornerTet corner_tet(const Model& model, LocalIndex t) {
     out.area0[f] = 3.0 * volume * out.inverse_height0[f];  // V = A h / 3
   }
   return out;
+}
+
+double corner_pair_apart_travel(const TetGeometry& a, const CornerTet& corner_a,
+                                const TetGeometry& b, const CornerTet& corner_b) {
+  if (!(corner_a.faces & 0xFu) || !(corner_b.faces & 0xFu)) return kUnboundedTravel;
+  if (!a.valid || !b.valid) return 0.0;
+  double margin = std::numeric_limits<double>::infinity();  // min over face pairs of n_s·n_t + ½
+  for (int s = 0; s < 4; ++s)
+    for (int t = 0; t < 4; ++t)
+      if ((corner_a.faces & contact_face_bits::surface(s)) &&
+          (corner_b.faces & contact_face_bits::surface(t)))
+        margin = std::min(margin, a.inward_normal[s].dot(b.inward_normal[t]) + 0.5);
+  if (!(margin > 1e-12)) return 0.0;  // faces that face each other (or NaN): evaluated each step
+  double longest = 0.0, smallest_area = std::numeric_limits<double>::infinity();  // m, m²
+  const auto face_size = [&](const TetGeometry& tet, int face) {
+    int w[3];
+    face_corners(face, w);
+    const Vec3 e1 = tet.corners.x[w[1]] - tet.corners.x[w[0]];
+    const Vec3 e2 = tet.corners.x[w[2]] - tet.corners.x[w[0]];
+    const Vec3 e3 = tet.corners.x[w[2]] - tet.corners.x[w[1]];
+    longest = std::max({longest, e1.norm(), e2.norm(), e3.norm()});
+    smallest_area = std::min(smallest_area, 0.5 * e1.cross(e2).norm());
+  };
+  for (int f = 0; f < 4; ++f) {
+    if (corner_a.faces & contact_face_bits::surface(f)) face_size(a, f);
+    if (corner_b.faces & contact_face_bits::surface(f)) face_size(b, f);
+  }
+  // (inward normals: their dot is the outward normals'; margin ≤ 0 or NaN: no travel; 1e-12
+  // covers the round-off of the dots, here and in the kernel)
+  const double travel = (margin - 1e-12) * smallest_area / (4.0 * kPi * longest) * (1.0 - 1e-9);
+  return travel > 0.0 ? travel : 0.0;
 }
 
 ContactPairResult corner_contact(const TetGeometry& a, const CornerTet& corner_a,

@@ -39,6 +39,9 @@
 
 namespace fdem {
 
+// A travel (m) beyond any that a run makes: the pair can never give corner contact.
+constexpr double kUnboundedTravel = 1e300;
+
 // How far beyond a fold a corner is held, as a fraction of its tet's altitude over its face.
 constexpr double kFoldTolerance = 0.02;
 
@@ -70,6 +73,19 @@ bool corner_over_face(const Vec3& p, const Vec3& n, double reach, const TetGeome
 // Tet t's CornerTet: TetArrays::contact_faces, node gids, and the reference shape's face areas
 // and altitudes.
 CornerTet corner_tet(const Model& model, LocalIndex t);
+
+// How far (m, in the sum of the two tets' corner travels; ApartPairs) the pair's tets can move
+// and still give no corner contact, for a pair that gives none now: unbounded when one tet has
+// no surface face (its contact_faces bits do not change), else, when no surface face of one
+// faces a surface face of the other (n_s·n_t ≥ −½ for all), the travel that cannot turn any two
+// of them to face each other.  Moving a face's corners by at most δ changes its doubled area
+// vector by at most 2δ(|e1| + |e2|) + 4δ² ≤ 4δ(L + δ) (e1, e2 two of its edges, L its longest),
+// so its unit normal turns by at most θ with sin θ ≤ 2δ(L + δ)/A (A its area) and moves by at
+// most θ ≤ (π/2) sin θ; n_s·n_t then drops by at most π·2δ(L + δ)/A over the pair's worst faces,
+// which stays below the margin min(n_s·n_t + ½) while δ ≤ margin·A/(4πL) (≤ L).  0 otherwise
+// (a pair with facing faces is evaluated every step).
+double corner_pair_apart_travel(const TetGeometry& a, const CornerTet& corner_a,
+                                const TetGeometry& b, const CornerTet& corner_b);
 
 // The pair's corner contact as a ContactPairResult: forces and energy as above; normal: the
 // direction of the resultant on the first tet; centroid: the force-weighted mean of the corners

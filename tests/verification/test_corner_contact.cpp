@@ -1,9 +1,12 @@
 // Corner contact (contact.formulation: corners; contact/corner_contact.hpp): impacts keep their
 // energy as potential contact's do, and a rocking block's uplift threshold is the rigid block's
-// at the default penalty (docs/verification.md, "Corner contact").
+// at the default penalty (docs/verification.md, "Corner contact"); the pairs the stage keeps apart
+// have no contact.
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "contact/contact_stage.hpp"
+#include "contact/corner_contact.hpp"
 #include "core/dynamics.hpp"
 #include "core/piece_moments.hpp"
 #include "impact_scenes.hpp"
@@ -151,4 +154,61 @@ TEST_CASE(
   CHECK(below.last_fifth < 2e-6);
   CHECK(above.last_fifth > 2e-5);
   CHECK(above.total > 2 * below.total);
+}
+
+TEST_CASE("corner contact: the pairs the stage keeps apart are the pairs without contact",
+          "[verification][corner_contact]") {
+  // A tall block toppling about its toe on a base under corner contact (gravity tilted to twice
+  // its uplift threshold): as it turns, pairs of its faces and the base's go from facing each
+  // other to not and back.  At every step each candidate pair's contact, evaluated afresh at the
+  // step's positions, must be what the stage found: a pair kept apart (corner_pair_apart_travel)
+  // had none.
+  const double b = 0.1, h = 0.4;  // m
+  Scene scene = basic_scene(0.6);
+  scene.gravity = Vec3(2 * 9.81 * b / h, 0, -9.81);
+  scene.contact_formulation = ContactFormulation::corners;
+  scene.materials.push_back(elastic_material(2000, 1e8, 0.2));
+  scene.materials[0].contact.friction = 0.8;
+  scene.bodies.push_back(box_body("base", Vec3(-0.3, -0.3, -0.1), Vec3(0.3, 0.3, 0), 3, 3, 1));
+  scene.bodies[0].fixed = true;
+  scene.bodies.push_back(
+      box_body("block", Vec3(-0.5 * b, -0.5 * b, 0), Vec3(0.5 * b, 0.5 * b, h), 1, 1, 4));
+  auto sim = quiet_simulation(scene);
+  const Model& model = sim->model();
+  const auto geometry = [&](const std::vector<double>& x, LocalIndex t) {
+    TetCorners corners;
+    for (int c = 0; c < 4; ++c) corners.x[c] = vec3_at(x.data(), model.tets.nodes[4 * t + c]);
+    TetGeometry g;
+    compute_tet_geometry(corners, g);
+    return g;
+  };
+  long evaluated = 0, in_contact = 0, mismatches = 0, steps = 0;
+  while (sim->time() < scene.time.end - 1e-12) {
+    ++steps;
+    const std::vector<double> x = model.nodes.x;  // the step's forces are taken here
+    sim->step();
+    const ContactStage& stage = *sim->contact_stage();
+    for (std::size_t i = 0; i < stage.candidates().size(); ++i) {
+      const CandidatePair& pair = stage.candidates()[i];
+      const bool contact = corner_contact(geometry(x, pair.a), corner_tet(model, pair.a),
+                                          geometry(x, pair.b), corner_tet(model, pair.b), 1e9)
+                               .overlapping;
+      mismatches += contact != (stage.overlapping()[i] != 0);
+      in_contact += contact;
+      ++evaluated;
+    }
+  }
+  const auto kept_apart = sim->contact_stage()->pair_steps_kept_apart();
+  INFO(steps << " steps, " << evaluated << " pair-steps, " << in_contact << " in contact, "
+             << kept_apart << " kept apart by the stage");
+  CHECK(mismatches == 0);
+  CHECK(in_contact > steps);  // the block stays on its toe
+  // It has turned: its top moved along x by more than its width (about 15°).
+  double top_shift = 0.0;  // m
+  for (LocalIndex n = 0; n < model.nodes.size(); ++n)
+    if (model.nodes.x0(n).z() > h - 1e-9)
+      top_shift = std::max(top_shift, vec3_at(model.nodes.x.data(), n).x() - model.nodes.x0(n).x());
+  INFO("top moved " << top_shift << " m");
+  CHECK(top_shift > b);
+  CHECK(kept_apart > static_cast<std::uint64_t>(evaluated / 4));
 }

@@ -178,3 +178,72 @@ TEST_CASE("corner contact: a joint pressed face on face has potential contact's 
   CHECK(corner_force == Approx(expected).epsilon(1e-9));
   CHECK(potential_force == Approx(expected).epsilon(1e-4));
 }
+
+TEST_CASE("corner contact: a pair whose faces face no other stays so for its apart travel",
+          "[corner_contact]") {
+  // Random lone tets turned at random: where no face of one faces a face of the other, every
+  // move of their corners by at most the apart travel in all (split at random between the two,
+  // each corner in a random direction) keeps every pair of faces apart (n_s·n_t ≥ −½), so the
+  // kernel gives nothing; where some pair faces, the travel is 0.
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0), share(0.0, 1.0);
+  const auto random_tet = [&](const Vec3& centre) {
+    for (;;) {
+      TetCorners x;
+      for (int c = 0; c < 4; ++c)
+        x.x[c] = centre + 0.1 * Vec3(coordinate(random), coordinate(random), coordinate(random));
+      TetGeometry g;
+      compute_tet_geometry(x, g);
+      if (g.valid && std::abs(g.edge_det) > 1e-5) return x;
+    }
+  };
+  const auto least_margin = [](const TetGeometry& a, const TetGeometry& b) {
+    double margin = 1e9;
+    for (int s = 0; s < 4; ++s)
+      for (int t = 0; t < 4; ++t)
+        margin = std::min(margin, a.inward_normal[s].dot(b.inward_normal[t]) + 0.5);
+    return margin;
+  };
+  int apart = 0, facing = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const TetCorners xa = random_tet(Vec3::Zero()), xb = random_tet(Vec3(0.15, 0, 0));
+    TetGeometry a, b;
+    compute_tet_geometry(xa, a);
+    compute_tet_geometry(xb, b);
+    const CornerTet ca = lone_tet(xa, 0), cb = lone_tet(xb, 4);
+    const double travel = corner_pair_apart_travel(a, ca, b, cb);
+    if (least_margin(a, b) <= 1e-12) {
+      ++facing;
+      CHECK(travel == 0.0);
+      continue;
+    }
+    ++apart;
+    REQUIRE(travel > 0.0);
+    for (int move = 0; move < 20; ++move) {
+      const double to_a = travel * share(random);
+      TetCorners ya = xa, yb = xb;
+      for (int c = 0; c < 4; ++c) {
+        const Vec3 da(coordinate(random), coordinate(random), coordinate(random));
+        const Vec3 db(coordinate(random), coordinate(random), coordinate(random));
+        ya.x[c] += to_a * share(random) * da.normalized();
+        yb.x[c] += (travel - to_a) * share(random) * db.normalized();
+      }
+      TetGeometry a2, b2;
+      compute_tet_geometry(ya, a2);
+      compute_tet_geometry(yb, b2);
+      INFO("trial " << trial << ", travel " << travel);
+      CHECK(least_margin(a2, b2) > 0.0);
+      CHECK_FALSE(corner_contact(a2, ca, b2, cb, 1e9).overlapping);
+    }
+  }
+  CHECK(apart > 100);  // both kinds of pairs are common among random tets
+  CHECK(facing > 100);
+  // A tet without surface faces never meets anything: unbounded.
+  TetGeometry a, b;
+  const TetCorners xa = random_tet(Vec3::Zero()), xb = random_tet(Vec3(0.05, 0, 0));
+  compute_tet_geometry(xa, a);
+  compute_tet_geometry(xb, b);
+  CornerTet inner = lone_tet(xa, 0);
+  inner.faces = 0;
+  CHECK(corner_pair_apart_travel(a, inner, b, lone_tet(xb, 4)) == kUnboundedTravel);
+}
