@@ -45,23 +45,29 @@ Tilt watch_hold(const Scene& scene, const Vec3& corner) {
   return t;
 }
 
-// The top corner (heel side) of a 0.1 × 0.1 × 0.4 m block (1 × 1 × 4 cells, E = 1 GPa, penalty
-// auto, μ 0.8) on a fixed base, held for 0.3 s under local damping 0.8 at a horizontal
-// acceleration `ratio` × g·b/h, the rigid block's uplift threshold.
-
-Tilt rocking_hold(double ratio, bool corners) {
-  const double g = 9.81, b = 0.1, h = 0.4, end = 0.3;
+// A block b × b × h (1 × 1 × 4 cells, E = `young`, μ 0.8) on a fixed 1 × 1 m base, under gravity
+// tilted to `ratio` × its uplift threshold g·b/h, for `end` s.
+constexpr double b = 0.1, h = 0.4;  // m
+Scene tall_block_scene(double ratio, double young, double end) {
+  const double g = 9.81;
   Scene scene = basic_scene(end);
-  scene.contact_formulation = corners ? ContactFormulation::corners : ContactFormulation::potential;
   scene.gravity = Vec3(ratio * g * b / h, 0, -g);
-  scene.quasi_static.local_damping = 0.8;
-  scene.time.safety = 0.7;
-  scene.materials.push_back(elastic_material(2000, 1e9, 0.2));
+  scene.materials.push_back(elastic_material(2000, young, 0.2));
   scene.materials[0].contact.friction = 0.8;
   scene.bodies.push_back(box_body("base", Vec3(-0.5, -0.5, -0.1), Vec3(0.5, 0.5, 0), 4, 4, 1));
   scene.bodies[0].fixed = true;
   scene.bodies.push_back(
       box_body("block", Vec3(-0.5 * b, -0.5 * b, 0), Vec3(0.5 * b, 0.5 * b, h), 1, 1, 4));
+  return scene;
+}
+
+// The top corner (heel side) of the tall block (E = 1 GPa, penalty auto) held for 0.3 s under
+// local damping 0.8 at a horizontal acceleration `ratio` × g·b/h.
+Tilt rocking_hold(double ratio, bool corners) {
+  Scene scene = tall_block_scene(ratio, 1e9, 0.3);
+  scene.contact_formulation = corners ? ContactFormulation::corners : ContactFormulation::potential;
+  scene.quasi_static.local_damping = 0.8;
+  scene.time.safety = 0.7;
   return watch_hold(scene, Vec3(-0.5 * b, -0.5 * b, h));
 }
 
@@ -163,16 +169,8 @@ TEST_CASE("corner contact: the pairs the stage keeps apart are the pairs without
   // other to not and back.  At every step each candidate pair's contact, evaluated afresh at the
   // step's positions, must be what the stage found: a pair kept apart (corner_pair_apart_travel)
   // had none.
-  const double b = 0.1, h = 0.4;  // m
-  Scene scene = basic_scene(0.6);
-  scene.gravity = Vec3(2 * 9.81 * b / h, 0, -9.81);
+  Scene scene = tall_block_scene(2.0, 1e8, 0.6);
   scene.contact_formulation = ContactFormulation::corners;
-  scene.materials.push_back(elastic_material(2000, 1e8, 0.2));
-  scene.materials[0].contact.friction = 0.8;
-  scene.bodies.push_back(box_body("base", Vec3(-0.3, -0.3, -0.1), Vec3(0.3, 0.3, 0), 3, 3, 1));
-  scene.bodies[0].fixed = true;
-  scene.bodies.push_back(
-      box_body("block", Vec3(-0.5 * b, -0.5 * b, 0), Vec3(0.5 * b, 0.5 * b, h), 1, 1, 4));
   auto sim = quiet_simulation(scene);
   const Model& model = sim->model();
   const auto geometry = [&](const std::vector<double>& x, LocalIndex t) {
