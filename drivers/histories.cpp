@@ -1,5 +1,7 @@
 #include "drivers/histories.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <limits>
@@ -141,6 +143,9 @@ bool HistoryRecorder::settle() {
   if (!pending_) return false;
   row_ = reduce_row();
   settled_ = true;
+  const bool stops = std::any_of(monitors_.begin(), monitors_.end(),
+                                 [](const Monitor& m) { return m.spec.stop_displacement > 0.0; });
+  if (!stops) return false;  // (no reduction for it)
   // The first monitor (in the scene's order) at or beyond its stop: decided on rank 0, which
   // holds the whole row, and sent to every rank with its distance (m).
   double stop[2] = {-1.0, 0.0};  // monitor index, distance
@@ -149,13 +154,16 @@ bool HistoryRecorder::settle() {
     const double limit = monitors_[m].spec.stop_displacement;
     const double* u = row_.data() + first_monitor + monitor_sums * m;
     const double distance = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    if (limit > 0.0 && distance >= limit) stop[0] = static_cast<double>(m), stop[1] = distance;
+    if (limit > 0.0 && distance >= limit) {
+      stop[0] = static_cast<double>(m);
+      stop[1] = distance;
+    }
   }
   if (comm_) {
     std::vector<double> sent(stop, stop + 2);
     if (comm_->rank() != 0) sent = {-1.0, 0.0};
     comm_->max_in_place(sent);
-    stop[0] = sent[0], stop[1] = sent[1];
+    std::copy(sent.begin(), sent.end(), stop);
   }
   if (stop[0] < 0.0) return false;
   const MonitorSpec& m = monitors_[static_cast<std::size_t>(stop[0])].spec;
