@@ -246,6 +246,12 @@ struct HistoriesSpec {
   std::vector<int> loads;  // indices into Scene::loads (velocity and base-motion loads only)
   std::vector<int> bodies;
   std::vector<MonitorSpec> monitors;
+  // A monitor ends the run at its stop_displacement: rows are taken even without output files.
+  bool stops_runs() const {
+    for (const MonitorSpec& m : monitors)
+      if (m.stop_displacement > 0.0) return true;
+    return false;
+  }
 };
 
 struct OutputSpec {

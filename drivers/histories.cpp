@@ -36,6 +36,7 @@ void add_group(std::vector<ExactSum>::iterator at, const GroupSums& g) {
 HistoryRecorder::HistoryRecorder(const Scene& scene, const Model& model, const Communicator* comm)
     : comm_(comm && comm->size() > 1 ? comm : nullptr) {
   const HistoriesSpec& spec = scene.output.histories;
+  stops_runs_ = spec.stops_runs();
   // Default interval: the energy rows' (energy_every, else every); 0 there means every step.
   every_ = spec.every >= 0.0                 ? spec.every
            : scene.output.energy_every > 0.0 ? scene.output.energy_every
@@ -143,9 +144,7 @@ bool HistoryRecorder::settle() {
   if (!pending_) return false;
   row_ = reduce_row();
   settled_ = true;
-  const bool stops = std::any_of(monitors_.begin(), monitors_.end(),
-                                 [](const Monitor& m) { return m.spec.stop_displacement > 0.0; });
-  if (!stops) return false;  // (no reduction for it)
+  if (!stops_runs_) return false;  // (no reduction for it)
   // The first monitor (in the scene's order) at or beyond its stop: decided on rank 0, which
   // holds the whole row, and sent to every rank with its distance (m).
   double stop[2] = {-1.0, 0.0};  // monitor index, distance

@@ -69,6 +69,7 @@ class HistoryRecorder {
   bool settled_ = false;        // row_ holds the last row, not yet written
   std::vector<double> row_;     // added over the ranks (rank 0; partial on the others)
   std::string stop_reason_;     // of the first monitor that reached its stop_displacement
+  bool stops_runs_ = false;     // some monitor has a stop_displacement
   std::vector<ExactSum> sums_;  // of the pending row: 7 per load and body, 12 per monitor
   std::ofstream file_;          // rank 0
 };

@@ -61,13 +61,6 @@ DistributionSettings distribution_settings(const ParallelSpec& spec) {
   return settings;
 }
 
-// A monitor ends the run at its stop_displacement: its rows are taken even without output.
-bool stops_at_a_monitor(const Scene& scene) {
-  for (const MonitorSpec& m : scene.output.histories.monitors)
-    if (m.stop_displacement > 0.0) return true;
-  return false;
-}
-
 }  // namespace
 
 std::vector<std::string> StagePlan::describe() const {
@@ -228,7 +221,8 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   }
   // Monitors are found by tet gid (rank-independent), so before the restart and the whole-model
   // start's distribution.
-  if (scene_.output.histories.enabled && (options_.write_output || stops_at_a_monitor(scene_)))
+  if (scene_.output.histories.enabled &&
+      (options_.write_output || scene_.output.histories.stops_runs()))
     histories_ = std::make_unique<HistoryRecorder>(scene_, model_, comm_);
   // A restart overwrites the state of the model (and of the stages) with the checkpoint's.
   if (!options_.restart_path.empty()) {
