@@ -53,10 +53,13 @@ Distribution::Distribution(const Communicator& comm, DistributionSettings settin
   // up held with them).
   // Decided alike on every rank (a rank may start with no tet, and receive some later), and so
   // is the branch below: both paths are collective.
-  has_joint_state_ = comm_.max(std::int32_t{!start.tet_joint_state.empty()}) > 0;
-  has_contact_faces_ = comm_.max(std::int32_t{!start.model.tets.contact_faces.empty()}) > 0;
+  std::vector<std::int32_t> held = {!start.tet_joint_state.empty(),
+                                    !start.model.tets.contact_faces.empty(), !start.joints.empty()};
+  comm_.max_in_place(held);  // one reduction: any rank holds them
+  has_joint_state_ = held[0] > 0;
+  has_contact_faces_ = held[1] > 0;
   state.tet_joint_state = std::move(start.tet_joint_state);
-  if (!has_joint_state_ && comm_.max(std::int32_t{!start.joints.empty()}) == 0) {
+  if (!has_joint_state_ && held[2] == 0) {
     local = std::move(start.model);
     append_halo(local, state, &start.tet_reach);
     local_state = std::move(state);
