@@ -40,6 +40,33 @@ double TimeHistory::operator()(double t) const {
   return value;
 }
 
+double TimeHistory::last_change() const {
+  switch (kind) {
+    case Kind::constant:
+      return 0.0;
+    case Kind::table: {
+      std::size_t i = values.size() - 1;
+      while (i > 0 && values[i - 1] == values[i]) --i;
+      return i == 0 ? 0.0 : times[i];  // all rows equal: constant
+    }
+    case Kind::smooth_step:
+      return from == to ? 0.0 : end;
+  }
+  return 0.0;
+}
+
+double TimeHistory::final_value() const {
+  switch (kind) {
+    case Kind::constant:
+      return value;
+    case Kind::table:
+      return values.back();
+    case Kind::smooth_step:
+      return to;
+  }
+  return value;
+}
+
 std::string TimeHistory::describe() const {
   std::ostringstream out;
   out.precision(6);

@@ -28,6 +28,10 @@ struct TimeHistory {
   double operator()(double t) const;
   // Whether the value can change in time.
   bool varies() const { return kind != Kind::constant; }
+  // The time (s) from which the value stays constant (0 when it never changes; a table's last
+  // row whose value differs from the row before; a smooth step's end) and that value.
+  double last_change() const;
+  double final_value() const;
   // One line for `fdem check`: "constant 1", "table of 4 rows (0 s .. 0.002 s)", ...
   std::string describe() const;
 

@@ -45,6 +45,61 @@ double ramp_acceleration(const RampSpec& ramp, double t) {
   return std::clamp(ramp.rate * (t - ramp.start), 0.0, ramp.max);
 }
 
+LoadsSettle loads_settle(const Scene& scene) {
+  LoadsSettle out;
+  for (std::size_t i = 0; i < scene.loads.size(); ++i) {
+    const LoadSpec& load = scene.loads[i];
+    double until = 0.0;  // s: this load is constant from then on
+    bool moving = false;
+    switch (load.kind) {
+      case LoadSpec::Kind::velocity:
+        if (load.velocity.isZero(0.0)) break;  // a support
+        moving = load.history.final_value() != 0.0;
+        until = moving ? HUGE_VAL : load.history.last_change();
+        break;
+      case LoadSpec::Kind::base_motion: {  // after its record the ground moves uniformly
+        BaseMotionSpec record = load.base_motion;
+        if (record.time.empty()) read_acceleration_record(record.file, record);
+        until = record.time.empty() ? 0.0 : record.time.back();
+        break;
+      }
+      case LoadSpec::Kind::tilt:
+        if (load.tilt.rate > 0.0 && load.tilt.max > 0.0)
+          until = load.tilt.start + load.tilt.max / load.tilt.rate;
+        break;
+      case LoadSpec::Kind::ramp:
+        if (load.ramp.history)
+          until = load.ramp.history->last_change();
+        else if (load.ramp.rate > 0.0 && load.ramp.max > 0.0)
+          until = load.ramp.start + load.ramp.max / load.ramp.rate;
+        break;
+      case LoadSpec::Kind::surface:
+        until = load.history.last_change();
+        break;
+    }
+    if (until > out.time) out = {until, static_cast<int>(i), moving};
+  }
+  return out;
+}
+
+std::string describe_loads_settle(const Scene& scene, const LoadsSettle& settle) {
+  if (settle.load < 0) return "no load changes";
+  const LoadSpec& load = scene.loads[static_cast<std::size_t>(settle.load)];
+  static const char* const kinds[] = {"a prescribed velocity", "a base motion", "a tilt", "a ramp",
+                                      "a surface load"};
+  std::ostringstream out;
+  if (load.name.empty())
+    out << "loads[" << settle.load << "]";
+  else
+    out << "load '" << load.name << "'";
+  out << ", " << kinds[static_cast<int>(load.kind)] << ", ";
+  if (settle.moving)
+    out << "keeps its boundary moving to the end";
+  else
+    out << "changes until t = " << settle.time << " s";
+  return out.str();
+}
+
 Vec3 gravity_at(const Scene& scene, double t) {
   Vec3 g = scene.gravity;
   for (const LoadSpec& load : scene.loads)

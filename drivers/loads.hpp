@@ -31,6 +31,18 @@ Vec3 gravity_at(const Scene& scene, double t);
 double tilt_angle(const TiltSpec& tilt, double t);
 double ramp_acceleration(const RampSpec& ramp, double t);
 
+// When the loads stop changing: quasi_static.equilibrium_ratio ends a run only from then on (an
+// equilibrium reached before a tilt starts or while a ramp rises is not the answer asked for).
+struct LoadsSettle {
+  double time = 0.0;    // s: no load changes from this time on (infinity: one never stops)
+  int load = -1;        // scene index of the load that changes last (-1: none changes)
+  bool moving = false;  // that load prescribes a non-zero velocity to the end (a moving boundary)
+};
+// Reads the base-motion records that the scene names by file.
+LoadsSettle loads_settle(const Scene& scene);
+// "load 'table', a tilt, changes until t = 4.02 s" / "..., keeps its boundary moving to the end".
+std::string describe_loads_settle(const Scene& scene, const LoadsSettle& settle);
+
 class LoadSchedule {
  public:
   // Reads the records not given in code and lists the nodes each base motion moves.

@@ -1,4 +1,5 @@
 // The `fdem` command: run | check | --version (see docs/scene-format.md and README.md).
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -127,6 +128,27 @@ int check(const fdem::Scene& scene) {
     }
     what.pop_back();
     std::printf("  histories.csv:%s\n", what.c_str());
+  }
+  if (const fdem::QuasiStaticSpec& q = scene.quasi_static; q.local_damping > 0.0) {
+    if (q.until < scene.time.end)
+      std::printf("  quasi-static: local damping %g until %g s", q.local_damping, q.until);
+    else
+      std::printf("  quasi-static: local damping %g for the whole run", q.local_damping);
+    const fdem::LoadsSettle& settle = sim->loads_settle();
+    const std::string loads = fdem::describe_loads_settle(scene, settle);
+    if (!(q.equilibrium_ratio > 0.0))
+      std::printf("\n");
+    else if (settle.time <= 0.0)
+      std::printf("; equilibrium_ratio %g ends the run at equilibrium\n", q.equilibrium_ratio);
+    else if (settle.time < std::min(scene.time.end, q.until))
+      std::printf("; equilibrium_ratio %g ends the run at equilibrium from t = %g s on (%s)\n",
+                  q.equilibrium_ratio, settle.time, loads.c_str());
+    else
+      std::printf(
+          "\n  note: quasi_static.equilibrium_ratio cannot end this run: %s, and the run ends "
+          "at equilibrium only once every load is constant%s (a monitor's stop_displacement "
+          "can end it)\n",
+          loads.c_str(), q.until < scene.time.end ? ", while the damping acts" : "");
   }
   std::printf("  stages:\n");
   for (const auto& s : sim->plan().describe()) std::printf("    %s\n", s.c_str());

@@ -14,6 +14,7 @@
 #include "core/energy.hpp"
 #include "core/model.hpp"
 #include "core/scene.hpp"
+#include "drivers/loads.hpp"
 #include "drivers/run_report.hpp"
 #include "drivers/stage_timer.hpp"
 
@@ -78,6 +79,8 @@ class Simulation {
   // The last step's mean unbalanced-force ratio (quasi_static.equilibrium_ratio); NaN when the
   // step was not damped.
   double unbalanced_force_ratio() const { return force_ratio_; }
+  // When the loads stop changing: equilibrium_ratio ends the run only from then on.
+  const LoadsSettle& loads_settle() const { return loads_settle_; }
   Model& model() { return model_; }
   const Scene& scene() const { return scene_; }
   const StagePlan& plan() const { return plan_; }
@@ -163,6 +166,7 @@ class Simulation {
   double energy_input_ = 0.0;       // J, largest energy put in so far (see check_state)
   double kinetic_half_step_ = 0.0;  // J, ½m|v_n+½|² of the last step
   double force_ratio_ = 0.0;        // unbalanced-force ratio of the last step (NaN: undamped)
+  LoadsSettle loads_settle_;        // with equilibrium_ratio
   StageClock clocks_[n_stages];
   std::chrono::steady_clock::time_point wall_start_;
   double next_frame_time_ = 0.0, next_energy_time_ = 0.0;

@@ -1,5 +1,6 @@
 // core/time_history: tables against linear interpolation and their held ends, the smooth steps
-// against their closed forms, their end values and the continuity of their derivatives.
+// against their closed forms, their end values and the continuity of their derivatives, and when
+// each stops changing.
 #include <catch2/catch.hpp>
 #include <cmath>
 
@@ -69,4 +70,20 @@ TEST_CASE("time history: a cubic step starts and ends at rest, a quintic without
   CHECK(slope(Shape::cubic, 0.5 - h / 2) == Approx(1.5).epsilon(1e-6));
   CHECK(slope(Shape::quintic, 0.5 - h / 2) == Approx(1.875).epsilon(1e-6));
   CHECK(slope(Shape::sine, 0.5 - h / 2) == Approx(M_PI / 2).epsilon(1e-6));
+}
+
+TEST_CASE("time history: when it stops changing, and at what value", "[core][time_history]") {
+  const TimeHistory constant = TimeHistory::constant_value(2.0);
+  CHECK(constant.last_change() == 0.0);
+  CHECK(constant.final_value() == 2.0);
+  // A table's last change is the last row whose value differs from the row before.
+  const TimeHistory table = TimeHistory::table({0.0, 0.1, 0.3, 0.6}, {0.0, 1.0, 0.5, 0.5});
+  CHECK(table.last_change() == 0.3);
+  CHECK(table.final_value() == 0.5);
+  CHECK(table(0.3) == table(0.6));
+  CHECK(TimeHistory::table({0.2, 0.4}, {1.0, 1.0}).last_change() == 0.0);  // never changes
+  const TimeHistory step = TimeHistory::smooth_step(0.1, 0.4, 0.0, 3.0);
+  CHECK(step.last_change() == 0.4);
+  CHECK(step.final_value() == 3.0);
+  CHECK(TimeHistory::smooth_step(0.1, 0.4, 1.0, 1.0).last_change() == 0.0);
 }

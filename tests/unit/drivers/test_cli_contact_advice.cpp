@@ -1,5 +1,6 @@
 // The `fdem` command's advice about the contact formulation and the sliding of undamped bodies:
-// what `fdem check` prints for a scene, and what a numerical failure says.
+// what `fdem check` prints for a scene, and what a numerical failure says; and what it says of
+// a quasi-static run that equilibrium_ratio may end.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -9,6 +10,7 @@ using Catch::Matchers::Contains;
 using fdem_test::critical_step_from_check;
 using fdem_test::format_g;
 using fdem_test::Outcome;
+using fdem_test::read_text;
 using fdem_test::run_fdem;
 using fdem_test::TempDir;
 using fdem_test::write_text;
@@ -109,4 +111,34 @@ TEST_CASE("fdem check advises element damping for sliding bodies with friction",
                std::string(block_on_base) + "quasi_static: {local_damping: 0.8, until: 0.01}\n");
     CHECK_THAT(run_fdem(dir, "check settle.yaml").out, Contains(advice));
   }
+}
+
+TEST_CASE(
+    "fdem check says from when quasi_static.equilibrium_ratio can end a run, or that it cannot",
+    "[cli]") {
+  TempDir dir;
+  const std::string qs =
+      std::string(block_on_base) + "quasi_static: {local_damping: 0.8, equilibrium_ratio: 1e-4}\n";
+  write_text(dir / "qs.yaml", qs);
+  CHECK_THAT(run_fdem(dir, "check qs.yaml").out,
+             Contains("quasi-static: local damping 0.8 for the whole run; equilibrium_ratio 0.0001 "
+                      "ends the run at equilibrium\n"));
+  // A tilt of 2° at 100°/s from 0.01 s is all there at 0.03 s; 10° only at 0.11 s, after the end.
+  write_text(dir / "tilt.yaml",
+             qs + "loads:\n  - {tilt: {axis: [0, 1, 0], rate: 100, max: 2, start: "
+                  "0.01}}\n");
+  CHECK_THAT(run_fdem(dir, "check tilt.yaml").out,
+             Contains("equilibrium_ratio 0.0001 ends the run at equilibrium from t = 0.03 s on "
+                      "(loads[0], a tilt, changes until t = 0.03 s)"));
+  std::string late_tilt = read_text(dir / "tilt.yaml");
+  late_tilt.replace(late_tilt.find("max: 2,"), 7, "max: 10,");
+  write_text(dir / "late.yaml", late_tilt);
+  const Outcome late = run_fdem(dir, "check late.yaml");
+  CHECK(late.exit_code == 0);
+  CHECK_THAT(late.out, Contains("note: quasi_static.equilibrium_ratio cannot end this run: "
+                                "loads[0], a tilt, changes until t = 0.11 s"));
+  CHECK_THAT(run_fdem(dir, "check tilt.yaml --set quasi_static.until=0.02").out,
+             Contains("cannot end this run: loads[0], a tilt, changes until t = 0.03 s, and the "
+                      "run ends at equilibrium only once every load is constant, while the damping "
+                      "acts"));
 }

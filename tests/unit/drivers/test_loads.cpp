@@ -318,3 +318,104 @@ TEST_CASE("a prescribed velocity follows its time history, a later constant load
   }
   CHECK(top_nodes == 3);  // 2 × 2 corners of one cell, less the held one
 }
+
+TEST_CASE("loads_settle: when each kind of load stops changing", "[drivers][loads]") {
+  const auto settle_of = [](LoadSpec load) {
+    Scene s = block_scene(1.0);
+    load.name = "l";
+    s.loads = {load};
+    return loads_settle(s);
+  };
+  LoadSpec support;  // a prescribed velocity of zero: constant
+  CHECK(settle_of(support).load == -1);
+  CHECK(settle_of(support).time == 0.0);
+
+  LoadSpec push;  // a constant velocity: the boundary never stops
+  push.velocity = Vec3(0.01, 0, 0);
+  CHECK(settle_of(push).moving);
+  CHECK(settle_of(push).time == HUGE_VAL);
+  push.history = TimeHistory::smooth_step(0.1, 0.3, 1.0, 0.0);  // slows to a stop at 0.3 s
+  CHECK_FALSE(settle_of(push).moving);
+  CHECK(settle_of(push).time == 0.3);
+  push.history = TimeHistory::table({0.0, 0.2, 0.5, 0.9}, {0.0, 1.0, 0.0, 0.0});
+  CHECK(settle_of(push).time == 0.5);  // its last change of value, not its last row
+  push.history = TimeHistory::smooth_step(0.1, 0.3, 0.0, 1.0);  // then moves at 0.01 m/s
+  CHECK(settle_of(push).moving);
+
+  LoadSpec tilt;
+  tilt.kind = LoadSpec::Kind::tilt;
+  tilt.tilt.rate = 0.5;
+  tilt.tilt.max = 0.2;
+  tilt.tilt.start = 0.1;
+  CHECK(settle_of(tilt).time == Approx(0.5));
+  CHECK(describe_loads_settle(block_scene(1.0), LoadsSettle{}) == "no load changes");
+  Scene named = block_scene(1.0);
+  tilt.name = "table";
+  named.loads = {support, tilt};
+  const LoadsSettle t = loads_settle(named);
+  CHECK(t.load == 1);
+  CHECK(describe_loads_settle(named, t) == "load 'table', a tilt, changes until t = 0.5 s");
+
+  LoadSpec ramp;
+  ramp.kind = LoadSpec::Kind::ramp;
+  ramp.ramp.rate = 10.0;
+  ramp.ramp.max = 2.0;
+  ramp.ramp.start = 0.05;
+  CHECK(settle_of(ramp).time == Approx(0.25));
+  ramp.ramp.history = TimeHistory::table({0.0, 0.4}, {0.0, 3.0});
+  CHECK(settle_of(ramp).time == 0.4);
+
+  LoadSpec surface;
+  surface.kind = LoadSpec::Kind::surface;
+  CHECK(settle_of(surface).time == 0.0);
+  surface.history = TimeHistory::smooth_step(0.0, 0.7, 0.0, 1.0);
+  CHECK(settle_of(surface).time == 0.7);
+
+  LoadSpec base;  // the ground moves uniformly after its record
+  base.kind = LoadSpec::Kind::base_motion;
+  base.base_motion.time = {0.0, 0.1, 0.6};
+  base.base_motion.acceleration = {0.0, 1.0, 0.0};
+  CHECK(settle_of(base).time == 0.6);
+  CHECK_FALSE(settle_of(base).moving);
+}
+
+TEST_CASE(
+    "quasi_static.equilibrium_ratio ends a run only once its loads are constant: not before a "
+    "ramp starts, not while it rises",
+    "[drivers][loads][quasi_static]") {
+  // The block held at its bottom face settles under local damping; a horizontal acceleration
+  // ramp from 0.05 s to 0.07 s (2 m/s² at 100 m/s³) then loads it sideways.
+  const auto run = [](bool with_ramp) {
+    Scene s = block_scene(0.3);
+    s.gravity = Vec3(0, 0, -9.81);
+    s.quasi_static.local_damping = 0.8;
+    s.quasi_static.equilibrium_ratio = 1e-3;
+    LoadSpec bottom;
+    bottom.region = RegionSpec{Vec3(-1, -1, -1), Vec3(1, 1, 0.01)};
+    s.loads = {bottom};
+    if (with_ramp) {
+      LoadSpec ramp;
+      ramp.kind = LoadSpec::Kind::ramp;
+      ramp.ramp.rate = 100.0;
+      ramp.ramp.max = 2.0;
+      ramp.ramp.start = 0.05;
+      s.loads.push_back(ramp);
+    }
+    auto sim = quiet(s);
+    const RunReport report = sim->run();
+    return std::make_tuple(report, sim->time(), sim->unbalanced_force_ratio(),
+                           sim->loads_settle().time);
+  };
+  const auto [alone, alone_time, alone_ratio, alone_settle] = run(false);
+  INFO("without the ramp: " << alone.reason);
+  CHECK_THAT(alone.reason, Contains("equilibrium at step"));
+  CHECK(alone_settle == 0.0);
+  CHECK(alone_time < 0.05);  // settled before the ramp would start
+  const auto [ramped, ramped_time, ramped_ratio, ramped_settle] = run(true);
+  INFO("with the ramp: " << ramped.reason);
+  CHECK(ramped_settle == Approx(0.07));
+  CHECK_THAT(ramped.reason, Contains("equilibrium at step"));
+  CHECK(ramped_time >= 0.07);  // it was below the ratio before, but the load was not all there
+  CHECK(ramped_time < 0.3);
+  CHECK(ramped_ratio < 1e-3);
+}
