@@ -130,6 +130,13 @@ void add_surface_forces(const SurfaceLoadSpec& spec, double factor, SurfaceFaces
   }
 }
 
+double surface_force_magnitude(const SurfaceFaces& faces) {
+  double sum = 0.0;
+  for (LocalIndex i = 0; i < faces.size(); ++i)
+    if (faces.owned[i]) sum += 3.0 * vec3_at(faces.corner_force.data(), i).norm();
+  return sum;
+}
+
 double surface_power(const SurfaceFaces& faces, const NodeArrays& nodes) {
   double power = 0.0;
   for (LocalIndex i = 0; i < faces.size(); ++i) {

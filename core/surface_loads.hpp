@@ -49,6 +49,10 @@ SurfaceFaces select_surface_faces(const Model& model, const LoadSpec& load);
 void add_surface_forces(const SurfaceLoadSpec& spec, double factor, SurfaceFaces& faces,
                         NodeArrays& nodes);
 
+// Σ |corner force| over the corners of the faces owned here (N): the loads' size, for the
+// unbalanced-force ratio of quasi-static runs.
+double surface_force_magnitude(const SurfaceFaces& faces);
+
 // Σ corner force · v over the corners at owned nodes (W), with the nodes' current velocities.
 double surface_power(const SurfaceFaces& faces, const NodeArrays& nodes);
 

@@ -202,6 +202,12 @@ double LoadSchedule::surface_power(const Model& model) const {
   return power;
 }
 
+double LoadSchedule::surface_force_magnitude() const {
+  double sum = 0.0;
+  for (const Surface& surface : surfaces_) sum += fdem::surface_force_magnitude(surface.faces);
+  return sum;
+}
+
 std::vector<std::pair<int, std::int64_t>> LoadSchedule::surface_face_counts() const {
   std::vector<std::pair<int, std::int64_t>> counts;
   for (const Surface& surface : surfaces_) {

@@ -63,6 +63,7 @@ class LoadSchedule {
   // work: before the integration with v(t − dt/2), after it with v(t + dt/2).
   void add_surface_forces(double t, Model& model);
   double surface_power(const Model& model) const;
+  double surface_force_magnitude() const;  // N, Σ over the owned faces' corners
   // Per surface load (scene order): its index in the scene's loads and the number of faces
   // whose tet is owned here (to refuse a load that acts on no face).
   std::vector<std::pair<int, std::int64_t>> surface_face_counts() const;

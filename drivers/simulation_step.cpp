@@ -192,6 +192,8 @@ void Simulation::add_external_forces(StepRecord& r) {
   if (plan_.surface_loads) {  // pressure and traction on boundary faces, at t_n
     loads_->add_surface_forces(time_, model_);
     r.surface_power_before = loads_->surface_power(model_);
+    if (scene_.quasi_static.active_at(time_))  // for the unbalanced-force ratio
+      r.surface_force = loads_->surface_force_magnitude();
   }
 }
 
@@ -277,9 +279,11 @@ void Simulation::sum_over_ranks(StepRecord& r) {
   bodies_cracking_ = r.flags.bodies_cracked > 0.0;
   // A signal on any rank ends the run after this step on every rank.
   if (r.flags.interrupted > 0.0) interrupt_ = interrupt_signal() != 0 ? interrupt_signal() : -1;
-  // Quasi-static runs: the mean unbalanced force over the applied ones (weight and supports), the
-  // equilibrium test of quasi_static.equilibrium_ratio (FLAC's and 3DEC's "ratio", averaged).
-  const double applied = r.motion.mass * model_.gravity.norm() + r.motion.support_force;
+  // Quasi-static runs: the mean unbalanced force over the applied ones (weight, supports and
+  // surface loads), the equilibrium test of quasi_static.equilibrium_ratio (FLAC's and 3DEC's
+  // "ratio", averaged).
+  const double applied =
+      r.motion.mass * model_.gravity.norm() + r.motion.support_force + r.surface_force;
   force_ratio_ = r.motion.mass > 0.0 && applied > 0.0 ? r.motion.unbalanced_force / applied
                                                       : std::numeric_limits<double>::quiet_NaN();
 }

@@ -33,12 +33,13 @@ struct StepRecord {
   IntegrationSummary motion;
   double boundary_before = 0.0, boundary_after = 0.0;  // J, absorbing dashpots' dissipation
   double surface_power_before = 0.0;                   // W, surface loads with v(t_n − dt/2)
-  CriticalStep deformed;  // stable step of the deformed mesh, when the guard checked it
+  double surface_force = 0.0;  // N, Σ|F| of the surface loads' corner forces (quasi-static runs)
+  CriticalStep deformed;       // stable step of the deformed mesh, when the guard checked it
   StepFlags flags;
 };
 
 // Every value of a StepRecord that the step sums over the ranks, each listed once.
-inline std::array<double*, 36> summed_values(StepRecord& r) {
+inline std::array<double*, 37> summed_values(StepRecord& r) {
   double* p_before = r.motion.momentum_before.data();
   double* p_after = r.motion.momentum_after.data();
   StepFlags& f = r.flags;
@@ -61,6 +62,7 @@ inline std::array<double*, 36> summed_values(StepRecord& r) {
           &r.motion.local_damping_work_after,
           &r.motion.unbalanced_force,
           &r.motion.support_force,
+          &r.surface_force,
           &r.motion.mass,
           p_before,
           p_before + 1,
