@@ -190,6 +190,16 @@ void read_loads(const Reader& r, const YAML::Node& loads, const std::string& sce
                    ": {...}}");
       scene.loads.push_back(tilt ? read_tilt(r, l["tilt"], lp + ".tilt")
                                  : read_ramp(r, l["ramp"], lp + ".ramp", scene_dir));
+      if (tilt) {  // a tilt that turns nothing is a mistake, not a load
+        const Vec3& g = scene.gravity;
+        if (!(g.norm() > 0.0))
+          r.fail(l["tilt"], lp + ".tilt",
+                 "a tilt turns the gravity, and the scene's gravity is zero: give gravity");
+        if (scene.loads.back().tilt.axis.cross(g).norm() <= 1e-9 * g.norm())
+          r.fail(l["tilt"]["axis"], lp + ".tilt.axis",
+                 "along the gravity: turning the gravity about it changes nothing; give a "
+                 "horizontal axis (e.g. [0, 1, 0] turns gravity [0, 0, -g] towards -x)");
+      }
       continue;
     }
     if (const YAML::Node bm = l["base_motion"]) {

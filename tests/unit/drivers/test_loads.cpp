@@ -230,6 +230,18 @@ TEST_CASE("scene reader: base_motion, tilt and ramp loads and their messages", "
              Contains("loads[0].velocity") && Contains("base_motion, tilt or ramp"));
   CHECK_THAT(error("  - {tilt: {axis: [0, 1, 0], rate: -5, max: 30}}\n"),
              Contains("loads[0].tilt.rate") && Contains("must be > 0"));
+  // A tilt about the gravity's own direction, or of no gravity, would turn nothing.
+  CHECK_THAT(
+      error("  - {tilt: {axis: [0, 0, 2], rate: 5, max: 30}}\n"),
+      Contains("scene.yaml:8:") && Contains("loads[0].tilt.axis") && Contains("along the gravity"));
+  std::string weightless = head;
+  weightless.replace(weightless.find("[0, 0, -9.81]"), 13, "[0, 0, 0]");
+  try {
+    parse_scene(weightless + "  - {tilt: {axis: [0, 1, 0], rate: 5, max: 30}}\n", "scene.yaml");
+    FAIL("a tilt of no gravity was accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(std::string(e.what()), Contains("loads[0].tilt") && Contains("gravity is zero"));
+  }
 }
 
 TEST_CASE(
