@@ -10,7 +10,8 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-// Two bodies, a named region load, an unnamed body load and a tilt; `output` is appended.
+// Two bodies, a named region load, an unnamed body load and a tilt (of gravity, line 3);
+// `output` is appended.
 //  1 time: {end: 0.1}
 //  ...
 // 11 loads:
@@ -21,8 +22,8 @@ namespace {
 // 16   histories: ...
 std::string scene_with(const std::string& output) {
   return "time: {end: 0.1}\n"
-         "materials:\n"
-         "  rock: {density: 2500, elastic: {young: 1.0e9, poisson: 0.25}}\n"
+         "materials: {rock: {density: 2500, elastic: {young: 1.0e9, poisson: 0.25}}}\n"
+         "gravity: [0, 0, -9.81]\n"
          "bodies:\n"
          "  - name: block\n"
          "    mesh: {box: {min: [0, 0, 0], max: [1, 1, 1]}}\n"
