@@ -6,6 +6,7 @@ issue 12's start and now (docs/benchmarks.md, "Each pair timed in the running st
       [--workdir /tmp/fdem_pair_timing] [--cases tower,dry_wall,pile,wall55,arch]
       [--repeats 1] [--cpu 0] [--without-friction-and-dashpot]
       [--csv docs/data/contact_pair_timing.csv]
+      [--histograms docs/data/contact_pair_timing_histograms.csv]
 
 Each commit is checked out as a git worktree under --workdir, its contact/contact_stage.cpp
 patched with start.patch or now.patch (they time every candidate pair from the top of the stage's
@@ -23,6 +24,9 @@ reads, ~50 ns on this machine) is measured at start and subtracted from every pa
 With --without-friction-and-dashpot every material's contact friction and damping are set to 0
 (the trajectories then differ from the default runs): the difference of the means is what
 friction and the dashpot cost per pair.
+
+--histograms gets the last repeat's cost histograms of the overlapping pairs (80 bins per decade
+from 1 ns), which plot.py draws (docs/contact_pair_costs.png).
 
 Cases: the scenes of benchmarks/contact_slivers/run.py that the start's binary can read (its
 reader has no quasi_static key): tower (default example, 0.1 s: the impact at 14 ms), dry_wall
@@ -126,11 +130,16 @@ def main():
     p.add_argument("--repeats", type=int, default=1)
     p.add_argument("--cpu", type=int, default=0)
     p.add_argument("--without-friction-and-dashpot", action="store_true")
+    p.add_argument("--histograms",
+                   default=os.path.join(root, "docs", "data", "contact_pair_timing_histograms.csv"))
     p.add_argument("--csv", default=os.path.join(root, "docs", "data", "contact_pair_timing.csv"))
     a = p.parse_args()
     os.makedirs(a.workdir, exist_ok=True)
     binaries = [("start", build(a.start, "start.patch", a.workdir, "start")),
                 ("now", build(a.now, "now.patch", a.workdir, "now"))]
+    histograms = open(a.histograms, "w", newline="")
+    hw = csv.writer(histograms)
+    hw.writerow(["case", "code", "repeat", "class", "bin", "pairs"])
     new_file = not os.path.exists(a.csv)
     out = open(a.csv, "a", newline="")
     w = csv.writer(out)
@@ -162,6 +171,11 @@ def main():
                                 f"{stage:.4f}", c, count, f"{mean:.2f}"] + [f"{x:.1f}" for x in qs])
                     key = (code, c)
                     means[key] = min(means.get(key, 1e30), mean)
+                if rep == a.repeats - 1:
+                    for c in ("carries_load", "overlapping_unloaded"):
+                        for low, _, n in classes.get(c, [0, 0, []])[2]:
+                            hw.writerow([case, code, rep + 1, c,
+                                         round(80 * math.log10(low)), f"{n:.0f}"])
                 # Every overlapping pair, loaded or not: the pairs the start's stage integrated.
                 both = [classes[c] for c in ("carries_load", "overlapping_unloaded") if c in classes]
                 count = sum(e[0] for e in both)
@@ -180,7 +194,8 @@ def main():
                 print(f"  {case}: {c}: {means[('start', c)]:.0f} -> {means[('now', c)]:.0f} ns, "
                       f"{means[('start', c)] / means[('now', c)]:.2f}x (best mean of the repeats)")
         out.flush()
-    print(f"appended to {a.csv}")
+        histograms.flush()
+    print(f"appended to {a.csv}; histograms in {a.histograms}")
 
 
 if __name__ == "__main__":
