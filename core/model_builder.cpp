@@ -338,6 +338,12 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes, Eleme
   return model;
 }
 
+std::int64_t owned_nodes_in_region(const RegionSpec& region, const NodeArrays& nodes) {
+  std::int64_t count = 0;
+  for (LocalIndex n = 0; n < nodes.n_owned; ++n) count += in_region(region, nodes.x0(n)) ? 1 : 0;
+  return count;
+}
+
 void apply_constraints(const Scene& scene, Model& model) {
   NodeArrays& nodes = model.nodes;
   FDEM_VERIFY(nodes.has_prescribed_velocity || !scene.prescribes_velocities(),
@@ -360,9 +366,7 @@ void apply_constraints(const Scene& scene, Model& model) {
     for (LocalIndex n = 0; n < nodes.size(); ++n) {
       bool applies = false;
       if (load.region) {
-        const Vec3 X = nodes.x0(n);
-        applies = (X.array() >= load.region->min.array()).all() &&
-                  (X.array() <= load.region->max.array()).all();
+        applies = in_region(*load.region, nodes.x0(n));
       } else {
         const std::int32_t body = model.pieces.body_of(nodes.piece[n]);
         applies = std::find(load.bodies.begin(), load.bodies.end(), body) != load.bodies.end();

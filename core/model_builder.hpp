@@ -94,4 +94,11 @@ Model build_model(const Scene& scene, const std::vector<BodyMesh>& meshes,
 
 // Applies fixed bodies and kinematic loads to the nodes' constraint masks.
 void apply_constraints(const Scene& scene, Model& model);
+
+// Whether a reference position lies in a load's region (its box, faces included).
+inline bool in_region(const RegionSpec& region, const Vec3& X) {
+  return (X.array() >= region.min.array()).all() && (X.array() <= region.max.array()).all();
+}
+// The owned nodes whose reference position lies in the region.
+std::int64_t owned_nodes_in_region(const RegionSpec& region, const NodeArrays& nodes);
 }  // namespace fdem

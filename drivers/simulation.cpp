@@ -103,18 +103,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
   plan_.kinematic_loads = scene_.prescribes_velocities();
   plan_.surface_loads = loads_->has_surface_loads();
-  // A surface load that acts on no face is a mistake in the scene (a region beside the model).
-  for (const auto& [index, owned] : loads_->surface_face_counts())
-    if (global_sum(owned) == 0) {
-      const LoadSpec& load = scene_.loads[static_cast<std::size_t>(index)];
-      throw InputError((load.where.empty()
-                            ? scene_.source_path + ": loads[" + std::to_string(index) + "]"
-                            : load.where) +
-                       ": surface load '" + load.name + "' acts on no face: no boundary face " +
-                       (load.region ? "has its three corners in the region's box at t = 0"
-                                    : "belongs to its bodies") +
-                       " (faces shared by two tets or by a joint are not boundary faces)");
-    }
+  check_load_targets(distributed);
 
   // On N ranks from the distributed start a rank may hold no tet (more ranks than tets at the
   // start, or a body's tets all elsewhere): every rank runs the contact stages when any needs them.

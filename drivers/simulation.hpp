@@ -112,6 +112,7 @@ class Simulation {
   void check_run_limits() const;
   // Every `absorbing:` entry must select a boundary face somewhere in the model (InputError).
   void check_absorbing_faces(bool distributed) const;
+  void check_load_targets(bool distributed) const;
   // Sets initial_residual_: |forces at t = 0| / |initial stress's forces| over free components.
   void check_initial_equilibrium(bool distributed);
   std::vector<double> initial_stress_;  // S0, 6 per local tet (Pa)

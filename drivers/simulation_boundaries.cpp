@@ -1,5 +1,6 @@
-// The Simulation's checks of boundaries and initial state at start-up: every absorbing entry
-// selects faces, and the equilibrium residual of the initial stress at t = 0.
+// The Simulation's checks of boundaries, loads and initial state at start-up: every absorbing
+// entry selects faces, every surface and region velocity load acts on something, and the
+// equilibrium residual of the initial stress at t = 0.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -7,6 +8,7 @@
 #include "core/dynamics.hpp"
 #include "core/error.hpp"
 #include "core/initial_stress.hpp"
+#include "core/model_builder.hpp"
 #include "drivers/simulation.hpp"
 #include "parallel/communicator.hpp"
 
@@ -27,6 +29,39 @@ void Simulation::check_initial_equilibrium(bool distributed) {
   std::vector<double> sums = {e.residual, e.scale};
   if (distributed) comm_->sum_in_place(sums);
   initial_residual_ = sums[1] > 0.0 ? std::sqrt(sums[0] / sums[1]) : 0.0;
+}
+
+// A load that acts on nothing is a mistake in the scene (a region beside the model): a surface
+// load without a boundary face, a prescribed velocity on a region without a node.
+void Simulation::check_load_targets(bool distributed) const {
+  const auto global_sum = [&](std::int64_t v) { return distributed ? comm_->sum(v) : v; };
+  for (const auto& [index, owned] : loads_->surface_face_counts())
+    if (global_sum(owned) == 0) {
+      const LoadSpec& load = scene_.loads[static_cast<std::size_t>(index)];
+      throw InputError((load.where.empty()
+                            ? scene_.source_path + ": loads[" + std::to_string(index) + "]"
+                            : load.where) +
+                       ": surface load '" + load.name + "' acts on no face: no boundary face " +
+                       (load.region ? "has its three corners in the region's box at t = 0"
+                                    : "belongs to its bodies") +
+                       " (faces shared by two tets or by a joint are not boundary faces)");
+    }
+  for (std::size_t i = 0; i < scene_.loads.size(); ++i) {
+    const LoadSpec& load = scene_.loads[i];
+    if (load.kind != LoadSpec::Kind::velocity || !load.region) continue;
+    if (global_sum(owned_nodes_in_region(*load.region, model_.nodes)) > 0) continue;
+    std::ostringstream box;
+    const auto point = [&](const Vec3& p) {
+      box << "[" << p[0] << ", " << p[1] << ", " << p[2] << "]";
+    };
+    point(load.region->min);
+    box << " .. ";
+    point(load.region->max);
+    throw InputError((load.where.empty() ? scene_.source_path + ": loads[" + std::to_string(i) + "]"
+                                         : load.where) +
+                     ": velocity load " + (load.name.empty() ? "" : "'" + load.name + "' ") +
+                     "holds no node: no node lies in its region's box " + box.str() + " at t = 0");
+  }
 }
 
 void Simulation::check_absorbing_faces(bool distributed) const {

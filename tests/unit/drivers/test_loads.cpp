@@ -431,3 +431,24 @@ TEST_CASE(
   CHECK(ramped_time < 0.3);
   CHECK(ramped_ratio < 1e-3);
 }
+
+TEST_CASE("a velocity load on a region that holds no node is refused, naming its key's line",
+          "[drivers][loads]") {
+  // A region beside the model held nothing and the run went on without its boundary condition.
+  const std::string scene_text =
+      "time: {end: 0.01}\n"
+      "materials:\n"
+      "  rock: {density: 2500, elastic: {young: 1.0e9, poisson: 0.25}}\n"
+      "bodies:\n"
+      "  - {name: block, mesh: {box: {min: [0, 0, 0], max: [1, 1, 1]}}, material: rock}\n"
+      "loads:\n"
+      "  - {region: {box: {min: [0, 0, 0.99], max: [1, 1, 2]}}, velocity: [0, 0, -0.1]}\n"
+      "  - {name: beside, region: {box: {min: [5, 5, 5], max: [6, 6, 6]}}, velocity: [0, 0, 1]}\n";
+  const Scene scene = parse_scene(scene_text, "scene.yaml");
+  CHECK_THROWS_WITH(quiet(scene), Contains("scene.yaml:8:") && Contains("loads[1].region") &&
+                                      Contains("velocity load 'beside' holds no node") &&
+                                      Contains("[5, 5, 5] .. [6, 6, 6] at t = 0"));
+  Scene held = scene;  // the top face's region alone holds its four nodes
+  held.loads.pop_back();
+  CHECK_NOTHROW(quiet(held));
+}
