@@ -381,6 +381,11 @@ Scene parse_scene(const std::string& yaml_text, const std::string& path,
     if (b["velocity"]) body.velocity = r.vec3(b["velocity"], bp + ".velocity");
     if (b["angular_velocity"])
       body.angular_velocity = r.vec3(b["angular_velocity"], bp + ".angular_velocity");
+    for (const char* key : {"velocity", "angular_velocity"})  // it would be dropped silently
+      if (body.fixed && b[key])
+        r.fail(b[key], bp + "." + key,
+               "a fixed body does not move: remove it, or move the body with a base_motion or a "
+               "velocity load");
     body_names.push_back(body.name);
     scene.bodies.push_back(body);
   }

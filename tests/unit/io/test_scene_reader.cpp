@@ -228,6 +228,14 @@ TEST_CASE("wrong value types name the key and what was expected", "[io]") {
     CHECK_THAT(msg, StartsWith("scene.yaml:10:12: bodies[0].fixed: expected true or false, got "
                                "'sometimes'"));
   }
+  SECTION("a velocity of a fixed body (it would be dropped)") {
+    const std::string msg =
+        input_error(minimal_plus("    fixed: true\n    angular_velocity: [0, 0, 1]\n"));
+    CHECK_THAT(msg, StartsWith("scene.yaml:11:23: bodies[0].angular_velocity: a fixed body does "
+                               "not move"));
+    CHECK_THAT(input_error(minimal_plus("    fixed: true\n    velocity: [1, 0, 0]\n")),
+               StartsWith("scene.yaml:11:15: bodies[0].velocity: a fixed body does not move"));
+  }
 }
 
 TEST_CASE("missing required keys name the parent's line and the missing key", "[io]") {
