@@ -77,6 +77,12 @@ int check(const fdem::Scene& scene) {
       "  time: end %g s, step %g s (%s; critical %g s), %ld steps (limit %g)\n", scene.time.end,
       sim->time_step(), scene.time.auto_step ? "auto" : "fixed", sim->critical_time_step(),
       fdem::checked_step_count(0.0, scene.time.end, sim->time_step()), scene.limits.max_steps);
+  if (sim->time_step() > sim->critical_time_step())  // the run would stop at its blow-up
+    std::printf(
+        "  advice: time.step is %.3g x the critical step %g s: above the stability limit, the run "
+        "will become unstable; use time.step: auto or a step below %g s\n",
+        sim->time_step() / sim->critical_time_step(), sim->critical_time_step(),
+        sim->critical_time_step());
   std::string ceiling_source;
   const double ceiling = fdem::memory_ceiling_per_rank(scene.limits, 1, &ceiling_source);
   std::printf(

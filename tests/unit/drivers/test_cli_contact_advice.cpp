@@ -1,6 +1,6 @@
-// The `fdem` command's advice about the contact formulation and the sliding of undamped bodies:
-// what `fdem check` prints for a scene, and what a numerical failure says; and what it says of
-// a quasi-static run that equilibrium_ratio may end.
+// The `fdem` command's advice about the contact formulation, the sliding of undamped bodies and a
+// fixed step above the critical one: what `fdem check` prints for a scene, and what a numerical
+// failure says; and what it says of a quasi-static run that equilibrium_ratio may end.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -141,4 +141,19 @@ TEST_CASE(
              Contains("cannot end this run: loads[0], a tilt, changes until t = 0.03 s, and the "
                       "run ends at equilibrium only once every load is constant, while the damping "
                       "acts"));
+}
+
+TEST_CASE("fdem check advises against a fixed step above the critical one", "[cli]") {
+  TempDir dir;
+  write_text(dir / "scene.yaml", block_on_base);
+  const Outcome automatic = run_fdem(dir, "check scene.yaml");
+  const double critical = critical_step_from_check(automatic.out);
+  REQUIRE(critical > 0.0);
+  CHECK_THAT(automatic.out, !Contains("advice: time.step"));
+  const Outcome above = run_fdem(dir, "check scene.yaml --set time.step=" + format_g(2 * critical));
+  CHECK(above.exit_code == 0);
+  CHECK_THAT(above.out, Contains("advice: time.step is 2 x the critical step") &&
+                            Contains("use time.step: auto or a step below"));
+  CHECK_THAT(run_fdem(dir, "check scene.yaml --set time.step=" + format_g(0.5 * critical)).out,
+             !Contains("advice: time.step"));
 }
