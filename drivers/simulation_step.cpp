@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "contact/contact_stage.hpp"
@@ -344,6 +345,14 @@ void Simulation::check_step(const StepRecord& r) {
   if (r.flags.tunnelling > 0.0) domain_->run_collectively([&] { check_tunnelling(r.motion); });
   if (r.flags.step_too_large > 0.0)
     domain_->run_collectively([&] { check_stable_step(r.deformed); });
+  // Bodies placed into each other: the penalty pushes them apart at once and their contact energy
+  // becomes motion.  Touching bodies have none at t = 0 (round-off: below 1e-12 of Σ E·V).
+  if (time_ == 0.0 && r.contact.energy > 1e3 * energy_floor_ && is_root())
+    std::fprintf(stderr,
+                 "fdem: warning: bodies overlap at t = 0: their contact energy is %.3g J (%.2g of "
+                 "the tets' sum of E x V): the penalty pushes them apart at once and that energy "
+                 "becomes motion; place the bodies apart or exactly touching\n",
+                 r.contact.energy, 1e-12 * r.contact.energy / energy_floor_);
 }
 
 // The stage state that moves with the local entries when the model is (re)distributed.

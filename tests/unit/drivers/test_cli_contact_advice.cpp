@@ -1,6 +1,7 @@
 // The `fdem` command's advice about the contact formulation, the sliding of undamped bodies and a
 // fixed step above the critical one: what `fdem check` prints for a scene, and what a numerical
-// failure says; and what it says of a quasi-static run that equilibrium_ratio may end.
+// failure says; what it says of a quasi-static run that equilibrium_ratio may end; and the
+// warning of `fdem run` about bodies overlapping at t = 0.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -156,4 +157,21 @@ TEST_CASE("fdem check advises against a fixed step above the critical one", "[cl
                             Contains("use time.step: auto or a step below"));
   CHECK_THAT(run_fdem(dir, "check scene.yaml --set time.step=" + format_g(0.5 * critical)).out,
              !Contains("advice: time.step"));
+}
+
+TEST_CASE("fdem run warns when bodies overlap at t = 0, not when they touch", "[cli]") {
+  // The block sunk 5 cm into the base is thrown off it by the penalty; resting on it, nothing.
+  TempDir dir;
+  std::string sunk = block_on_base;
+  sunk.replace(sunk.find("min: [-0.2, -0.2, 0]"), 20, "min: [-0.2, -0.2, -0.05]");
+  write_text(dir / "sunk.yaml", sunk);
+  write_text(dir / "resting.yaml", block_on_base);
+  const Outcome thrown = run_fdem(dir, "run sunk.yaml -o out1 --set time.end=1e-3");
+  CHECK(thrown.exit_code == 0);
+  CHECK_THAT(thrown.err,
+             Contains("fdem: warning: bodies overlap at t = 0: their contact energy is") &&
+                 Contains("place the bodies apart or exactly touching"));
+  const Outcome resting = run_fdem(dir, "run resting.yaml -o out2 --set time.end=1e-3");
+  CHECK(resting.exit_code == 0);
+  CHECK_THAT(resting.err, !Contains("warning: bodies overlap"));
 }
