@@ -99,6 +99,18 @@ int check(const fdem::Scene& scene) {
                 scene.contact_formulation != fdem::ContactFormulation::automatic ? ""
                 : corners ? " (auto: quasi-static throughout, no joints)"
                           : " (auto: potential unless quasi-static throughout without joints)");
+    // A penalty far below E: contacts much softer than the bodies (a block on a base at 1e-4 E
+    // falls through it).
+    for (std::size_t m = 0; m < model.materials.size(); ++m) {
+      const double penalty = contact->material_penalty()[m], young = model.materials[m].young;
+      if (penalty < 0.01 * young)
+        std::printf(
+            "  advice: material '%s' has a contact penalty of %.2g x its E (%g Pa against %g Pa): "
+            "its contacts are far softer than its bodies, which sink into each other under load, "
+            "or through each other where the contact cannot hold the load; the default (auto) is "
+            "10 E\n",
+            model.materials[m].name.c_str(), penalty / young, penalty, young);
+    }
   }
   // Local damping for the whole run damps every vibration, the friction-induced one too.
   if (sim->contact_stage() && !scene.quasi_static.active_until(scene.time.end)) {

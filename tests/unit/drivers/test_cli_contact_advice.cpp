@@ -1,7 +1,7 @@
 // The `fdem` command's advice about the contact formulation, the sliding of undamped bodies and a
-// fixed step above the critical one: what `fdem check` prints for a scene, and what a numerical
-// failure says; what it says of a quasi-static run that equilibrium_ratio may end; and the
-// warning of `fdem run` about bodies overlapping at t = 0.
+// fixed step above the critical one or a contact penalty far below E: what `fdem check` prints for
+// a scene, and what a numerical failure says; what it says of a quasi-static run that
+// equilibrium_ratio may end; and the warning of `fdem run` about bodies overlapping at t = 0.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -174,4 +174,17 @@ TEST_CASE("fdem run warns when bodies overlap at t = 0, not when they touch", "[
   const Outcome resting = run_fdem(dir, "run resting.yaml -o out2 --set time.end=1e-3");
   CHECK(resting.exit_code == 0);
   CHECK_THAT(resting.err, !Contains("warning: bodies overlap"));
+}
+
+TEST_CASE("fdem check advises against a contact penalty far below E", "[cli]") {
+  // E = 1 MPa: a penalty of 100 Pa (1e-4 E) lets the block sink through its base.
+  TempDir dir;
+  write_text(dir / "scene.yaml", block_on_base);
+  const std::string advice = "advice: material 'soft' has a contact penalty of";
+  CHECK_THAT(run_fdem(dir, "check scene.yaml").out, !Contains(advice));
+  CHECK_THAT(run_fdem(dir, "check scene.yaml --set materials.soft.contact.penalty=100").out,
+             Contains(advice + std::string(" 0.0001 x its E (100 Pa against 1e+06 Pa)")) &&
+                 Contains("the default (auto) is 10 E"));
+  CHECK_THAT(run_fdem(dir, "check scene.yaml --set materials.soft.contact.penalty=1e5").out,
+             !Contains(advice));
 }
