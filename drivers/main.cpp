@@ -54,6 +54,33 @@ std::vector<std::string> sliding_advice(const fdem::Scene& scene) {
   return lines;
 }
 
+// Materials whose bodies may touch (one of them free) and of which only one has friction: their
+// contact takes the smaller coefficient, so it has none (a block with friction on a base without
+// slides freely).
+std::vector<std::string> friction_mix_advice(const fdem::Scene& scene) {
+  const std::size_t n = scene.materials.size();
+  std::vector<bool> used(n, false), free(n, false);
+  for (const auto& b : scene.bodies) {
+    used[static_cast<std::size_t>(b.material)] = true;
+    if (!b.fixed) free[static_cast<std::size_t>(b.material)] = true;
+  }
+  std::vector<std::string> lines;
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b) {
+      const double mu_a = scene.materials[a].contact.friction;
+      const double mu_b = scene.materials[b].contact.friction;
+      if (!used[a] || !used[b] || !(free[a] || free[b]) || !(mu_a > 0.0) || mu_b > 0.0) continue;
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "contact between materials '%s' (friction %g) and '%s' (none) is frictionless: "
+                    "a pair takes the smaller coefficient; give '%s' a friction too",
+                    scene.materials[a].name.c_str(), mu_a, scene.materials[b].name.c_str(),
+                    scene.materials[b].name.c_str());
+      lines.emplace_back(line);
+    }
+  return lines;
+}
+
 int check(const fdem::Scene& scene) {
   auto sim = fdem::make_simulation(scene, {});
   const fdem::Model& model = sim->model();
@@ -99,6 +126,8 @@ int check(const fdem::Scene& scene) {
                 scene.contact_formulation != fdem::ContactFormulation::automatic ? ""
                 : corners ? " (auto: quasi-static throughout, no joints)"
                           : " (auto: potential unless quasi-static throughout without joints)");
+    for (const std::string& line : friction_mix_advice(scene))
+      std::printf("  advice: %s\n", line.c_str());
     // A penalty far below E: contacts much softer than the bodies (a block on a base at 1e-4 E
     // falls through it).
     for (std::size_t m = 0; m < model.materials.size(); ++m) {

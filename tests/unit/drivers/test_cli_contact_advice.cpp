@@ -1,7 +1,8 @@
-// The `fdem` command's advice about the contact formulation, the sliding of undamped bodies and a
-// fixed step above the critical one or a contact penalty far below E: what `fdem check` prints for
-// a scene, and what a numerical failure says; what it says of a quasi-static run that
-// equilibrium_ratio may end; and the warning of `fdem run` about bodies overlapping at t = 0.
+// The `fdem` command's advice about the contact formulation, the sliding of undamped bodies, a
+// fixed step above the critical one, a contact penalty far below E and friction on only one of two
+// touching materials: what `fdem check` prints for a scene, and what a numerical failure says;
+// what it says of a quasi-static run that equilibrium_ratio may end; and the warning of `fdem run`
+// about bodies overlapping at t = 0.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -187,4 +188,24 @@ TEST_CASE("fdem check advises against a contact penalty far below E", "[cli]") {
                  Contains("the default (auto) is 10 E"));
   CHECK_THAT(run_fdem(dir, "check scene.yaml --set materials.soft.contact.penalty=1e5").out,
              !Contains(advice));
+}
+
+TEST_CASE("fdem check says when only one of two touching materials has friction", "[cli]") {
+  // The block's material has friction, the base's none: their contact takes the smaller, 0.
+  TempDir dir;
+  std::string mixed = block_on_base;
+  mixed.replace(mixed.find("materials:\n"), 11,
+                "materials:\n  bare:\n    density: 1000\n    elastic: {young: 1.0e6, poisson: "
+                "0.25}\n");
+  mixed.replace(mixed.find("material: soft\n    fixed: true"), 14, "material: bare");
+  write_text(dir / "mixed.yaml", mixed);
+  write_text(dir / "scene.yaml", block_on_base);
+  const std::string advice =
+      "advice: contact between materials 'soft' (friction 0.5) and 'bare' (none) is frictionless: "
+      "a pair takes the smaller coefficient; give 'bare' a friction too";
+  const Outcome o = run_fdem(dir, "check mixed.yaml");
+  INFO(o.out << o.err);
+  CHECK(o.exit_code == 0);
+  CHECK_THAT(o.out, Contains(advice));
+  CHECK_THAT(run_fdem(dir, "check scene.yaml").out, !Contains("is frictionless"));
 }
