@@ -45,10 +45,14 @@ double ramp_acceleration(const RampSpec& ramp, double t) {
   return std::clamp(ramp.rate * (t - ramp.start), 0.0, ramp.max);
 }
 
-LoadsSettle loads_settle(const Scene& scene) {
+LoadsSettle later(const LoadsSettle& a, const LoadsSettle& b) {
+  return b.time > a.time ? b : a;
+}
+
+LoadsSettle loads_settle(const std::vector<LoadSpec>& loads) {
   LoadsSettle out;
-  for (std::size_t i = 0; i < scene.loads.size(); ++i) {
-    const LoadSpec& load = scene.loads[i];
+  for (std::size_t i = 0; i < loads.size(); ++i) {
+    const LoadSpec& load = loads[i];
     double until = 0.0;  // s: this load is constant from then on
     bool moving = false;
     switch (load.kind) {
@@ -57,12 +61,9 @@ LoadsSettle loads_settle(const Scene& scene) {
         moving = load.history.final_value() != 0.0;
         until = moving ? HUGE_VAL : load.history.last_change();
         break;
-      case LoadSpec::Kind::base_motion: {  // after its record the ground moves uniformly
-        BaseMotionSpec record = load.base_motion;
-        if (record.time.empty()) read_acceleration_record(record.file, record);
-        until = record.time.empty() ? 0.0 : record.time.back();
+      case LoadSpec::Kind::base_motion:  // after its record the ground moves uniformly
+        until = load.base_motion.time.empty() ? 0.0 : load.base_motion.time.back();
         break;
-      }
       case LoadSpec::Kind::tilt:
         if (load.tilt.rate > 0.0 && load.tilt.max > 0.0)
           until = load.tilt.start + load.tilt.max / load.tilt.rate;
@@ -77,7 +78,7 @@ LoadsSettle loads_settle(const Scene& scene) {
         until = load.history.last_change();
         break;
     }
-    if (until > out.time) out = {until, static_cast<int>(i), moving};
+    out = later(out, {until, static_cast<int>(i), moving});
   }
   return out;
 }
@@ -123,6 +124,8 @@ LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
       if (base.motion.time.size() != base.motion.acceleration.size() || base.motion.time.size() < 2)
         throw InputError(scene.source_path +
                          ": a base motion needs at least two samples of time and acceleration");
+      settle_ = later(
+          settle_, {base.motion.time.back(), static_cast<int>(&load - scene.loads.data()), false});
       bases_.push_back(std::move(base));
     } else if (load.kind == LoadSpec::Kind::surface) {
       surfaces_.push_back({load, static_cast<int>(&load - scene.loads.data()), {}});
@@ -131,6 +134,7 @@ LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
     }
   }
   all_loads_ = scene.loads;
+  settle_ = later(settle_, loads_settle(scene.loads));
   rebind(model);
 }
 

@@ -38,8 +38,11 @@ struct LoadsSettle {
   int load = -1;        // scene index of the load that changes last (-1: none changes)
   bool moving = false;  // that load prescribes a non-zero velocity to the end (a moving boundary)
 };
-// Reads the base-motion records that the scene names by file.
-LoadsSettle loads_settle(const Scene& scene);
+// A base motion counts by its record given in code (LoadSchedule::settle has the ones read from
+// files too).
+LoadsSettle loads_settle(const std::vector<LoadSpec>& loads);
+// The one of the two that settles later.
+LoadsSettle later(const LoadsSettle& a, const LoadsSettle& b);
 // "load 'table', a tilt, changes until t = 4.02 s" / "..., keeps its boundary moving to the end".
 std::string describe_loads_settle(const Scene& scene, const LoadsSettle& settle);
 
@@ -64,6 +67,8 @@ class LoadSchedule {
   void add_surface_forces(double t, Model& model);
   double surface_power(const Model& model) const;
   double surface_force_magnitude() const;  // N, Σ over the owned faces' corners
+  // When the loads stop changing (base motions by their records, read once here).
+  const LoadsSettle& settle() const { return settle_; }
   // Per surface load (scene order): its index in the scene's loads and the number of faces
   // whose tet is owned here (to refuse a load that acts on no face).
   std::vector<std::pair<int, std::int64_t>> surface_face_counts() const;
@@ -96,6 +101,7 @@ class LoadSchedule {
   };
   std::vector<Surface> surfaces_;
   std::vector<LoadSpec> all_loads_;
+  LoadsSettle settle_;
   bool changes_gravity_ = false;
 };
 

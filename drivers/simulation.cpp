@@ -99,7 +99,6 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
   const auto global_min = [&](double v) { return distributed ? comm_->min(v) : v; };
   const auto global_sum = [&](auto v) { return distributed ? comm_->sum(v) : v; };
   loads_ = std::make_unique<LoadSchedule>(scene_, model_);
-  if (scene_.quasi_static.equilibrium_ratio > 0.0) loads_settle_ = fdem::loads_settle(scene_);
   plan_.gravity = scene_.gravity.squaredNorm() > 0.0 || loads_->changes_gravity();
   plan_.kinematic_loads = scene_.prescribes_velocities();
   plan_.surface_loads = loads_->has_surface_loads();
@@ -440,7 +439,7 @@ RunReport Simulation::run() {
     while (steps_ < total_steps && interrupt_ == 0 && !equilibrium && !stopped) {
       step();
       // NaN (undamped): no; and not while a load still changes
-      equilibrium = ratio > 0.0 && time_ >= loads_settle_.time && force_ratio_ < ratio;
+      equilibrium = ratio > 0.0 && time_ >= loads_->settle().time && force_ratio_ < ratio;
       stopped = histories_ && histories_->settle();  // a monitor's stop_displacement
       const bool last = steps_ == total_steps || equilibrium || stopped;
       write_outputs(last);

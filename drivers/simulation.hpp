@@ -80,7 +80,7 @@ class Simulation {
   // step was not damped.
   double unbalanced_force_ratio() const { return force_ratio_; }
   // When the loads stop changing: equilibrium_ratio ends the run only from then on.
-  const LoadsSettle& loads_settle() const { return loads_settle_; }
+  const LoadsSettle& loads_settle() const { return loads_->settle(); }
   Model& model() { return model_; }
   const Scene& scene() const { return scene_; }
   const StagePlan& plan() const { return plan_; }
@@ -167,7 +167,6 @@ class Simulation {
   double energy_input_ = 0.0;       // J, largest energy put in so far (see check_state)
   double kinetic_half_step_ = 0.0;  // J, ½m|v_n+½|² of the last step
   double force_ratio_ = 0.0;        // unbalanced-force ratio of the last step (NaN: undamped)
-  LoadsSettle loads_settle_;        // with equilibrium_ratio
   StageClock clocks_[n_stages];
   std::chrono::steady_clock::time_point wall_start_;
   double next_frame_time_ = 0.0, next_energy_time_ = 0.0;

@@ -35,13 +35,15 @@ void Simulation::check_initial_equilibrium(bool distributed) {
 // load without a boundary face, a prescribed velocity on a region without a node.
 void Simulation::check_load_targets(bool distributed) const {
   const auto global_sum = [&](std::int64_t v) { return distributed ? comm_->sum(v) : v; };
+  const auto where = [&](const LoadSpec& load, std::size_t i) {  // "FILE:LINE:COLUMN: loads[i]…"
+    return load.where.empty() ? scene_.source_path + ": loads[" + std::to_string(i) + "]"
+                              : load.where;
+  };
   for (const auto& [index, owned] : loads_->surface_face_counts())
     if (global_sum(owned) == 0) {
       const LoadSpec& load = scene_.loads[static_cast<std::size_t>(index)];
-      throw InputError((load.where.empty()
-                            ? scene_.source_path + ": loads[" + std::to_string(index) + "]"
-                            : load.where) +
-                       ": surface load '" + load.name + "' acts on no face: no boundary face " +
+      throw InputError(where(load, static_cast<std::size_t>(index)) + ": surface load '" +
+                       load.name + "' acts on no face: no boundary face " +
                        (load.region ? "has its three corners in the region's box at t = 0"
                                     : "belongs to its bodies") +
                        " (faces shared by two tets or by a joint are not boundary faces)");
@@ -57,9 +59,8 @@ void Simulation::check_load_targets(bool distributed) const {
     point(load.region->min);
     box << " .. ";
     point(load.region->max);
-    throw InputError((load.where.empty() ? scene_.source_path + ": loads[" + std::to_string(i) + "]"
-                                         : load.where) +
-                     ": velocity load " + (load.name.empty() ? "" : "'" + load.name + "' ") +
+    throw InputError(where(load, i) + ": velocity load " +
+                     (load.name.empty() ? "" : "'" + load.name + "' ") +
                      "holds no node: no node lies in its region's box " + box.str() + " at t = 0");
   }
 }

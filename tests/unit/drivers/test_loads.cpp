@@ -336,7 +336,7 @@ TEST_CASE("loads_settle: when each kind of load stops changing", "[drivers][load
     Scene s = block_scene(1.0);
     load.name = "l";
     s.loads = {load};
-    return loads_settle(s);
+    return loads_settle(s.loads);
   };
   LoadSpec support;  // a prescribed velocity of zero: constant
   CHECK(settle_of(support).load == -1);
@@ -364,7 +364,7 @@ TEST_CASE("loads_settle: when each kind of load stops changing", "[drivers][load
   Scene named = block_scene(1.0);
   tilt.name = "table";
   named.loads = {support, tilt};
-  const LoadsSettle t = loads_settle(named);
+  const LoadsSettle t = loads_settle(named.loads);
   CHECK(t.load == 1);
   CHECK(describe_loads_settle(named, t) == "load 'table', a tilt, changes until t = 0.5 s");
 
@@ -389,6 +389,16 @@ TEST_CASE("loads_settle: when each kind of load stops changing", "[drivers][load
   base.base_motion.acceleration = {0.0, 1.0, 0.0};
   CHECK(settle_of(base).time == 0.6);
   CHECK_FALSE(settle_of(base).moving);
+  // A record named by file: the schedule reads it once and counts it too.
+  Scene from_file = block_scene(1.0);
+  base.bodies = {0};
+  base.base_motion.time.clear();
+  base.base_motion.acceleration.clear();
+  base.base_motion.file = temp_file("settle.csv", "0,0\n0.2,1\n0.7,0\n");
+  from_file.loads = {base};
+  auto sim = quiet(from_file);
+  CHECK(sim->loads_settle().time == 0.7);
+  CHECK(sim->loads_settle().load == 0);
 }
 
 TEST_CASE(
