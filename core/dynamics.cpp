@@ -249,7 +249,8 @@ struct IntegrationSums {
 // `constrained` are known per call.
 template <bool damped, bool constrained>
 inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, std::uint8_t mask,
-                           double local_damping, IntegrationSums& sum, IntegrationSummary& out) {
+                           const StepDamping& damping, IntegrationSums& sum,
+                           IntegrationSummary& out) {
   const double m = nodes.mass[n];
   double dx2 = 0.0;
   for (int k = 0; k < 3; ++k) {
@@ -263,10 +264,20 @@ inline void integrate_node(double dt, NodeArrays& nodes, LocalIndex n, std::uint
       else
         out.unbalanced_force += std::abs(nodes.f[i]);
     }
-    if (damped && !prescribed && v_old != 0.0) {
-      // The damping force opposes v⁻; v⁻ = 0 (a node at rest) gets none.
-      const double f_damping = -local_damping * std::abs(nodes.f[i]) * (v_old > 0 ? 1.0 : -1.0);
-      v_new += dt * f_damping / m;
+    if (damped && !prescribed && (v_old != 0.0 || damping.stop_motion)) {
+      // The local damping force opposes v⁻; v⁻ = 0 (a node at rest) gets none.
+      double f_damping = 0.0;  // N
+      if (v_old != 0.0) {
+        f_damping = -damping.local * std::abs(nodes.f[i]) * (v_old > 0 ? 1.0 : -1.0);
+        v_new += dt * f_damping / m;
+      }
+      // Kinetic damping: the force that stops it within the step takes ½m·v⁻·v⁺ from the energy
+      // central difference conserves; a component whose velocity turns in this step would gain
+      // (near the stability limit), so it goes on: it is at its own turning point.
+      if (damping.stop_motion && v_old * v_new >= 0.0) {
+        f_damping -= m * v_new / dt;
+        v_new = 0.0;
+      }
       sum.damping_power_old += f_damping * v_old;
       sum.damping_power_new += f_damping * v_new;
     }
@@ -326,7 +337,7 @@ inline void integrate_four_free_nodes(double dt, NodeArrays& nodes, LocalIndex n
 }
 
 template <bool damped>
-void integrate_nodes(double dt, NodeArrays& nodes, double local_damping, IntegrationSums& sum,
+void integrate_nodes(double dt, NodeArrays& nodes, const StepDamping& damping, IntegrationSums& sum,
                      IntegrationSummary& out) {
   LocalIndex n = 0;
   if (!damped)  // runs of four free nodes, the common case, four at a time
@@ -338,16 +349,16 @@ void integrate_nodes(double dt, NodeArrays& nodes, double local_damping, Integra
       }
       for (LocalIndex one = n; one < n + 4; ++one)
         if (mask[one - n])
-          integrate_node<false, true>(dt, nodes, one, mask[one - n], local_damping, sum, out);
+          integrate_node<false, true>(dt, nodes, one, mask[one - n], damping, sum, out);
         else
-          integrate_node<false, false>(dt, nodes, one, 0, local_damping, sum, out);
+          integrate_node<false, false>(dt, nodes, one, 0, damping, sum, out);
     }
   for (; n < nodes.n_owned; ++n) {
     const std::uint8_t mask = nodes.constrained[n];
     if (mask)
-      integrate_node<damped, true>(dt, nodes, n, mask, local_damping, sum, out);
+      integrate_node<damped, true>(dt, nodes, n, mask, damping, sum, out);
     else
-      integrate_node<damped, false>(dt, nodes, n, mask, local_damping, sum, out);
+      integrate_node<damped, false>(dt, nodes, n, mask, damping, sum, out);
   }
 }
 
@@ -358,17 +369,17 @@ __attribute__((target_clones("avx2", "default"), flatten))
 #endif
 void integrate_undamped_nodes(double dt, NodeArrays& nodes, IntegrationSums& sum,
                               IntegrationSummary& out) {
-  integrate_nodes<false>(dt, nodes, 0.0, sum, out);
+  integrate_nodes<false>(dt, nodes, StepDamping{}, sum, out);
 }
 
 }  // namespace
 
 IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
-                                                double local_damping) {
+                                                const StepDamping& damping) {
   IntegrationSummary out;
   IntegrationSums sum;
-  if (local_damping > 0.0)
-    integrate_nodes<true>(dt, nodes, local_damping, sum, out);
+  if (damping.quasi_static)
+    integrate_nodes<true>(dt, nodes, damping, sum, out);
   else
     integrate_undamped_nodes(dt, nodes, sum, out);
   // The four-node vectors' sums, lane by lane in a fixed order.
@@ -380,8 +391,8 @@ IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
       out.momentum_before[k] += sum.momentum_before_lanes[j][l];
       out.momentum_after[k] += sum.momentum_after_lanes[j][l];
     }
-  out.local_damping_work_before = 0.5 * dt * sum.damping_power_old;
-  out.local_damping_work_after = 0.5 * dt * sum.damping_power_new;
+  out.damping_work_before = 0.5 * dt * sum.damping_power_old;
+  out.damping_work_after = 0.5 * dt * sum.damping_power_new;
   out.kinetic_energy = 0.5 * sum.kinetic2;
   out.kinetic_energy_half_step = 0.5 * sum.kinetic_half2;
   out.max_displacement_increment = std::sqrt(sum.max_dx2);

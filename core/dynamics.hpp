@@ -49,13 +49,13 @@ void add_gravity(const Vec3& gravity, NodeArrays& nodes);
 struct IntegrationSummary {
   double kinetic_energy = 0.0;  // J, ½m·v⁻·v⁺ (the energy central difference conserves)
   double constraint_work_before = 0.0;  // J, reactions at prescribed components · (x_n − x_n−1)/2
-  double constraint_work_after = 0.0;      // J, reactions · (x_n+1 − x_n)/2
-  double kinetic_energy_half_step = 0.0;   // J, ½m|v_n+½|² (grows in an unstable run)
-  Vec3 momentum_before = Vec3::Zero();     // Σ m·v_n−½ (kg m/s), for the work of uniform loads
-  Vec3 momentum_after = Vec3::Zero();      // Σ m·v_n+½
-  double local_damping_work_before = 0.0;  // J, local damping forces · (x_n − x_n−1)/2 (≤ 0)
-  double local_damping_work_after = 0.0;   // J, local damping forces · (x_n+1 − x_n)/2
-  // With local damping only (the quasi-static mode's equilibrium test), over the owned nodes: the
+  double constraint_work_after = 0.0;     // J, reactions · (x_n+1 − x_n)/2
+  double kinetic_energy_half_step = 0.0;  // J, ½m|v_n+½|² (grows in an unstable run)
+  Vec3 momentum_before = Vec3::Zero();    // Σ m·v_n−½ (kg m/s), for the work of uniform loads
+  Vec3 momentum_after = Vec3::Zero();     // Σ m·v_n+½
+  double damping_work_before = 0.0;  // J, quasi-static damping forces · (x_n − x_n−1)/2 (≤ 0)
+  double damping_work_after = 0.0;   // J, quasi-static damping forces · (x_n+1 − x_n)/2
+  // In quasi-static steps only (the mode's equilibrium test), over the owned nodes: the
   // unbalanced force Σ|f_k| over free components, the supports' Σ|f_k| over prescribed ones (N),
   // and the mass (kg).
   double unbalanced_force = 0.0, support_force = 0.0, mass = 0.0;
@@ -67,13 +67,33 @@ struct IntegrationSummary {
   bool finite = true;               // false if any velocity became NaN or infinite
 };
 
+// The quasi-static mode's part in one step (core/scene.hpp, QuasiStaticSpec); {} is a dynamic
+// step.
+struct StepDamping {
+  bool quasi_static = false;  // sum the unbalanced and support forces (the equilibrium test)
+  double local = 0.0;         // α of local damping; 0: none
+  bool stop_motion = false;   // kinetic damping: every free component ends the step at rest
+};
+
 // Central difference: v⁺ = v⁻ + dt·f/m (prescribed components set), x += dt·v⁺, on owned nodes.
-// With local_damping α > 0 (Cundall's non-viscous damping, quasi-static runs) every free component
+// With local damping α > 0 (Cundall's non-viscous damping, quasi-static runs) every free component
 // is driven by f − α·|f|·sign(v⁻) instead of f: the unbalanced force is reduced by the fraction α
 // while a node moves with it and enlarged while it moves against it, whatever the mass or
-// frequency.  Its work is returned for the energy balance.
+// frequency.  With stop_motion every free component whose velocity keeps its sign gets the force
+// −m·v⁺/dt more, which leaves it at rest (v⁺ = 0, x_n+1 = x_n) and takes ½m·v⁻·v⁺ ≥ 0 from the
+// energy central difference conserves; one whose velocity turns is left as it is (stopping it
+// would add energy).  The damping's work is returned for the energy balance.
 IntegrationSummary integrate_central_difference(double dt, NodeArrays& nodes,
-                                                double local_damping = 0.0);
+                                                const StepDamping& damping = {});
+
+// Kinetic damping's decision for the next step from the kinetic energy ½m|v|² (J) of the last two
+// half steps: the energy fell, so it peaked in the last step, and the next step stops every free
+// node about there (where the bodies are near their least potential energy along the motion).
+// After a stop the energy restarts from 0, so never two stops running; a motion that keeps
+// speeding up (a mechanism) is never stopped.
+inline bool kinetic_energy_peaked(double before, double last, bool stopped_last) {
+  return !stopped_last && last < before;
+}
 
 // Mass-weighted position, velocity and rotation of every piece of a model held whole by one
 // process, indexed by piece id (exact sums: core/piece_moments; on N ranks

@@ -297,15 +297,24 @@ struct ParallelSpec {
 
 // Quasi-static mode: Cundall's local non-viscous damping on every free node component (the
 // dynamics are then not physical: only the equilibria and the collapse thresholds are).
+// quasi_static.damping: how the quasi-static mode takes the motion out.  local: Cundall's local
+// damping α·|f| on every free component (3DEC, FLAC); kinetic: every free velocity set to 0 each
+// time the kinetic energy passes a peak (kinetic damping, dynamic relaxation), with no force
+// taken from a motion that keeps speeding up (a mechanism that forms).
+enum class QuasiStaticDamping { local, kinetic };
+
 struct QuasiStaticSpec {
+  QuasiStaticDamping damping = QuasiStaticDamping::local;
   double local_damping = 0.0;  // α in [0, 1): the unbalanced force is damped by α·|f|; 0: off
   double until = HUGE_VAL;     // s: dynamic (undamped) from this time on, e.g. after settling
   // > 0: the run ends at the first step (while damped) whose mean unbalanced force is below this
   // fraction of the weight and support forces: Σ|f| over free components / (Σm·|g| + Σ|f| over
   // prescribed ones).  0: runs to time.end.
   double equilibrium_ratio = 0.0;
-  bool active_at(double t) const { return local_damping > 0.0 && t < until; }
-  bool active_until(double end) const { return local_damping > 0.0 && until >= end; }  // whole run
+  bool kinetic() const { return damping == QuasiStaticDamping::kinetic; }
+  bool enabled() const { return kinetic() || local_damping > 0.0; }
+  bool active_at(double t) const { return enabled() && t < until; }
+  bool active_until(double end) const { return enabled() && until >= end; }  // whole run
 };
 
 // Ceilings between a valid scene and a runnable one (drivers/run_limits): checked by `fdem check`

@@ -176,11 +176,19 @@ int check(const fdem::Scene& scene) {
     what.pop_back();
     std::printf("  histories.csv:%s\n", what.c_str());
   }
-  if (const fdem::QuasiStaticSpec& q = scene.quasi_static; q.local_damping > 0.0) {
-    if (q.until < scene.time.end)
-      std::printf("  quasi-static: local damping %g until %g s", q.local_damping, q.until);
+  if (const fdem::QuasiStaticSpec& q = scene.quasi_static; q.enabled()) {
+    char damping[64];
+    if (q.kinetic() && q.local_damping > 0.0)
+      std::snprintf(damping, sizeof damping, "kinetic damping and local damping %g",
+                    q.local_damping);
+    else if (q.kinetic())
+      std::snprintf(damping, sizeof damping, "kinetic damping");
     else
-      std::printf("  quasi-static: local damping %g for the whole run", q.local_damping);
+      std::snprintf(damping, sizeof damping, "local damping %g", q.local_damping);
+    if (q.until < scene.time.end)
+      std::printf("  quasi-static: %s until %g s", damping, q.until);
+    else
+      std::printf("  quasi-static: %s for the whole run", damping);
     const fdem::LoadsSettle& settle = sim->loads_settle();
     const std::string loads = fdem::describe_loads_settle(scene, settle);
     if (!(q.equilibrium_ratio > 0.0))

@@ -244,6 +244,8 @@ std::string summary_json(const RunReport& r, const Model& model, const std::stri
     j << "  \"initial_stress\": {\"equilibrium_residual\": "
       << JsonNumber{r.initial_equilibrium_residual} << "},\n";
   if (r.fragments >= 0) j << "  \"fragments\": " << r.fragments << ",\n";
+  if (r.kinetic_damping_stops >= 0)
+    j << "  \"quasi_static\": {\"kinetic_damping_stops\": " << r.kinetic_damping_stops << "},\n";
   j << "  \"gids\": {\"offset\": " << r.gid_offset << ", \"node_max\": " << r.node_gid_max
     << ", \"tet_max\": " << r.tet_gid_max << ", \"joint_max\": " << r.joint_gid_max << "},\n";
   const MigrationReport& m = r.migration;

@@ -38,6 +38,7 @@ struct RunReport {
   long nodes = 0, elements = 0, pieces = 0, joints = 0, broken_joints = 0;
   long broken_by_mode[3] = {0, 0, 0};  // tension, shear, mixed
   long fragments = -1;                 // discrete elements now (−1: not counted)
+  long kinetic_damping_stops = -1;     // steps that stopped every free node (−1: not kinetic)
   // Model::gid_offset and the largest node, tet and joint gid held (−1: none): what the run's
   // gids were (a run with parallel.gid_offset shows them above it).
   std::int64_t gid_offset = 0, node_gid_max = -1, tet_gid_max = -1, joint_gid_max = -1;

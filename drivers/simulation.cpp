@@ -126,7 +126,7 @@ Simulation::Simulation(Scene scene, Model model, RunOptions options, const Commu
                              scene_.contact_sliver_tolerance,
                              scene_.contact_clip_replay,
                              uses_corner_contact(scene_)};
-    if (settings.corners && scene_.quasi_static.local_damping > 0.0)
+    if (settings.corners && scene_.quasi_static.enabled())
       settings.least_damping_ratio = kCornerDampingRatio;
     contact_ = std::make_unique<ContactStage>(model_, settings);
     // Elastic and contact stiffness add, so do their ω² = (2/Δt)².

@@ -166,6 +166,8 @@ class Simulation {
   double energy_floor_ = 0.0;       // J, see the constructor
   double energy_input_ = 0.0;       // J, largest energy put in so far (see check_state)
   double kinetic_half_step_ = 0.0;  // J, ½m|v_n+½|² of the last step
+  bool stop_motion_ = false;        // kinetic damping: the next step stops every free node
+  long kinetic_damping_stops_ = 0;  // steps that did
   double force_ratio_ = 0.0;        // unbalanced-force ratio of the last step (NaN: undamped)
   StageClock clocks_[n_stages];
   std::chrono::steady_clock::time_point wall_start_;

@@ -54,6 +54,8 @@ void Simulation::write_checkpoint() {
                                            : state_hash(model_.nodes, model_.gid_offset);
   header.integers = {{"steps", steps_},
                      {"contact_detected", contact_ && contact_->detected() ? 1 : 0},
+                     {"kinetic_damping_stop", stop_motion_ ? 1 : 0},
+                     {"kinetic_damping_stops", kinetic_damping_stops_},
                      {"contact_detections", contact_ ? contact_->detections() : 0},
                      {"state_hash", static_cast<std::int64_t>(hash)},
                      {"gid_offset", model_.gid_offset}};  // for the record: rows are gid − it
@@ -170,6 +172,11 @@ void Simulation::restore_checkpoint(const std::string& path) {
   dt_critical_ = number("critical_time_step");
   energy_input_ = number("energy_input");
   kinetic_half_step_ = number("kinetic_half_step");
+  // Checkpoints from before kinetic damping have no stop pending.
+  const auto stop = integers.find("kinetic_damping_stop");
+  stop_motion_ = stop != integers.end() && stop->second != 0;
+  const auto stops = integers.find("kinetic_damping_stops");
+  kinetic_damping_stops_ = stops != integers.end() ? stops->second : 0;
   next_frame_time_ = number("next_frame_time");
   next_energy_time_ = number("next_energy_time");
   next_checkpoint_time_ = number("next_checkpoint_time");

@@ -26,6 +26,7 @@ RunReport Simulation::report() const {
   r.balance_error = ledger_.balance_error();
   for (const auto& c : clocks_) r.stages.push_back(c);
   r.pieces = static_cast<long>(model_.pieces.size());
+  if (scene_.quasi_static.kinetic()) r.kinetic_damping_stops = kinetic_damping_stops_;
   // Counts of what this rank owns (joints: by their tet A), summed over the ranks below.
   std::vector<std::int64_t> counts = {model_.nodes.n_owned, 0, 0, 0, 0, 0, 0};
   for (LocalIndex t = 0; t < model_.tets.size(); ++t) counts[1] += model_.tets.is_owned(t);

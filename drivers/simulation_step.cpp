@@ -209,9 +209,11 @@ void Simulation::integrate(StepRecord& r) {
   Timed timed(clocks_[integration]);
   // The stored velocity is v(t − dt/2): at the start turn the initial v(0) into it (half kick).
   if (steps_ == 0) start_half_step(nodes);
-  const double local_damping =
-      scene_.quasi_static.active_at(time_) ? scene_.quasi_static.local_damping : 0.0;
-  r.motion = integrate_central_difference(dt_, nodes, local_damping);
+  StepDamping damping;
+  if (const QuasiStaticSpec& q = scene_.quasi_static; q.active_at(time_))
+    damping = {true, q.local_damping, q.kinetic() && stop_motion_};
+  r.motion = integrate_central_difference(dt_, nodes, damping);
+  kinetic_damping_stops_ += damping.stop_motion ? 1 : 0;
   if (absorbing_) r.boundary_after = absorbing_->dissipation_after(dt_, model_);
   moved_since_halo_ = true;
   // The surface loads' work goes with the reactions' (external_work), by the same trapezoid.
@@ -276,6 +278,9 @@ void Simulation::sum_over_ranks(StepRecord& r) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.motion.finite = r.flags.nonfinite_velocity == 0.0;
   detection_due_ = r.flags.detection_due > 0.0 ? 1 : 0;
+  // Kinetic damping: from the summed energy, so the same on every rank.
+  stop_motion_ =
+      kinetic_energy_peaked(kinetic_half_step_, r.motion.kinetic_energy_half_step, stop_motion_);
   breaks_pending_ = r.flags.broken_joints > 0.0;
   bodies_cracking_ = r.flags.bodies_cracked > 0.0;
   // A signal on any rank ends the run after this step on every rank.
@@ -315,10 +320,10 @@ void Simulation::book_energy(const StepRecord& r) {
     energy.gravity = -ledger_.gravity.add(0.5 * dt_ * model_.gravity.dot(r.motion.momentum_before),
                                           0.5 * dt_ * model_.gravity.dot(r.motion.momentum_after));
   const double viscous_step = r.forces.damping_power * dt_;  // element damping, J
-  // Element and contact dashpots, and the local damping of a quasi-static run (its work is ≤ 0).
+  // Element and contact dashpots, and the quasi-static damping, local and kinetic (its work ≤ 0).
   energy.dissipated_damping = ledger_.damping.add(
-      0.5 * viscous_step + r.contact.work_before.damping - r.motion.local_damping_work_before,
-      0.5 * viscous_step + r.contact_after.damping - r.motion.local_damping_work_after);
+      0.5 * viscous_step + r.contact.work_before.damping - r.motion.damping_work_before,
+      0.5 * viscous_step + r.contact_after.damping - r.motion.damping_work_after);
   energy.external_work =
       ledger_.external.add(r.motion.constraint_work_before, r.motion.constraint_work_after);
   if (absorbing_)

@@ -1,6 +1,7 @@
 // Scene keys of boundaries and initial state: `absorbing:` (viscous absorbing boundaries),
 // `initial_stress:` (uniform or geostatic in-situ stress) and `quasi_static:` (local damping, for
 // settling or quasi-static runs).  docs/scene-format.md.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -81,14 +82,26 @@ std::vector<InitialStressSpec> read_initial_stress(const Reader& r, const YAML::
 }
 
 QuasiStaticSpec read_quasi_static(const Reader& r, const YAML::Node& node) {
-  r.check_keys(node, "quasi_static", {"local_damping", "until", "equilibrium_ratio"},
-               {"local_damping"});
+  r.check_keys(node, "quasi_static", {"damping", "local_damping", "until", "equilibrium_ratio"},
+               {});
   QuasiStaticSpec spec;
-  spec.local_damping = r.number(node["local_damping"], "quasi_static.local_damping");
-  if (!(spec.local_damping > 0.0 && spec.local_damping < 1.0))
-    r.fail(node["local_damping"], "quasi_static.local_damping",
-           "must be in (0, 1): the fraction of a node's unbalanced force taken by the damping (0.8 "
-           "is usual)");
+  if (node["damping"] &&
+      r.choice(node["damping"], "quasi_static.damping", {"local", "kinetic"}) == "kinetic")
+    spec.damping = QuasiStaticDamping::kinetic;
+  // Kinetic damping may take local damping besides, for the vibrations of the highest modes.
+  if (!spec.kinetic() && !node["local_damping"])
+    r.fail(node, "quasi_static.local_damping",
+           "missing required key 'local_damping' (0.8 is usual), or give damping: kinetic");
+  if (node["local_damping"]) {
+    spec.local_damping = r.number(node["local_damping"], "quasi_static.local_damping");
+    const double least = spec.kinetic() ? 0.0 : std::nextafter(0.0, 1.0);
+    if (!(spec.local_damping >= least && spec.local_damping < 1.0))
+      r.fail(node["local_damping"], "quasi_static.local_damping",
+             spec.kinetic() ? "must be in [0, 1): the fraction of a node's unbalanced force taken "
+                              "by local damping besides the kinetic damping (0.1 is usual)"
+                            : "must be in (0, 1): the fraction of a node's unbalanced force taken "
+                              "by the damping (0.8 is usual)");
+  }
   if (node["until"])
     spec.until = r.positive(node["until"], "quasi_static.until",
                             "time (s) after which the run is dynamic again");

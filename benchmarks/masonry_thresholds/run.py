@@ -7,7 +7,7 @@ from the start at `ratio` × the rigid-block threshold and held under local damp
   benchmarks/masonry_thresholds/run.py [--fdem build/drivers/fdem] [--cases all|NAME,...]
                                        [--ratios all|R,...] [--hold-scale 1]
                                        [--equilibrium-ratio R] [--stop-displacement D]
-                                       [--penalty-factor F]
+                                       [--penalty-factor F] [--damping local|kinetic]
                                        [--set KEY=VALUE ...]
                                        [--csv docs/data/masonry_thresholds.csv]
   benchmarks/masonry_thresholds/run.py --references   # the rigid-block values only
@@ -36,7 +36,9 @@ With --equilibrium-ratio R every hold also ends at equilibrium (quasi_static.equ
 the mean unbalanced-force ratio below R); a hold that ends so `stands (equilibrium)`, before its
 full time.  With --stop-displacement D every hold also ends once its monitor has moved D (m;
 the monitor's stop_displacement): a hold that ends so `turns (stop)`.  With both, each hold ends
-by itself whichever way it goes.
+by itself whichever way it goes.  With --damping kinetic the holds take kinetic damping
+(quasi_static.damping: kinetic: every free velocity zeroed at each peak of the kinetic energy)
+instead of local damping 0.8.
 Time is the user CPU time of the fdem process (/usr/bin/time), one core.
 """
 import argparse, csv, itertools, json, math, os, subprocess, sys, tempfile
@@ -268,6 +270,8 @@ def main():
                    help="end holds at equilibrium (quasi_static.equilibrium_ratio), e.g. 1e-4")
     p.add_argument("--stop-displacement", type=float, default=0.0,
                    help="end holds once the monitor has moved this far (m), e.g. 0.001")
+    p.add_argument("--damping", choices=("local", "kinetic"), default="local",
+                   help="the quasi-static damping (quasi_static.damping): local 0.8 or kinetic")
     a = p.parse_args()
     refs = {"wall_tilt": math.degrees(math.atan(0.6)),
             "arch_min_thickness": minimum_thickness(),
@@ -288,9 +292,11 @@ def main():
             continue
         hold *= a.hold_scale
         text = scene(hold)
-        if a.equilibrium_ratio > 0:
+        if a.damping == "kinetic":
             text = text.replace("quasi_static: {local_damping: 0.8}",
-                                "quasi_static: {local_damping: 0.8, equilibrium_ratio: %g}" %
+                                "quasi_static: {damping: kinetic}")
+        if a.equilibrium_ratio > 0:
+            text = text.replace("quasi_static: {", "quasi_static: {equilibrium_ratio: %g, " %
                                 a.equilibrium_ratio)
         if a.stop_displacement > 0:
             text = text.replace("point: [", "stop_displacement: %g, point: [" % a.stop_displacement)
@@ -309,7 +315,7 @@ def main():
         results.append({"problem": name, "ratio": ratio, "reference": refs[name], "hold_s": hold,
                         "equilibrium_ratio": a.equilibrium_ratio,
                         "stop_displacement_m": a.stop_displacement,
-                        "penalty_factor": a.penalty_factor or 10.0,
+                        "penalty_factor": a.penalty_factor or 10.0, "damping": a.damping,
                         "overrides": " ".join(a.set),
                         "steps": steps, "cpu_s": cpu, "displacement_m": end,
                         "last_window_m": d1, "outcome": verdict})

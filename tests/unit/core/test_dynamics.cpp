@@ -48,9 +48,10 @@ TEST_CASE("local damping: a linear oscillator's turning points shrink by √((1�
     const double x = nodes.x[0];
     nodes.f.assign(3, 0.0);
     nodes.f[0] = -k * x;
-    const IntegrationSummary step = integrate_central_difference(dt, nodes, alpha);
+    const IntegrationSummary step =
+        integrate_central_difference(dt, nodes, StepDamping{true, alpha});
     // Balance at t_n: ½m·v⁻·v⁺ + ½kx² + dissipated = E0 (spring work by the trapezoid is exact).
-    dissipated = -damping.add(step.local_damping_work_before, step.local_damping_work_after);
+    dissipated = -damping.add(step.damping_work_before, step.damping_work_after);
     if (s > 0)
       worst_balance = std::max(
           worst_balance, std::abs(step.kinetic_energy + 0.5 * k * x * x + dissipated - e0) / e0);
@@ -77,16 +78,16 @@ TEST_CASE("local damping: nothing on prescribed components or nodes at rest, α 
   damped.prescribed_velocity[2] = -0.25;
   NodeArrays plain = damped;
   for (NodeArrays* nodes : {&damped, &plain}) nodes->f = {3.0, -2.0, 7.0};
-  const IntegrationSummary d = integrate_central_difference(1e-3, damped, 0.8);
-  const IntegrationSummary p = integrate_central_difference(1e-3, plain, 0.0);
+  const IntegrationSummary d = integrate_central_difference(1e-3, damped, StepDamping{true, 0.8});
+  const IntegrationSummary p = integrate_central_difference(1e-3, plain, StepDamping{true, 0.0});
   CHECK(damped.v[0] == plain.v[0]);  // at rest: no damping, the force accelerates it fully
   CHECK(damped.v[2] == -0.25);       // prescribed
   // Moving in +y against f_y = −2: the damping adds 0.8·2 N against the motion.
   CHECK(damped.v[1] == Approx(0.5 + 1e-3 * (-2.0 - 1.6)).epsilon(1e-14));
   CHECK(plain.v[1] == Approx(0.5 + 1e-3 * -2.0).epsilon(1e-14));
-  CHECK(d.local_damping_work_before == Approx(0.5 * 1e-3 * -1.6 * 0.5));
-  CHECK(p.local_damping_work_before == 0.0);
-  CHECK(p.local_damping_work_after == 0.0);
+  CHECK(d.damping_work_before == Approx(0.5 * 1e-3 * -1.6 * 0.5));
+  CHECK(p.damping_work_before == 0.0);
+  CHECK(p.damping_work_after == 0.0);
 }
 
 namespace {
@@ -235,8 +236,8 @@ IntegrationSummary integrate_per_component(double dt, NodeArrays& nodes, double 
     }
     max_dx2 = std::max(max_dx2, dx2);
   }
-  out.local_damping_work_before = 0.5 * dt * power_old;
-  out.local_damping_work_after = 0.5 * dt * power_new;
+  out.damping_work_before = 0.5 * dt * power_old;
+  out.damping_work_after = 0.5 * dt * power_new;
   out.kinetic_energy = 0.5 * kinetic2;
   out.kinetic_energy_half_step = 0.5 * kinetic_half2;
   out.max_displacement_increment = std::sqrt(max_dx2);
@@ -270,7 +271,8 @@ TEST_CASE(
   const auto close = [](double a, double b) { return std::abs(a - b) <= 1e-13 * std::abs(b); };
   for (const double alpha : {0.0, 0.8}) {
     NodeArrays a = nodes, b = nodes;
-    const IntegrationSummary s = integrate_central_difference(1e-4, a, alpha);
+    const IntegrationSummary s =
+        integrate_central_difference(1e-4, a, StepDamping{alpha > 0.0, alpha});
     const IntegrationSummary r = integrate_per_component(1e-4, b, alpha);
     REQUIRE(std::memcmp(a.x.data(), b.x.data(), a.x.size() * sizeof(double)) == 0);
     REQUIRE(std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(double)) == 0);
@@ -278,15 +280,15 @@ TEST_CASE(
     CHECK(close(s.kinetic_energy_half_step, r.kinetic_energy_half_step));
     CHECK(same(s.constraint_work_before, r.constraint_work_before));
     CHECK(same(s.constraint_work_after, r.constraint_work_after));
-    CHECK(same(s.local_damping_work_before, r.local_damping_work_before));
-    CHECK(same(s.local_damping_work_after, r.local_damping_work_after));
+    CHECK(same(s.damping_work_before, r.damping_work_before));
+    CHECK(same(s.damping_work_after, r.damping_work_after));
     CHECK(same(s.max_displacement_increment, r.max_displacement_increment));
     for (int k = 0; k < 3; ++k) {
       CHECK(std::abs(s.momentum_before[k] - r.momentum_before[k]) <= 1e-12);
       CHECK(std::abs(s.momentum_after[k] - r.momentum_after[k]) <= 1e-12);
     }
     CHECK(r.constraint_work_before != 0.0);
-    if (alpha > 0.0) CHECK(r.local_damping_work_before != 0.0);
+    if (alpha > 0.0) CHECK(r.damping_work_before != 0.0);
   }
 }
 

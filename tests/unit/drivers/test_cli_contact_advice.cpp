@@ -125,6 +125,12 @@ TEST_CASE(
   CHECK_THAT(run_fdem(dir, "check qs.yaml").out,
              Contains("quasi-static: local damping 0.8 for the whole run; equilibrium_ratio 0.0001 "
                       "ends the run at equilibrium\n"));
+  write_text(dir / "kinetic.yaml",
+             std::string(block_on_base) + "quasi_static: {damping: kinetic, until: 0.02}\n");
+  CHECK_THAT(run_fdem(dir, "check kinetic.yaml").out,
+             Contains("quasi-static: kinetic damping until 0.02 s\n"));
+  CHECK_THAT(run_fdem(dir, "check kinetic.yaml --set quasi_static.local_damping=0.1").out,
+             Contains("quasi-static: kinetic damping and local damping 0.1 until 0.02 s\n"));
   // A tilt of 2° at 100°/s from 0.01 s is all there at 0.03 s; 10° only at 0.11 s, after the end.
   write_text(dir / "tilt.yaml",
              qs + "loads:\n  - {tilt: {axis: [0, 1, 0], rate: 100, max: 2, start: "

@@ -239,35 +239,45 @@ TEST_CASE("surface loads: a Gmsh physical surface selects the faces on its trian
 
 TEST_CASE(
     "surface loads: a quasi-static cube under all-round pressure alone ends at equilibrium, its "
-    "unbalanced force measured against the pressure's",
+    "unbalanced force measured against the pressure's, under local and under kinetic damping",
     "[drivers][surface_loads][quasi_static]") {
   // No gravity and no support: the pressure's forces are the only ones applied, so they scale
   // the unbalanced-force ratio (before, the ratio had nothing to compare with and the run went to
   // its end).  Static: each side shortens by p (1 − 2ν) / E.
   const double young = 1e7, nu = 0.25, side = 0.2, p = 1e4;  // Pa, –, m, Pa
-  Scene scene = builders::basic_scene(2.0);
-  scene.gravity = Vec3::Zero();
-  scene.materials.push_back(builders::elastic_material(1000, young, nu));
-  scene.bodies.push_back(builders::box_body("cube", Vec3::Zero(), Vec3(side, side, side), 1, 1, 1));
-  LoadSpec pressure;
-  pressure.kind = LoadSpec::Kind::surface;
-  pressure.bodies = {0};
-  pressure.surface.pressure = p;
-  scene.loads.push_back(pressure);
-  scene.quasi_static.local_damping = 0.8;
-  scene.quasi_static.equilibrium_ratio = 1e-4;
-  auto sim = builders::quiet_simulation(scene);
-  const RunReport report = sim->run();
-  INFO(report.reason);
-  CHECK_THAT(report.reason, Contains("equilibrium at step"));
-  CHECK(sim->time() < 0.5);
-  CHECK(sim->unbalanced_force_ratio() < 1e-4);
-  const NodeArrays& nodes = sim->model().nodes;
-  double lo = 1e9, hi = -1e9;
-  for (LocalIndex n = 0; n < nodes.size(); ++n) {
-    lo = std::min(lo, nodes.x[3 * n]);
-    hi = std::max(hi, nodes.x[3 * n]);
+  for (const bool kinetic : {false, true}) {
+    Scene scene = builders::basic_scene(2.0);
+    scene.gravity = Vec3::Zero();
+    scene.materials.push_back(builders::elastic_material(1000, young, nu));
+    scene.bodies.push_back(
+        builders::box_body("cube", Vec3::Zero(), Vec3(side, side, side), 1, 1, 1));
+    LoadSpec pressure;
+    pressure.kind = LoadSpec::Kind::surface;
+    pressure.bodies = {0};
+    pressure.surface.pressure = p;
+    scene.loads.push_back(pressure);
+    // Kinetic damping with local damping 0.4 besides: kinetic damping alone leaves the highest
+    // modes of this one-cell cube ringing: 758 steps to 1e-4 (docs/verification.md).
+    scene.quasi_static.damping = kinetic ? QuasiStaticDamping::kinetic : QuasiStaticDamping::local;
+    scene.quasi_static.local_damping = kinetic ? 0.4 : 0.8;
+    scene.quasi_static.equilibrium_ratio = 1e-4;
+    auto sim = builders::quiet_simulation(scene);
+    const RunReport report = sim->run();
+    INFO((kinetic ? "kinetic: " : "local: ")
+         << report.reason << ", balance " << report.balance_error);
+    CHECK_THAT(report.reason, Contains("equilibrium at step"));
+    CHECK(sim->time() < 0.5);
+    CHECK(sim->unbalanced_force_ratio() < 1e-4);
+    CHECK(report.balance_error < 1e-3);
+    CHECK(report.kinetic_damping_stops == (kinetic ? report.kinetic_damping_stops : -1));
+    if (kinetic) CHECK(report.kinetic_damping_stops > 0);
+    const NodeArrays& nodes = sim->model().nodes;
+    double lo = 1e9, hi = -1e9;
+    for (LocalIndex n = 0; n < nodes.size(); ++n) {
+      lo = std::min(lo, nodes.x[3 * n]);
+      hi = std::max(hi, nodes.x[3 * n]);
+    }
+    const double strain = (hi - lo) / side - 1.0;
+    CHECK(strain == Approx(-p * (1 - 2 * nu) / young).epsilon(1e-2));
   }
-  const double strain = (hi - lo) / side - 1.0;
-  CHECK(strain == Approx(-p * (1 - 2 * nu) / young).epsilon(1e-2));
 }

@@ -104,3 +104,37 @@ TEST_CASE("quasi_static: local damping and the time it ends, errors name the key
                          bad + "}\n")),
         Contains("scene.yaml:8:") && Contains("quasi_static.equilibrium_ratio: must be in (0, 1)"));
 }
+
+TEST_CASE("quasi_static.damping: local (the default) or kinetic, which takes no local_damping",
+          "[io][quasi_static]") {
+  const fdem::Scene local = fdem::parse_scene(
+      scene_with("quasi_static: {damping: local, local_damping: 0.6}\n"), "scene.yaml");
+  CHECK(local.quasi_static.damping == fdem::QuasiStaticDamping::local);
+  CHECK(local.quasi_static.local_damping == 0.6);
+  const fdem::Scene kinetic = fdem::parse_scene(
+      scene_with("quasi_static: {damping: kinetic, until: 0.05, equilibrium_ratio: 1e-4}\n"),
+      "scene.yaml");
+  CHECK(kinetic.quasi_static.kinetic());
+  CHECK(kinetic.quasi_static.local_damping == 0.0);
+  CHECK(kinetic.quasi_static.active_at(0.0));
+  CHECK_FALSE(kinetic.quasi_static.active_at(0.05));
+  CHECK(kinetic.quasi_static.equilibrium_ratio == 1e-4);
+  // Local damping besides, for the highest modes' vibration: 0 allowed here.
+  const fdem::Scene both = fdem::parse_scene(
+      scene_with("quasi_static: {damping: kinetic, local_damping: 0.1}\n"), "scene.yaml");
+  CHECK(both.quasi_static.kinetic());
+  CHECK(both.quasi_static.local_damping == 0.1);
+  CHECK(fdem::parse_scene(scene_with("quasi_static: {damping: kinetic, local_damping: 0}\n"),
+                          "scene.yaml")
+            .quasi_static.local_damping == 0.0);
+  CHECK_THAT(
+      error(scene_with("quasi_static: {damping: kinetic, local_damping: 1}\n")),
+      Contains("scene.yaml:8:") && Contains("quasi_static.local_damping: must be in [0, 1)"));
+  CHECK_THAT(error(scene_with("quasi_static: {local_damping: 0}\n")),
+             Contains("quasi_static.local_damping: must be in (0, 1)"));
+  CHECK_THAT(error(scene_with("quasi_static: {damping: viscous}\n")),
+             Contains("scene.yaml:8:") && Contains("quasi_static.damping") && Contains("local") &&
+                 Contains("kinetic"));
+  CHECK_THAT(error(scene_with("quasi_static: {damping: local}\n")),
+             Contains("quasi_static.local_damping: missing required key 'local_damping'"));
+}
