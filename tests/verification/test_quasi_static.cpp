@@ -302,6 +302,41 @@ TEST_CASE(
 }
 
 TEST_CASE(
+    "kinetic damping, tilting table: a dry running-bond wall ends at equilibrium at 0.98 θc and "
+    "turns its end wedge at 1.02 θc at the speed of the undamped collapse (docs/references.md 17, "
+    "22)",
+    "[verification][quasi_static]") {
+  // The holds above under quasi_static.damping: kinetic.  Measured (docs/verification.md, "Kinetic
+  // damping"): 0.98 θc ends at equilibrium (ratio 1e-3) at step 8,380 after 12 stops; at 1.02 θc
+  // the wedge is not slowed to (1 − α) of its unbalanced moment: the corner moves 0.39 mm in the
+  // last 0.04 s of the 0.12 s hold, 6.4× the 61 µm under local damping 0.8.
+  const double critical = std::atan(0.2 / (4 * 0.1) * (4 * 4 + 2) / (4 * 4 - 1));  // 30.96°
+  const auto kinetic = [](double angle, double end) {
+    Scene scene = tilting_table_wall(angle, end);
+    scene.quasi_static.damping = QuasiStaticDamping::kinetic;
+    scene.quasi_static.local_damping = 0.0;
+    return scene;
+  };
+  Scene standing = kinetic(0.98 * critical, 0.2);
+  standing.quasi_static.equilibrium_ratio = 1e-3;
+  auto sim = quiet_simulation(standing);
+  const RunReport stands = sim->run();
+  const WallHold turns = hold_wall(kinetic(1.02 * critical, 0.12), 0.08);
+  const WallHold damped = hold_wall(tilting_table_wall(1.02 * critical, 0.12), 0.08);
+  INFO("0.98 θc: " << stands.reason << ", " << stands.kinetic_damping_stops
+                   << " stops; 1.02 θc: the corner moved " << turns.displacement << " m, "
+                   << turns.moved_late << " m in the last 0.04 s (under local damping 0.8: "
+                   << damped.displacement << " m, " << damped.moved_late << " m)");
+  CHECK_THAT(stands.reason, Catch::Matchers::Contains("equilibrium at step"));
+  CHECK(sim->steps_done() < 11000);
+  CHECK(stands.kinetic_damping_stops > 0);
+  CHECK(stands.balance_error < 1e-3);
+  CHECK(turns.moved_late > 3.0 * damped.moved_late);
+  CHECK(turns.moved_late > 1.5e-4);
+  CHECK(turns.balance < 1e-3);
+}
+
+TEST_CASE(
     "a dry running-bond wall at τ/μσ = 0.95 holds for 2 s after settling and slides at 1.01 μ",
     "[verification][quasi_static][long]") {
   // 3 courses of 3 units (108 tets) on the held lowest course, E = 0.1 GPa, μ = 0.5, contact
