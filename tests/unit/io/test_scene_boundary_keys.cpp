@@ -105,8 +105,9 @@ TEST_CASE("quasi_static: local damping and the time it ends, errors name the key
         Contains("scene.yaml:8:") && Contains("quasi_static.equilibrium_ratio: must be in (0, 1)"));
 }
 
-TEST_CASE("quasi_static.damping: local (the default) or kinetic, which takes no local_damping",
-          "[io][quasi_static]") {
+TEST_CASE(
+    "quasi_static.damping: local (the default) or kinetic, with local damping beside it or not",
+    "[io][quasi_static]") {
   const fdem::Scene local = fdem::parse_scene(
       scene_with("quasi_static: {damping: local, local_damping: 0.6}\n"), "scene.yaml");
   CHECK(local.quasi_static.damping == fdem::QuasiStaticDamping::local);
