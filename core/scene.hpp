@@ -295,12 +295,11 @@ struct ParallelSpec {
   std::int64_t gid_offset = 0;
 };
 
-// Quasi-static mode: Cundall's local non-viscous damping on every free node component (the
-// dynamics are then not physical: only the equilibria and the collapse thresholds are).
-// quasi_static.damping: how the quasi-static mode takes the motion out.  local: Cundall's local
-// damping α·|f| on every free component (3DEC, FLAC); kinetic: every free velocity set to 0 each
-// time the kinetic energy passes a peak (kinetic damping, dynamic relaxation), with no force
-// taken from a motion that keeps speeding up (a mechanism that forms).
+// Quasi-static mode (the dynamics are then not physical: only the equilibria and the collapse
+// thresholds are).  quasi_static.damping: how it takes the motion out.  local: Cundall's local
+// non-viscous damping α·|f| on every free component (3DEC, FLAC); kinetic: every free velocity
+// set to 0 each time the kinetic energy passes a peak (kinetic damping, dynamic relaxation), with
+// no force taken from a motion that keeps speeding up (a mechanism that forms).
 enum class QuasiStaticDamping { local, kinetic };
 
 struct QuasiStaticSpec {

@@ -1,6 +1,7 @@
 #include "drivers/restart_check.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -167,6 +168,13 @@ std::vector<std::pair<std::string, double>> restart_scene_values(const Scene& sc
   // The contact law the run uses (contact.formulation, auto resolved), listed only under corner
   // contact, so that a checkpoint of potential contact restarts without a key it never had.
   if (uses_corner_contact(scene)) values.emplace_back("contact.corners", 1.0);
+  // The quasi-static mode, listed only while on (a dynamic run's checkpoint has no such key).
+  if (const QuasiStaticSpec& q = scene.quasi_static; q.enabled()) {
+    values.emplace_back("quasi_static.damping", q.kinetic() ? 1.0 : 0.0);  // 0 local, 1 kinetic
+    values.emplace_back("quasi_static.local_damping", q.local_damping);
+    values.emplace_back("quasi_static.until", std::isfinite(q.until) ? q.until : -1.0);
+    values.emplace_back("quasi_static.equilibrium_ratio", q.equilibrium_ratio);
+  }
   for (const BodySpec& body : scene.bodies) {
     const std::string key = "bodies." + key_name(body.name);
     values.emplace_back(key + ".material", body.material);

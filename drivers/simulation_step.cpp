@@ -280,6 +280,7 @@ void Simulation::sum_over_ranks(StepRecord& r) {
   detection_due_ = r.flags.detection_due > 0.0 ? 1 : 0;
   // Kinetic damping: from the summed energy, so the same on every rank.
   stop_motion_ =
+      scene_.quasi_static.kinetic() &&
       kinetic_energy_peaked(kinetic_half_step_, r.motion.kinetic_energy_half_step, stop_motion_);
   breaks_pending_ = r.flags.broken_joints > 0.0;
   bodies_cracking_ = r.flags.bodies_cracked > 0.0;

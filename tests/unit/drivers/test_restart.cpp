@@ -92,6 +92,13 @@ TEST_CASE("a restart lists other changes as warnings by key and continues", "[cl
   CHECK_THAT(changed.err, Contains("materials.stone.contact.friction changed from 0.6 to 0.3 "
                                    "applies from the checkpoint's time on"));
   CHECK_THAT(changed.err, Contains("gravity.z changed from -9.81 to -5"));
+  // The quasi-static mode (its keys listed only while it is on; 0 local, 1 kinetic damping).
+  const Outcome settled = run_fdem(dir, "run scene.yaml -o settled -q --restart " + checkpoint +
+                                            " --set quasi_static.damping=kinetic");
+  INFO(settled.err);
+  CHECK(settled.exit_code == 0);
+  CHECK_THAT(settled.err, Contains("quasi_static.damping (new, 1) applies from the checkpoint's "
+                                   "time on"));
 }
 
 TEST_CASE("a restart warns when the contact law changes, auto's choice included",
