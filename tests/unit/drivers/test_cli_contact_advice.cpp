@@ -166,7 +166,8 @@ TEST_CASE("fdem check advises against a fixed step above the critical one", "[cl
              !Contains("advice: time.step"));
 }
 
-TEST_CASE("fdem run warns when bodies overlap at t = 0, not when they touch", "[cli]") {
+TEST_CASE("fdem run and fdem check warn when bodies overlap at t = 0, not when they touch",
+          "[cli]") {
   // The block sunk 5 cm into the base is thrown off it by the penalty; resting on it, nothing.
   TempDir dir;
   std::string sunk = block_on_base;
@@ -181,6 +182,11 @@ TEST_CASE("fdem run warns when bodies overlap at t = 0, not when they touch", "[
   const Outcome resting = run_fdem(dir, "run resting.yaml -o out2 --set time.end=1e-3");
   CHECK(resting.exit_code == 0);
   CHECK_THAT(resting.err, !Contains("warning: bodies overlap"));
+  // `fdem check` takes the first step too.
+  const Outcome checked = run_fdem(dir, "check sunk.yaml");
+  CHECK(checked.exit_code == 0);
+  CHECK_THAT(checked.err, Contains("fdem: warning: bodies overlap at t = 0"));
+  CHECK_THAT(run_fdem(dir, "check resting.yaml").err, !Contains("warning: bodies overlap"));
 }
 
 TEST_CASE("fdem check advises against a contact penalty far below E", "[cli]") {
