@@ -155,6 +155,12 @@ Model model_frame(const Scene& scene) {
   model.gid_offset = scene.parallel.gid_offset;
   for (const auto& spec : scene.materials) model.materials.push_back(resolve_material(spec));
   for (const auto& body : scene.bodies) {
+    // The reader names materials; a scene made in code gives indices (BodySpec's default, −1,
+    // is none).
+    if (body.material < 0 || body.material >= static_cast<int>(scene.materials.size()))
+      throw InputError(scene.source_path + ": body '" + body.name + "' has material index " +
+                       std::to_string(body.material) + ", not one of the scene's " +
+                       std::to_string(scene.materials.size()) + " materials");
     model.body_names.push_back(body.name);
     model.body_fixed.push_back(body.fixed);
   }

@@ -69,6 +69,19 @@ TEST_CASE("build_model: masses, pieces, ids and gather map", "[model]") {
   CHECK(linear_momentum(model.nodes).isApprox(mass * Vec3(1, 2, 3)));
 }
 
+TEST_CASE("build_model: a body without a material (a scene made in code) is refused, named",
+          "[model]") {
+  for (const int material : {-1, 1}) {
+    Scene scene = scene_for(1);
+    scene.bodies[0].material = material;
+    CHECK_THROWS_WITH(
+        build_model(scene, {two_pieces()}),
+        Catch::Matchers::Contains("body '") &&
+            Catch::Matchers::Contains("has material index " + std::to_string(material) +
+                                      ", not one of the scene's 1 materials"));
+  }
+}
+
 TEST_CASE("inverted tetrahedra are rejected with the element named", "[model]") {
   BodyMesh m = two_pieces();
   std::swap(m.tets[1], m.tets[2]);
