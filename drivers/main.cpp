@@ -177,18 +177,15 @@ int check(const fdem::Scene& scene) {
     std::printf("  histories.csv:%s\n", what.c_str());
   }
   if (const fdem::QuasiStaticSpec& q = scene.quasi_static; q.enabled()) {
-    char damping[64];
-    if (q.kinetic() && q.local_damping > 0.0)
-      std::snprintf(damping, sizeof damping, "kinetic damping and local damping %g",
+    char local[48] = "";
+    if (q.local_damping > 0.0)
+      std::snprintf(local, sizeof local, "%slocal damping %g", q.kinetic() ? " and " : "",
                     q.local_damping);
-    else if (q.kinetic())
-      std::snprintf(damping, sizeof damping, "kinetic damping");
-    else
-      std::snprintf(damping, sizeof damping, "local damping %g", q.local_damping);
+    std::printf("  quasi-static: %s%s", q.kinetic() ? "kinetic damping" : "", local);
     if (q.until < scene.time.end)
-      std::printf("  quasi-static: %s until %g s", damping, q.until);
+      std::printf(" until %g s", q.until);
     else
-      std::printf("  quasi-static: %s for the whole run", damping);
+      std::printf(" for the whole run");
     const fdem::LoadsSettle& settle = sim->loads_settle();
     const std::string loads = fdem::describe_loads_settle(scene, settle);
     if (!(q.equilibrium_ratio > 0.0))

@@ -1,7 +1,6 @@
 // Scene keys of boundaries and initial state: `absorbing:` (viscous absorbing boundaries),
 // `initial_stress:` (uniform or geostatic in-situ stress) and `quasi_static:` (local damping, for
 // settling or quasi-static runs).  docs/scene-format.md.
-#include <cmath>
 #include <string>
 #include <vector>
 
@@ -93,12 +92,12 @@ QuasiStaticSpec read_quasi_static(const Reader& r, const YAML::Node& node) {
     r.fail(node, "quasi_static.local_damping",
            "missing required key 'local_damping' (0.8 is usual), or give damping: kinetic");
   if (node["local_damping"]) {
-    spec.local_damping = r.number(node["local_damping"], "quasi_static.local_damping");
-    const double least = spec.kinetic() ? 0.0 : std::nextafter(0.0, 1.0);
-    if (!(spec.local_damping >= least && spec.local_damping < 1.0))
+    const double alpha = spec.local_damping =
+        r.number(node["local_damping"], "quasi_static.local_damping");
+    if (!(alpha < 1.0 && (spec.kinetic() ? alpha >= 0.0 : alpha > 0.0)))
       r.fail(node["local_damping"], "quasi_static.local_damping",
              spec.kinetic() ? "must be in [0, 1): the fraction of a node's unbalanced force taken "
-                              "by local damping besides the kinetic damping (0.1 is usual)"
+                              "by local damping besides the kinetic damping (0, none, by default)"
                             : "must be in (0, 1): the fraction of a node's unbalanced force taken "
                               "by the damping (0.8 is usual)");
   }
