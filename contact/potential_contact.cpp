@@ -127,6 +127,32 @@ struct PairNormals {
   const Vec3* of[2];
 };
 
+// The four vertices of sub-tet i, [i][slot]: own corners s != i and the centroid in slot i, with
+// their own barycentric coordinates, neighbours and planes (the other tet's coordinates are the
+// pair's, filled in per pair).  In lambda_1..3 coordinates the own tet is the unit simplex
+// (positive), and replacing corner i by the centroid keeps the orientation, so kTetNeighbours
+// applies unchanged.  Slot s lies on the three faces opposite the other slots: the face opposite
+// slot i is the base (own face i), the face opposite slot k != i a side through the centroid.
+struct SubTetVertices {
+  PieceVertex v[4][4];
+};
+constexpr SubTetVertices make_sub_tet_vertices() {
+  SubTetVertices table{};
+  for (int i = 0; i < 4; ++i)
+    for (int s = 0; s < 4; ++s) {
+      PieceVertex& v = table.v[i][s];
+      for (int a = 0; a < 4; ++a) v.lam[a] = (s == i) ? 0.25 : (a == s ? 1.0 : 0.0);
+      for (int b = 0; b < 4; ++b) v.lam[4 + b] = 0.0;
+      for (int e = 0; e < 3; ++e) v.next[e] = kTetNeighbours[s][e];
+      unsigned planes = 0;
+      for (int s2 = 0; s2 < 4; ++s2)
+        if (s2 != s) planes |= (s2 == i) ? kOuterFaceBit : (1u << (1 + s2));
+      v.planes = planes;
+    }
+  return table;
+}
+constexpr SubTetVertices kSubTetVertices = make_sub_tet_vertices();
+
 // Integrates the four pieces (sub-tet i of `own`) ∩ other.
 void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int own, int moments,
                     unsigned left_out, ClipMemo* memo, SideIntegrals& out) {
@@ -176,23 +202,13 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
                (own_at_other_corner[2][i] > own_at_other_corner[2][k]) &
                (own_at_other_corner[3][i] > own_at_other_corner[3][k]);
     if (empty) continue;
-    // Sub-tet i = own corners k != i plus the centroid in slot i.  In lambda_1..3 coordinates
-    // the own tet is the unit simplex (positive), and replacing corner i by the centroid keeps
-    // the orientation, so kTetNeighbours applies unchanged.
-    const double* slot_other[4];
-    for (int s = 0; s < 4; ++s) slot_other[s] = (s == i) ? other_at_centroid : other_at_corner[s];
+    // Sub-tet i = own corners k != i plus the centroid in slot i (kSubTetVertices).
     piece.count = 4;
     for (int s = 0; s < 4; ++s) {
       PieceVertex& v = piece.v[s];
-      for (int a = 0; a < 4; ++a) v.lam[a] = (s == i) ? 0.25 : (a == s ? 1.0 : 0.0);
-      for (int b = 0; b < 4; ++b) v.lam[4 + b] = slot_other[s][b];
-      for (int e = 0; e < 3; ++e) v.next[e] = kTetNeighbours[s][e];
-      // Slot s lies on the three faces opposite the other slots.  Face opposite slot i is the
-      // base (own face i); face opposite slot k != i is a side through the centroid.
-      unsigned planes = 0;
-      for (int s2 = 0; s2 < 4; ++s2)
-        if (s2 != s) planes |= (s2 == i) ? kOuterFaceBit : (1u << (1 + s2));
-      v.planes = planes;
+      v = kSubTetVertices.v[i][s];
+      const double* other = (s == i) ? other_at_centroid : other_at_corner[s];
+      for (int b = 0; b < 4; ++b) v.lam[4 + b] = other[b];
     }
     // The piece's clip: replayed from the step before where every vertex kept its side of every
     // plane (clip_replay.hpp), else clipped afresh (and recorded for the next step).
@@ -283,8 +299,10 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
   double volume[2] = {0.0, 0.0};
   for (int s = 0; s < 2; ++s) {
     const double jac = std::abs(frame.map[s].edge_det);
+    const int carried = s == 0 ? 8 : 4;  // the target's side carries its own values only
     for (int i = 0; i < 4; ++i) {
-      for (int c = 0; c < 8; ++c) vol_integral[s][i][c] = jac * side[s].moment[i][c] * (1.0 / 24.0);
+      for (int c = 0; c < carried; ++c)
+        vol_integral[s][i][c] = jac * side[s].moment[i][c] * (1.0 / 24.0);
       volume[s] += jac * side[s].vol6[i] * (1.0 / 6.0);
     }
   }
@@ -297,16 +315,24 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
     const SideIntegrals& other_side = side[1 - s];  // its surfaces lie on this tet's faces
     for (int i = 0; i < 4; ++i) energy += vol_integral[s][i][i];
     const Vec3* inward_normal = normals.of[s];  // of own face i: grad lambda_i / |grad lambda_i|
-    for (int a = 0; a < 4; ++a) {
-      Vec3 f = Vec3::Zero();
-      for (int i = 0; i < 4; ++i) {
+    // The four nodes side by side (one vector lane each), each summed in the same order as alone.
+    double f[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // [component][node a]
+    for (int i = 0; i < 4; ++i) {
+      const Vec3& gradient = own.gradient[i];
+      const Vec3& normal = inward_normal[i];
+      for (int a = 0; a < 4; ++a) {
         // volume term: grad phi = 4 grad lambda_i on sub-tet i
-        f += (4.0 * vol_integral[s][i][a]) * own.gradient[i];
+        const double volume_term = 4.0 * vol_integral[s][i][a];
         // surface term on own face i: - ∫ phi_other lambda_a n dS, n = outward unit normal
-        f += (other_side.surface[i][a] * (1.0 / 24.0)) * inward_normal[i];
+        const double surface_term = other_side.surface[i][a] * (1.0 / 24.0);
+        for (int k = 0; k < 3; ++k) {
+          f[k][a] += volume_term * gradient[k];
+          f[k][a] += surface_term * normal[k];
+        }
       }
-      force[s][a] = penalty * f;
     }
+    for (int a = 0; a < 4; ++a)
+      force[s][a] = Vec3(penalty * f[0][a], penalty * f[1][a], penalty * f[2][a]);
     // The pieces' forces sum to the gradient of the energy because the boundary term
     // -p ∫ phi lambda_a n dS on the face two sub-tets share cancels between their pieces.  A
     // left-out piece i leaves it to each kept neighbour k, over k's face on their plane (normal
