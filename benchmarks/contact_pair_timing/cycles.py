@@ -23,8 +23,10 @@ carry load and the few that do not), the probes sum the cycles of:
   stage     pair − kernel: friction, dashpot, the scatter to the nodes, the pair's records.
 
 The figures are time-stamp-counter cycles (the counter's rate is measured and printed, so that
-they convert to ns) and include the probes' own reads (~14 per pair; the cost of one read is
-measured and printed): they give the shares, the running stage's ns per pair come from run.py.
+they convert to ns) and include the probes' own reads (~14 per pair; the counter read does not
+wait for the work before it, so stamps may overlap it by some dozens of cycles): they give the
+shares; the running stage's ns per pair come from run.py.  "fresh": pieces clipped afresh rather
+than replayed from the step before (clip_replay.hpp).
 """
 import argparse, csv, importlib.util, os, re, subprocess, sys
 
@@ -43,7 +45,7 @@ namespace fdem_cycles {
 struct Sums {
   unsigned long long pair = 0, kernel = 0, frame = 0, bound = 0, forces = 0, pairs = 0;
   unsigned long long setup[2] = {0, 0}, clip[2] = {0, 0}, record[2] = {0, 0}, integrate[2] = {0, 0};
-  unsigned long long pieces[2] = {0, 0};
+  unsigned long long pieces[2] = {0, 0}, fresh[2] = {0, 0};
   ~Sums() {
     // one counter read, and the counter's rate against the steady clock
     unsigned long long least = ~0ull;
@@ -61,10 +63,11 @@ struct Sums {
                  "CYCLES pairs=%llu pair=%.1f kernel=%.1f frame=%.1f bound=%.1f "
                  "setup_c=%.1f clip_c=%.1f record_c=%.1f integrate_c=%.1f pieces_c=%.3f "
                  "setup_t=%.1f clip_t=%.1f record_t=%.1f integrate_t=%.1f pieces_t=%.3f "
-                 "forces=%.1f read=%llu rate_ghz=%.4f\n",
+                 "fresh_c=%.3f fresh_t=%.3f forces=%.1f read=%llu rate_ghz=%.4f\n",
                  pairs, pair / n, kernel / n, frame / n, bound / n, setup[0] / n, clip[0] / n,
                  record[0] / n, integrate[0] / n, pieces[0] / n, setup[1] / n, clip[1] / n,
-                 record[1] / n, integrate[1] / n, pieces[1] / n, forces / n, least, rate * 1e-9);
+                 record[1] / n, integrate[1] / n, pieces[1] / n, fresh[0] / n, fresh[1] / n, forces / n,
+                 least, rate * 1e-9);
   }
 };
 inline Sums sums;
@@ -73,7 +76,7 @@ struct Pair {
   unsigned long long start = 0, kernel_start = 0, kernel_end = 0, frame_end = 0, bound_end = 0,
                      sides_end = 0;
   unsigned long long setup[2] = {0, 0}, clip[2] = {0, 0}, record[2] = {0, 0}, integrate[2] = {0, 0};
-  unsigned long long pieces[2] = {0, 0};
+  unsigned long long pieces[2] = {0, 0}, fresh[2] = {0, 0};
 };
 inline Pair now;
 }  // namespace fdem_cycles
@@ -107,6 +110,7 @@ def add_probes(tree):
          '      unsigned long long sides = 0;\n'
          '      for (int k = 0; k < 2; ++k) { s.setup[k] += p.setup[k]; s.clip[k] += p.clip[k];\n'
          '        s.record[k] += p.record[k]; s.integrate[k] += p.integrate[k]; s.pieces[k] += p.pieces[k];\n'
+         '        s.fresh[k] += p.fresh[k];\n'
          '        sides += p.setup[k] + p.clip[k] + p.record[k] + p.integrate[k]; }\n'
          '      s.forces += (p.kernel_end - p.bound_end) - sides; ++s.pairs; } } end_;\n'
          '    std::uint32_t clip_read_at = kNoClipRecord;'),
@@ -135,7 +139,7 @@ def add_probes(tree):
         ('      ClipLog log;\n',
          '      ClipLog log;\n      const unsigned long long clip_from = __rdtsc();\n'),
         ('      if (memo) ++memo->clipped;\n',
-         '      if (memo) ++memo->clipped;\n'
+         '      if (memo) ++memo->clipped;\n      ++fdem_cycles::now.fresh[own];\n'
          '      { const unsigned long long t = __rdtsc(); fdem_cycles::now.clip[own] += t - clip_from;\n'
          '        fdem_cycles::now.record[own] -= t - clip_from; }\n'),
         ('    if (alive) {\n      out.nonempty |= 1u << i;',
@@ -153,10 +157,12 @@ def add_probes(tree):
 
 def build(commit, workdir):
     tree = os.path.join(workdir, "tree_" + commit)
-    if not os.path.isdir(tree):
+    if os.path.isdir(tree):  # the probes as this script writes them now; the build is kept
+        subprocess.run(["git", "-C", tree, "checkout", "-q", "--", "contact"], check=True)
+    else:
         subprocess.run(["git", "-C", root, "worktree", "add", "-f", "--detach", tree, commit],
                        check=True, stdout=subprocess.DEVNULL)
-        add_probes(tree)
+    add_probes(tree)
     build_dir = os.path.join(tree, "build")
     subprocess.run(["cmake", "-S", tree, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release"],
                    check=True, stdout=subprocess.DEVNULL)
@@ -209,7 +215,8 @@ def main():
                       f"record {(r['record_c'] + r['record_t']) / c:.0%}, "
                       f"integrate {(r['integrate_c'] + r['integrate_t']) / c:.0%}, "
                       f"forces {r['forces'] / c:.0%}), stage {(c - r['kernel']) / c:.0%}; "
-                      f"{r['pieces_c'] + r['pieces_t']:.2f} pieces per pair", flush=True)
+                      f"{r['pieces_c'] + r['pieces_t']:.2f} pieces per pair, "
+                      f"{r['fresh_c'] + r['fresh_t']:.2f} clipped afresh", flush=True)
     if len(commits) > 1:  # the least cycles per pair of each commit, against the first
         for case in a.cases.split(","):
             least = {c: min(r["pair"] for r in rows if r["case"] == case and r["commit"] == c)
@@ -218,7 +225,7 @@ def main():
                                           for c in commits))
     keys = ["case", "repeat", "commit", "pairs", "pair", "kernel", "frame", "bound", "setup_c",
             "clip_c", "record_c", "integrate_c", "pieces_c", "setup_t", "clip_t", "record_t",
-            "integrate_t", "pieces_t", "forces", "read", "rate_ghz"]
+            "integrate_t", "pieces_t", "fresh_c", "fresh_t", "forces", "read", "rate_ghz"]
     os.makedirs(os.path.dirname(a.csv), exist_ok=True)
     with open(a.csv, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
