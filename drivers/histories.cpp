@@ -83,6 +83,28 @@ HistoryRecorder::HistoryRecorder(const Scene& scene, const Model& model, const C
   }
 }
 
+std::vector<std::string> monitors_held_at_rest(const Scene& scene, const Model& model) {
+  std::vector<std::string> out;
+  const TetArrays& tets = model.tets;
+  for (const MonitorSpec& m : scene.output.histories.monitors) {
+    if (!(m.stop_displacement > 0.0)) continue;
+    const GlobalId gid = owned_tet_holding(model, m.point);
+    const LocalIndex t = gid >= 0 ? tets.find(gid) : -1;
+    if (t < 0) continue;  // in no tet: refused when the simulation was made
+    const std::int32_t body = model.pieces.body_of(tets.piece[t]);
+    if (!model.body_fixed[static_cast<std::size_t>(body)]) continue;
+    bool moved = false;
+    for (const LoadSpec& load : scene.loads)
+      for (int c = 0; c < 4 && load.prescribes_velocity(); ++c)
+        moved =
+            moved || load_holds_node(load, model, tets.nodes[4 * static_cast<std::size_t>(t) + c]);
+    if (!moved)
+      out.push_back("monitor '" + m.name + "' lies in fixed body '" +
+                    scene.bodies[static_cast<std::size_t>(body)].name + "'");
+  }
+  return out;
+}
+
 bool HistoryRecorder::due(double time, double dt) const {
   return every_ <= 0.0 || time >= next_time_ - 1e-12 * dt;
 }

@@ -18,6 +18,12 @@ namespace fdem {
 
 class Communicator;
 
+// The monitors with a stop_displacement that can never move: the tet that holds the point at
+// t = 0 lies in a fixed body and no velocity or base-motion load holds any of its nodes, so their
+// stop can never end the run.  "monitor 'NAME' lies in fixed body 'BODY'" each; `model` is the
+// whole model on one process (fdem check).
+std::vector<std::string> monitors_held_at_rest(const Scene& scene, const Model& model);
+
 class HistoryRecorder {
  public:
   // Finds each monitor's tet: the lowest gid whose reference shape holds the point, over all

@@ -9,6 +9,7 @@
 
 #include "contact/contact_stage.hpp"
 #include "core/error.hpp"
+#include "drivers/histories.hpp"
 #include "drivers/interrupt.hpp"
 #include "drivers/process_memory.hpp"
 #include "drivers/run_limits.hpp"
@@ -175,6 +176,11 @@ int check(const fdem::Scene& scene) {
     }
     what.pop_back();
     std::printf("  histories.csv:%s\n", what.c_str());
+    for (const std::string& at_rest : fdem::monitors_held_at_rest(scene, model))
+      std::printf(
+          "  warning: %s, which no velocity or base-motion load moves: its stop_displacement "
+          "can never end the run; place the monitor in a body that moves\n",
+          at_rest.c_str());
   }
   if (const fdem::QuasiStaticSpec& q = scene.quasi_static; q.enabled()) {
     char local[48] = "";

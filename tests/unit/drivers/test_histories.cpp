@@ -324,3 +324,39 @@ TEST_CASE("histories: a monitor's stop_displacement ends the run at the first ro
   const Outcome check = run_fdem(dir, "check scene.yaml");
   CHECK_THAT(check.out, Contains("monitor centre (ends the run when it has moved 0.01 m)"));
 }
+
+TEST_CASE("histories: fdem check warns of a stop_displacement on a monitor no load can move",
+          "[drivers][histories][cli]") {
+  TempDir dir;
+  // The falling cube on a fixed slab, the monitor in the slab: it can never move.
+  std::string scene = falling_cube;
+  const std::string cube_body = "  - {name: cube,";
+  scene.replace(scene.find(cube_body), 0,
+                "  - {name: slab, fixed: true, mesh: {box: {min: [-0.2, -0.2, -0.2], max: [0.3, "
+                "0.3, -0.1], cells: [1, 1, 1]}},\n     material: stone}\n");
+  const std::string centre = "point: [0.05, 0.05, 0.05]";
+  scene.replace(scene.find(centre), centre.size(), "point: [0.05, 0.05, -0.15]");
+  write_text(dir / "at_rest.yaml", scene);
+  const Outcome at_rest = run_fdem(dir, "check at_rest.yaml");
+  INFO(at_rest.out << at_rest.err);
+  REQUIRE(at_rest.exit_code == 0);
+  CHECK_THAT(at_rest.out, Contains("warning: monitor 'centre' lies in fixed body 'slab', which no "
+                                   "velocity or base-motion load moves: its stop_displacement "
+                                   "can never end the run"));
+
+  // A base motion of the slab moves it: no warning.
+  write_text(dir / "ground.csv", "time,acceleration\n0,0\n1,1\n");
+  write_text(dir / "moved.yaml", scene +
+                                     "loads:\n  - {bodies: [slab], base_motion: {file: ground.csv, "
+                                     "direction: [1, 0, 0]}}\n");
+  const Outcome moved = run_fdem(dir, "check moved.yaml");
+  INFO(moved.out << moved.err);
+  REQUIRE(moved.exit_code == 0);
+  CHECK_THAT(moved.out, !Contains("can never end the run"));
+
+  // The monitor in the falling cube: no warning.
+  write_text(dir / "falling.yaml", falling_cube);
+  const Outcome falling = run_fdem(dir, "check falling.yaml");
+  REQUIRE(falling.exit_code == 0);
+  CHECK_THAT(falling.out, !Contains("can never end the run"));
+}
