@@ -124,8 +124,17 @@ LoadSchedule::LoadSchedule(const Scene& scene, const Model& model) {
       if (base.motion.time.size() != base.motion.acceleration.size() || base.motion.time.size() < 2)
         throw InputError(scene.source_path +
                          ": a base motion needs at least two samples of time and acceleration");
-      settle_ = later(
-          settle_, {base.motion.time.back(), static_cast<int>(&load - scene.loads.data()), false});
+      const int index = static_cast<int>(&load - scene.loads.data());
+      settle_ = later(settle_, {base.motion.time.back(), index, false});
+      // Linear between samples, zero before the first: the ground moves from the sample before
+      // the first non-zero acceleration on.
+      const std::vector<double>& a = base.motion.acceleration;
+      const auto first = std::find_if(a.begin(), a.end(), [](double x) { return x != 0.0; });
+      if (first != a.end()) {
+        const std::size_t k = static_cast<std::size_t>(first - a.begin());
+        const double start = base.motion.time[k > 0 ? k - 1 : 0];
+        if (start < base_motion_start_.time) base_motion_start_ = {start, index, false};
+      }
       bases_.push_back(std::move(base));
     } else if (load.kind == LoadSpec::Kind::surface) {
       surfaces_.push_back({load, static_cast<int>(&load - scene.loads.data()), {}});

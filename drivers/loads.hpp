@@ -4,6 +4,7 @@
 // velocities stay in apply_constraints.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,9 @@ class LoadSchedule {
   double surface_force_magnitude() const;  // N, Σ over the owned faces' corners
   // When the loads stop changing (base motions by their records, read once here).
   const LoadsSettle& settle() const { return settle_; }
+  // When the ground first moves: the earliest time from which a base motion's acceleration is
+  // not zero (`time`, s; infinity without one) and that load's scene index (`load`, -1: none).
+  const LoadsSettle& base_motion_start() const { return base_motion_start_; }
   // Per surface load (scene order): its index in the scene's loads and the number of faces
   // whose tet is owned here (to refuse a load that acts on no face).
   std::vector<std::pair<int, std::int64_t>> surface_face_counts() const;
@@ -102,6 +106,7 @@ class LoadSchedule {
   std::vector<Surface> surfaces_;
   std::vector<LoadSpec> all_loads_;
   LoadsSettle settle_;
+  LoadsSettle base_motion_start_{std::numeric_limits<double>::infinity(), -1, false};
   bool changes_gravity_ = false;
 };
 

@@ -194,6 +194,9 @@ int check(const fdem::Scene& scene) {
       std::printf(" for the whole run");
     const fdem::LoadsSettle& settle = sim->loads_settle();
     const std::string loads = fdem::describe_loads_settle(scene, settle);
+    // The damping acts on absolute velocities: it holds back the free bodies the ground carries.
+    const fdem::LoadsSettle& ground = sim->base_motion_start();
+    const bool ground_damped = ground.load >= 0 && ground.time < std::min(q.until, scene.time.end);
     if (!(q.equilibrium_ratio > 0.0))
       std::printf("\n");
     else if (settle.time <= 0.0)
@@ -207,6 +210,17 @@ int check(const fdem::Scene& scene) {
           "at equilibrium only once every load is constant%s (a monitor's stop_displacement "
           "can end it)\n",
           loads.c_str(), q.until < scene.time.end ? ", while the damping acts" : "");
+    if (ground_damped) {
+      const std::string& name = scene.loads[static_cast<std::size_t>(ground.load)].name;
+      std::printf(
+          "  warning: the ground moves from t = %g s (%s, a base motion) while the quasi-static "
+          "damping acts: it holds back the bodies the ground carries; end the damping before "
+          "the record starts (quasi_static.until <= %g)\n",
+          ground.time,
+          (name.empty() ? "loads[" + std::to_string(ground.load) + "]" : "load '" + name + "'")
+              .c_str(),
+          ground.time);
+    }
   }
   std::printf("  stages:\n");
   for (const auto& s : sim->plan().describe()) std::printf("    %s\n", s.c_str());

@@ -81,6 +81,7 @@ class Simulation {
   double unbalanced_force_ratio() const { return force_ratio_; }
   // When the loads stop changing: equilibrium_ratio ends the run only from then on.
   const LoadsSettle& loads_settle() const { return loads_->settle(); }
+  const LoadsSettle& base_motion_start() const { return loads_->base_motion_start(); }
   Model& model() { return model_; }
   const Scene& scene() const { return scene_; }
   const StagePlan& plan() const { return plan_; }

@@ -2,7 +2,8 @@
 // fixed step above the critical one, a contact penalty far below E and friction on only one of two
 // touching materials: what `fdem check` prints for a scene, and what a numerical failure says;
 // what it says of a quasi-static run that equilibrium_ratio may end; and the warning of `fdem run`
-// about bodies overlapping at t = 0.
+// about bodies overlapping at t = 0; and its warning of a ground that moves while the quasi-static
+// damping acts.
 #include <catch2/catch.hpp>
 #include <string>
 
@@ -220,4 +221,29 @@ TEST_CASE("fdem check says when only one of two touching materials has friction"
   CHECK(o.exit_code == 0);
   CHECK_THAT(o.out, Contains(advice));
   CHECK_THAT(run_fdem(dir, "check scene.yaml").out, !Contains("is frictionless"));
+}
+
+TEST_CASE("fdem check warns when the ground moves while the quasi-static damping acts", "[cli]") {
+  TempDir dir;
+  // The base moves with a record that is at rest until 0.02 s.
+  write_text(dir / "ground.csv", "time,acceleration\n0,0\n0.02,0\n0.03,1\n0.04,0\n");
+  write_text(dir / "scene.yaml", std::string(block_on_base) +
+                                     "loads:\n  - {name: quake, bodies: [base], base_motion: "
+                                     "{file: ground.csv, direction: [1, 0, 0]}}\n"
+                                     "quasi_static: {local_damping: 0.8}\n");
+  const std::string warning =
+      "warning: the ground moves from t = 0.02 s (load 'quake', a base "
+      "motion) while the quasi-static damping acts";
+  const Outcome whole = run_fdem(dir, "check scene.yaml");
+  INFO(whole.out << whole.err);
+  REQUIRE(whole.exit_code == 0);
+  CHECK_THAT(whole.out, Contains(warning));
+  CHECK_THAT(whole.out, Contains("(quasi_static.until <= 0.02)"));
+  CHECK_THAT(run_fdem(dir, "check scene.yaml --set quasi_static.damping=kinetic").out,
+             Contains(warning));
+  // Settled before the record starts: no warning.
+  const Outcome settled = run_fdem(dir, "check scene.yaml --set quasi_static.until=0.02");
+  REQUIRE(settled.exit_code == 0);
+  CHECK_THAT(settled.out, Contains("quasi-static: local damping 0.8 until 0.02 s"));
+  CHECK_THAT(settled.out, !Contains("warning: the ground moves"));
 }
