@@ -36,6 +36,10 @@ _spec = importlib.util.spec_from_file_location(
     "contact_slivers_run", os.path.join(root, "benchmarks", "contact_slivers", "run.py"))
 slivers = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(slivers)
+_spec = importlib.util.spec_from_file_location("contact_pair_timing_run",
+                                               os.path.join(here, "run.py"))
+pair_timing = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(pair_timing)
 
 PROBE_HEADER = r'''
 #include <x86intrin.h>
@@ -163,12 +167,7 @@ def build(commit, workdir):
         subprocess.run(["git", "-C", root, "worktree", "add", "-f", "--detach", tree, commit],
                        check=True, stdout=subprocess.DEVNULL)
     add_probes(tree)
-    build_dir = os.path.join(tree, "build")
-    subprocess.run(["cmake", "-S", tree, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release"],
-                   check=True, stdout=subprocess.DEVNULL)
-    subprocess.run(["cmake", "--build", build_dir, "-j2", "--target", "fdem"], check=True,
-                   stdout=subprocess.DEVNULL)
-    return os.path.join(build_dir, "drivers", "fdem")
+    return pair_timing.build_fdem(tree)
 
 
 def run_case(fdem, case, workdir, cpu):

@@ -58,6 +58,11 @@ def build(commit, patch, workdir, name):
         subprocess.run(["cp", os.path.join(here, "pair_timing_probe.hpp"),
                         os.path.join(tree, "contact")], check=True)
         subprocess.run(["git", "-C", tree, "apply", os.path.join(here, patch)], check=True)
+    return build_fdem(tree)
+
+
+def build_fdem(tree):
+    """`fdem` of a source tree built in TREE/build (Release); returns the binary."""
     build_dir = os.path.join(tree, "build")
     subprocess.run(["cmake", "-S", tree, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release"],
                    check=True, stdout=subprocess.DEVNULL)
