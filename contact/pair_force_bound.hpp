@@ -66,7 +66,34 @@ inline double slab_depths(const TetPairFrame& frame, double (&mu)[8]) {
   return thinnest;
 }
 
-// The bound from the slab depths of slab_depths; penalty in Pa.
+// The slab depths narrowed by caps (into `reach`): Omega also lies in T ∩ {lambda_b^O >= 0} for
+// each face b of the other tet O, the cap of T beyond that face's plane.  On the cap lambda_a^T
+// peaks at a vertex: corner a itself when it lies beyond the plane (lambda_a^T = 1 there), else a
+// point where an edge from a corner v beyond the plane to corner a crosses it, where
+// lambda_a^T = l_v / (l_v - l_a) (l = lambda_b^O at the corners), largest for the largest l_v,
+// which is mu_b^O.  This is what makes a small tet's slabs thin when it presses on a larger one:
+// the larger tet's corners lie far out in every slab of the smaller (its mu near 1), though the
+// overlap is a sheet along the larger tet's face.  Only the faces T pokes through thinly
+// (mu_b^O < kPrismSlab) are tried: elsewhere the cap is most of T.
+inline void narrow_slab_depths(const TetPairFrame& frame, const double (&mu)[8],
+                               double (&reach)[8]) {
+  for (int k = 0; k < 8; ++k) reach[k] = mu[k];
+  for (int T = 0; T < 2; ++T) {
+    const int other = 1 - T;
+    const double(&at_corner)[4][4] = frame.lambda_other[T];  // [corner v of T][face b of other]
+    for (int b = 0; b < 4; ++b) {
+      if (!(mu[4 * other + b] < kPrismSlab)) continue;
+      double beyond = 0.0;  // the largest lambda_b^O at a corner of T: mu_b^O unclamped
+      for (int v = 0; v < 4; ++v) beyond = std::max(beyond, at_corner[v][b]);
+      for (int a = 0; a < 4; ++a)
+        if (at_corner[a][b] < 0.0)
+          reach[4 * T + a] = std::min(reach[4 * T + a], beyond / (beyond - at_corner[a][b]));
+    }
+  }
+}
+
+// The bound from the slab depths of slab_depths (or narrowed by narrow_slab_depths); penalty in
+// Pa.
 inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (&mu)[8],
                                        double penalty) {
   const Vec3* gradient[8];
@@ -136,11 +163,15 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
   return bound;
 }
 
-// `frame` as filled by prepare_tet_pair (the pair passed the face-plane test); penalty in Pa.
+// `frame` as filled by prepare_tet_pair (the pair passed the face-plane test); penalty in Pa.  The
+// slab depths narrowed by caps; `thinnest` is the smallest slab depth as slab_depths gives it.
 inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty) {
-  double mu[8];
-  slab_depths(frame, mu);
-  return pair_force_bound(frame, mu, penalty);
+  double mu[8], reach[8];
+  const double thinnest = slab_depths(frame, mu);
+  narrow_slab_depths(frame, mu, reach);
+  PairForceBound bound = pair_force_bound(frame, reach, penalty);
+  bound.thinnest = thinnest;
+  return bound;
 }
 
 // Per piece of a pair (sub-tet i of tet T clipped by the other tet: index 4T + i), an upper bound
@@ -209,14 +240,16 @@ constexpr unsigned kEveryPiece = 0xFFu;
 
 inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   constexpr double kThinSlab = 1e-3;
-  double mu[8];
-  if (!(slab_depths(frame, mu) < kThinSlab)) return 0;
-  const PairForceBound bound = pair_force_bound(frame, mu, 1.0);
+  double mu[8], reach[8];
+  const double thinnest = slab_depths(frame, mu);  // the depth of the pressure: sets the limit
+  if (!(thinnest < kThinSlab)) return 0;
+  narrow_slab_depths(frame, mu, reach);
+  const PairForceBound bound = pair_force_bound(frame, reach, 1.0);
   const double limit =
-      std::min(tolerance, kPressedFaceShare * bound.thinnest) * bound.length * bound.length;
+      std::min(tolerance, kPressedFaceShare * thinnest) * bound.length * bound.length;
   if (bound.nodal_force <= limit) return kEveryPiece;
   double piece[8];
-  piece_force_bounds(frame, mu, bound, limit, piece);
+  piece_force_bounds(frame, reach, bound, limit, piece);
   unsigned skipped = 0;
   for (int k = 0; k < 8; ++k) skipped |= piece[k] <= limit ? 1u << k : 0u;
   return skipped;
