@@ -36,6 +36,7 @@ struct PairForceBound {
   double surface = 0.0;      // m^2: the area of the overlap's boundary is below it
   double length = 0.0;       // m: the shorter of the two tets' longest edges
   double thinnest = 1.0;     // the thinnest slab mu (barycentric): ~ depth / size when pressed
+  bool complete = true;      // false: stopped once nodal_force was low enough (pair_force_bound)
 };
 
 inline double longest_edge_squared(const Vec3 (&x)[4]) {
@@ -48,6 +49,7 @@ inline double longest_edge_squared(const Vec3 (&x)[4]) {
 // Prisms are formed from slabs thinner than this (barycentric units) only: a thicker slab's prism
 // is rarely the smallest, and each costs a cross product and a square root.
 constexpr double kPrismSlab = 1e-2;
+constexpr int kMaxThinSlabs = 4;
 
 // The slab depths mu[4T + a] (face a of tet T: 0 contactor, 1 target), clamped to [0, 1], of a
 // pair that passed the face-plane test (`frame` as filled by prepare_tet_pair); returns the
@@ -93,9 +95,11 @@ inline void narrow_slab_depths(const TetPairFrame& frame, const double (&mu)[8],
 }
 
 // The bound from the slab depths of slab_depths (or narrowed by narrow_slab_depths); penalty in
-// Pa.
+// Pa.  With `enough` >= 0 it returns as soon as its nodal force is at most `enough` (then
+// `complete` is false and only nodal_force, length and thinnest hold): each further prism only
+// lowers it, so whether the whole bound is at most `enough` is decided alike, for less.
 inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (&mu)[8],
-                                       double penalty) {
+                                       double penalty, double enough = -1.0) {
   const Vec3* gradient[8];
   double potential_bound[2], gradient_max[2], volume[2];
   int thin[8], thin_count = 0;  // slabs thin enough for their prisms to matter
@@ -112,14 +116,34 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
     gradient_max[T] = std::sqrt(largest_gradient_squared);
     volume[T] = std::abs(frame.map[T].edge_det) / 6.0;
   }
-  const double length = std::sqrt(
+  // The thinnest slabs first, and the prisms and parallelepipeds of the kMaxThinSlabs thinnest
+  // only (their number grows as the cube of the slabs'; any of them bounds, so fewer leave the
+  // bound rigorous).
+  for (int i = 1; i < thin_count; ++i)  // insertion sort: at most 8, stable
+    for (int j = i; j > 0 && mu[thin[j]] < mu[thin[j - 1]]; --j) std::swap(thin[j], thin[j - 1]);
+  thin_count = std::min(thin_count, kMaxThinSlabs);
+  PairForceBound bound;
+  bound.length = std::sqrt(
       std::min(longest_edge_squared(frame.local[0]), longest_edge_squared(frame.local[1])));
+  const double length = bound.length;
+  bound.thinnest = *std::min_element(mu, mu + 8);
 
   // Whole tets: face a's area is 3V |grad lambda_a| <= 3V G_T.
   double volume_bound = std::min(volume[0], volume[1]);
   double surface_bound = 12.0 * std::min(volume[0] * gradient_max[0], volume[1] * gradient_max[1]);
   // One slab alone: the part of T within lambda_a <= mu is at most 3 mu of T's volume.
   for (int k = 0; k < 8; ++k) volume_bound = std::min(volume_bound, 3.0 * mu[k] * volume[k / 4]);
+  const auto nodal_force = [&] {
+    return penalty *
+           std::max(4.0 * gradient_max[0] * volume_bound + potential_bound[1] * surface_bound,
+                    4.0 * gradient_max[1] * volume_bound + potential_bound[0] * surface_bound);
+  };
+  const auto early = [&] {
+    bound.nodal_force = nodal_force();
+    bound.complete = !(bound.nodal_force <= enough);
+    return !bound.complete;
+  };
+  if (early()) return bound;
   double norm[8];
   for (int i = 0; i < thin_count; ++i) norm[i] = gradient[thin[i]]->norm();
   Vec3 cross[8][8];  // [i][j], i < j: g_thin[i] × g_thin[j]
@@ -133,6 +157,7 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
       const double perimeter = 2.0 * (mu[k] * norm[j] + mu[l] * norm[i]) / cross_norm;
       volume_bound = std::min(volume_bound, section * length);
       surface_bound = std::min(surface_bound, 2.0 * section + perimeter * length);
+      if (early()) return bound;
     }
   // Three slabs: a parallelepiped, thin in all three directions where a corner pokes into the
   // other tet (the prism above stays a whole edge long there).  Its edges are mu_k times the dual
@@ -149,15 +174,12 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
             surface_bound,
             2.0 * (mu[l] * mu[n] * norm[i] + mu[k] * mu[n] * norm[j] + mu[k] * mu[l] * norm[m]) /
                 det);
+        if (early()) return bound;
       }
-  PairForceBound bound;
   bound.volume = volume_bound;
   bound.surface = surface_bound;
-  bound.length = length;
-  bound.thinnest = *std::min_element(mu, mu + 8);
-  bound.nodal_force =
-      penalty * std::max(4.0 * gradient_max[0] * volume_bound + potential_bound[1] * surface_bound,
-                         4.0 * gradient_max[1] * volume_bound + potential_bound[0] * surface_bound);
+  bound.nodal_force = nodal_force();
+  bound.complete = true;
   bound.energy = penalty * volume_bound *
                  (std::min(1.0, potential_bound[0]) + std::min(1.0, potential_bound[1]));
   return bound;
@@ -244,9 +266,10 @@ inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   const double thinnest = slab_depths(frame, mu);  // the depth of the pressure: sets the limit
   if (!(thinnest < kThinSlab)) return 0;
   narrow_slab_depths(frame, mu, reach);
-  const PairForceBound bound = pair_force_bound(frame, reach, 1.0);
-  const double limit =
-      std::min(tolerance, kPressedFaceShare * thinnest) * bound.length * bound.length;
+  const double length = std::sqrt(
+      std::min(longest_edge_squared(frame.local[0]), longest_edge_squared(frame.local[1])));
+  const double limit = std::min(tolerance, kPressedFaceShare * thinnest) * length * length;
+  const PairForceBound bound = pair_force_bound(frame, reach, 1.0, limit);
   if (bound.nodal_force <= limit) return kEveryPiece;
   double piece[8];
   piece_force_bounds(frame, reach, bound, limit, piece);
