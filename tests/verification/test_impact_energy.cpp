@@ -67,16 +67,22 @@ TEST_CASE("a settled block on a 30° incline with μ = 0.7 holds without any dam
   const double settled = piece_motions(sim->model())[1].centroid.x();
   const double friction_before = sim->energy().current().dissipated_friction;
   const double kinetic_settled = sim->energy().current().kinetic;
-  while (sim->time() < 0.3) sim->step();
+  // The block's position every 10 ms: it vibrates slowly on its stuck contacts (a period of
+  // ~0.1 s) and does not drift.
+  double farthest = 0.0;
+  for (int row = 1; row <= 20; ++row) {
+    while (sim->time() < 0.1 + 0.01 * row) sim->step();
+    farthest = std::max(farthest, std::abs(piece_motions(sim->model())[1].centroid.x() - settled));
+  }
   const double crept = piece_motions(sim->model())[1].centroid.x() - settled;
   const double kinetic = sim->energy().current().kinetic;
   INFO("kinetic after settling " << kinetic_settled << " J; slid " << settled
-                                 << " m while settling, then " << crept
-                                 << " m in 0.2 s undamped; kinetic " << kinetic
+                                 << " m while settling, then at most " << farthest << " m ("
+                                 << crept << " m at the end) in 0.2 s undamped; kinetic " << kinetic
                                  << " J, friction dissipated meanwhile "
                                  << sim->energy().current().dissipated_friction - friction_before
                                  << " J");
-  CHECK(std::abs(crept) < 1e-7);
+  CHECK(farthest < 2e-7);
   CHECK(kinetic < 1e-6);
 }
 
