@@ -262,17 +262,19 @@ constexpr unsigned kEveryPiece = 0xFFu;
 
 inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   constexpr double kThinSlab = 1e-3;
-  double mu[8], reach[8];
+  double mu[8];
   const double thinnest = slab_depths(frame, mu);  // the depth of the pressure: sets the limit
   if (!(thinnest < kThinSlab)) return 0;
-  narrow_slab_depths(frame, mu, reach);
   const double length = std::sqrt(
       std::min(longest_edge_squared(frame.local[0]), longest_edge_squared(frame.local[1])));
   const double limit = std::min(tolerance, kPressedFaceShare * thinnest) * length * length;
-  const PairForceBound bound = pair_force_bound(frame, reach, 1.0, limit);
-  if (bound.nodal_force <= limit) return kEveryPiece;
-  double piece[8];
-  piece_force_bounds(frame, reach, bound, limit, piece);
+  // The pair as a whole is tried on its slab depths, its pieces on the depths narrowed by the caps.
+  // (Whole pairs skipped on the narrowed depths cost a block sliding over shifted meshes 2 % of
+  // its friction work against mu·N·s; leaving their pieces out instead does not.)
+  if (pair_force_bound(frame, mu, 1.0, limit).nodal_force <= limit) return kEveryPiece;
+  double reach[8], piece[8];
+  narrow_slab_depths(frame, mu, reach);
+  piece_force_bounds(frame, reach, pair_force_bound(frame, reach, 1.0), limit, piece);
   unsigned skipped = 0;
   for (int k = 0; k < 8; ++k) skipped |= piece[k] <= limit ? 1u << k : 0u;
   return skipped;
