@@ -77,8 +77,10 @@ inline double slab_depths(const TetPairFrame& frame, double (&mu)[8]) {
 // the larger tet's corners lie far out in every slab of the smaller (its mu near 1), though the
 // overlap is a sheet along the larger tet's face.  Only the faces T pokes through thinly
 // (mu_b^O < kPrismSlab) are tried: elsewhere the cap is most of T.
-inline void narrow_slab_depths(const TetPairFrame& frame, const double (&mu)[8],
+// True when some depth was narrowed.
+inline bool narrow_slab_depths(const TetPairFrame& frame, const double (&mu)[8],
                                double (&reach)[8]) {
+  bool narrowed = false;
   for (int k = 0; k < 8; ++k) reach[k] = mu[k];
   for (int T = 0; T < 2; ++T) {
     const int other = 1 - T;
@@ -88,10 +90,14 @@ inline void narrow_slab_depths(const TetPairFrame& frame, const double (&mu)[8],
       double beyond = 0.0;  // the largest lambda_b^O at a corner of T: mu_b^O unclamped
       for (int v = 0; v < 4; ++v) beyond = std::max(beyond, at_corner[v][b]);
       for (int a = 0; a < 4; ++a)
-        if (at_corner[a][b] < 0.0)
-          reach[4 * T + a] = std::min(reach[4 * T + a], beyond / (beyond - at_corner[a][b]));
+        if (at_corner[a][b] < 0.0) {
+          const double cap = beyond / (beyond - at_corner[a][b]);
+          narrowed = narrowed || cap < reach[4 * T + a];
+          reach[4 * T + a] = std::min(reach[4 * T + a], cap);
+        }
     }
   }
+  return narrowed;
 }
 
 // The bound from the slab depths of slab_depths (or narrowed by narrow_slab_depths); penalty in
@@ -271,10 +277,13 @@ inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   // The pair as a whole is tried on its slab depths, its pieces on the depths narrowed by the caps.
   // (Whole pairs skipped on the narrowed depths cost a block sliding over shifted meshes 2 % of
   // its friction work against mu·N·s; leaving their pieces out instead does not.)
-  if (pair_force_bound(frame, mu, 1.0, limit).nodal_force <= limit) return kEveryPiece;
+  const PairForceBound bound = pair_force_bound(frame, mu, 1.0, limit);
+  if (bound.nodal_force <= limit) return kEveryPiece;  // (else the bound is complete)
   double reach[8], piece[8];
-  narrow_slab_depths(frame, mu, reach);
-  piece_force_bounds(frame, reach, pair_force_bound(frame, reach, 1.0), limit, piece);
+  if (narrow_slab_depths(frame, mu, reach))
+    piece_force_bounds(frame, reach, pair_force_bound(frame, reach, 1.0), limit, piece);
+  else
+    piece_force_bounds(frame, mu, bound, limit, piece);
   unsigned skipped = 0;
   for (int k = 0; k < 8; ++k) skipped |= piece[k] <= limit ? 1u << k : 0u;
   return skipped;
