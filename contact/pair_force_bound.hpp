@@ -36,7 +36,6 @@ struct PairForceBound {
   double surface = 0.0;      // m^2: the area of the overlap's boundary is below it
   double length = 0.0;       // m: the shorter of the two tets' longest edges
   double thinnest = 1.0;     // the thinnest slab mu (barycentric): ~ depth / size when pressed
-  bool complete = true;      // false: stopped once nodal_force was low enough (pair_force_bound)
 };
 
 inline double longest_edge_squared(const Vec3 (&x)[4]) {
@@ -101,11 +100,11 @@ inline bool narrow_slab_depths(const TetPairFrame& frame, const double (&mu)[8],
 }
 
 // The bound from the slab depths of slab_depths (or narrowed by narrow_slab_depths); penalty in
-// Pa.  With `enough` >= 0 it returns as soon as its nodal force is at most `enough` (then
-// `complete` is false and only nodal_force, length and thinnest hold): each further prism only
-// lowers it, so whether the whole bound is at most `enough` is decided alike, for less.
+// Pa.  With `enough_share` >= 0 it returns as soon as its nodal force is at most
+// enough_share · length² (then only nodal_force, length and thinnest hold): each further prism
+// only lowers it, so whether the whole bound is that low is decided alike, for less.
 inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (&mu)[8],
-                                       double penalty, double enough = -1.0) {
+                                       double penalty, double enough_share = -1.0) {
   const Vec3* gradient[8];
   double potential_bound[2], gradient_max[2], volume[2];
   int thin[8], thin_count = 0;  // slabs thin enough for their prisms to matter
@@ -144,10 +143,10 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
            std::max(4.0 * gradient_max[0] * volume_bound + potential_bound[1] * surface_bound,
                     4.0 * gradient_max[1] * volume_bound + potential_bound[0] * surface_bound);
   };
+  const double enough = enough_share * length * length;
   const auto early = [&] {
     bound.nodal_force = nodal_force();
-    bound.complete = !(bound.nodal_force <= enough);
-    return !bound.complete;
+    return bound.nodal_force <= enough;
   };
   if (early()) return bound;
   double norm[8];
@@ -185,7 +184,6 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
   bound.volume = volume_bound;
   bound.surface = surface_bound;
   bound.nodal_force = nodal_force();
-  bound.complete = true;
   bound.energy = penalty * volume_bound *
                  (std::min(1.0, potential_bound[0]) + std::min(1.0, potential_bound[1]));
   return bound;
@@ -271,14 +269,13 @@ inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   double mu[8];
   const double thinnest = slab_depths(frame, mu);  // the depth of the pressure: sets the limit
   if (!(thinnest < kThinSlab)) return 0;
-  const double length = std::sqrt(
-      std::min(longest_edge_squared(frame.local[0]), longest_edge_squared(frame.local[1])));
-  const double limit = std::min(tolerance, kPressedFaceShare * thinnest) * length * length;
+  const double share = std::min(tolerance, kPressedFaceShare * thinnest);
   // The pair as a whole is tried on its slab depths, its pieces on the depths narrowed by the caps.
   // (Whole pairs skipped on the narrowed depths cost a block sliding over shifted meshes 2 % of
   // its friction work against mu·N·s; leaving their pieces out instead does not.)
-  const PairForceBound bound = pair_force_bound(frame, mu, 1.0, limit);
-  if (bound.nodal_force <= limit) return kEveryPiece;  // (else the bound is complete)
+  const PairForceBound bound = pair_force_bound(frame, mu, 1.0, share);
+  const double limit = share * bound.length * bound.length;
+  if (bound.nodal_force <= limit) return kEveryPiece;  // (else the bound is whole)
   double reach[8], piece[8];
   if (narrow_slab_depths(frame, mu, reach))
     piece_force_bounds(frame, reach, pair_force_bound(frame, reach, 1.0), limit, piece);

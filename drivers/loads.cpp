@@ -83,17 +83,18 @@ LoadsSettle loads_settle(const std::vector<LoadSpec>& loads) {
   return out;
 }
 
+std::string load_label(const Scene& scene, int index) {
+  const std::string& name = scene.loads[static_cast<std::size_t>(index)].name;
+  return name.empty() ? "loads[" + std::to_string(index) + "]" : "load '" + name + "'";
+}
+
 std::string describe_loads_settle(const Scene& scene, const LoadsSettle& settle) {
   if (settle.load < 0) return "no load changes";
   const LoadSpec& load = scene.loads[static_cast<std::size_t>(settle.load)];
   static const char* const kinds[] = {"a prescribed velocity", "a base motion", "a tilt", "a ramp",
                                       "a surface load"};
   std::ostringstream out;
-  if (load.name.empty())
-    out << "loads[" << settle.load << "]";
-  else
-    out << "load '" << load.name << "'";
-  out << ", " << kinds[static_cast<int>(load.kind)] << ", ";
+  out << load_label(scene, settle.load) << ", " << kinds[static_cast<int>(load.kind)] << ", ";
   if (settle.moving)
     out << "keeps its boundary moving to the end";
   else

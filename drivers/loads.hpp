@@ -46,6 +46,8 @@ LoadsSettle loads_settle(const std::vector<LoadSpec>& loads);
 LoadsSettle later(const LoadsSettle& a, const LoadsSettle& b);
 // "load 'table', a tilt, changes until t = 4.02 s" / "..., keeps its boundary moving to the end".
 std::string describe_loads_settle(const Scene& scene, const LoadsSettle& settle);
+// "load 'NAME'", or "loads[i]" for a load without a name (scene index i).
+std::string load_label(const Scene& scene, int index);
 
 class LoadSchedule {
  public:

@@ -210,17 +210,12 @@ int check(const fdem::Scene& scene) {
           "at equilibrium only once every load is constant%s (a monitor's stop_displacement "
           "can end it)\n",
           loads.c_str(), q.until < scene.time.end ? ", while the damping acts" : "");
-    if (ground_damped) {
-      const std::string& name = scene.loads[static_cast<std::size_t>(ground.load)].name;
+    if (ground_damped)
       std::printf(
           "  warning: the ground moves from t = %g s (%s, a base motion) while the quasi-static "
           "damping acts: it holds back the bodies the ground carries; end the damping before "
           "the record starts (quasi_static.until <= %g)\n",
-          ground.time,
-          (name.empty() ? "loads[" + std::to_string(ground.load) + "]" : "load '" + name + "'")
-              .c_str(),
-          ground.time);
-    }
+          ground.time, fdem::load_label(scene, ground.load).c_str(), ground.time);
   }
   std::printf("  stages:\n");
   for (const auto& s : sim->plan().describe()) std::printf("    %s\n", s.c_str());
