@@ -58,10 +58,11 @@ int main(int argc, char** argv) {
     double mu[8], reach[8], bound[8];  // as negligible_parts has them
     const double thinnest = slab_depths(frame, mu);
     narrow_slab_depths(frame, mu, reach);
-    const PairForceBound pair = pair_force_bound(frame, reach, 1.0);
+    const FrameMetrics metrics(frame);
+    const PairForceBound pair = pair_force_bound(frame, metrics.pair(), reach, 1.0);
     const double limit =
         std::min(tolerance, kPressedFaceShare * thinnest) * pair.length * pair.length;
-    piece_force_bounds(frame, reach, pair, std::numeric_limits<double>::infinity(), bound);
+    piece_force_bounds(metrics.pair(), reach, pair, std::numeric_limits<double>::infinity(), bound);
     double contribution[8] = {};
     for (int k = 0; k < 8; ++k) {
       if ((left_out >> k) & 1u) continue;

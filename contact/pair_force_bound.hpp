@@ -99,27 +99,40 @@ inline bool narrow_slab_depths(const TetPairFrame& frame, const double (&mu)[8],
   return narrowed;
 }
 
+// The two tets' gradient metrics ([0] contactor, [1] target), from the tets or from `frame`.
+struct PairMetrics {
+  const GradientMetrics* of[2];
+};
+struct FrameMetrics {
+  GradientMetrics metrics[2];
+  explicit FrameMetrics(const TetPairFrame& frame) {
+    for (int T = 0; T < 2; ++T)
+      gradient_metrics(frame.map[T].gradient, frame.map[T].edge_det, metrics[T]);
+  }
+  PairMetrics pair() const { return PairMetrics{{&metrics[0], &metrics[1]}}; }
+};
+
 // The bound from the slab depths of slab_depths (or narrowed by narrow_slab_depths); penalty in
-// Pa.  With `enough_share` >= 0 it returns as soon as its nodal force is at most
-// enough_share · length² (then only nodal_force, length and thinnest hold): each further prism
-// only lowers it, so whether the whole bound is that low is decided alike, for less.
-inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (&mu)[8],
-                                       double penalty, double enough_share = -1.0) {
+// Pa; `metrics` of frame's gradients.  With `enough_share` >= 0 it returns as soon as its nodal
+// force is at most enough_share · length² (then only nodal_force, length and thinnest hold): each
+// further prism only lowers it, so whether the whole bound is that low is decided alike, for less.
+inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetrics& metrics,
+                                       const double (&mu)[8], double penalty,
+                                       double enough_share = -1.0) {
   const Vec3* gradient[8];
   double potential_bound[2], gradient_max[2], volume[2];
   int thin[8], thin_count = 0;  // slabs thin enough for their prisms to matter
   for (int T = 0; T < 2; ++T) {
-    double smallest_mu = 1.0, largest_gradient_squared = 0.0;
+    double smallest_mu = 1.0;
     for (int a = 0; a < 4; ++a) {
       const int k = 4 * T + a;
       smallest_mu = std::min(smallest_mu, mu[k]);
       gradient[k] = &frame.map[T].gradient[a];
-      largest_gradient_squared = std::max(largest_gradient_squared, gradient[k]->squaredNorm());
       if (mu[k] < kPrismSlab) thin[thin_count++] = k;
     }
     potential_bound[T] = 4.0 * smallest_mu;
-    gradient_max[T] = std::sqrt(largest_gradient_squared);
-    volume[T] = std::abs(frame.map[T].edge_det) / 6.0;
+    gradient_max[T] = metrics.of[T]->largest;
+    volume[T] = metrics.of[T]->volume;
   }
   // The thinnest slabs first, and the prisms and parallelepipeds of the kMaxThinSlabs thinnest
   // only (their number grows as the cube of the slabs'; any of them bounds, so fewer leave the
@@ -150,13 +163,16 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const double (
   };
   if (early()) return bound;
   double norm[8];
-  for (int i = 0; i < thin_count; ++i) norm[i] = gradient[thin[i]]->norm();
+  for (int i = 0; i < thin_count; ++i) norm[i] = metrics.of[thin[i] / 4]->norm[thin[i] % 4];
   Vec3 cross[8][8];  // [i][j], i < j: g_thin[i] × g_thin[j]
   for (int i = 0; i < thin_count; ++i)
     for (int j = i + 1; j < thin_count; ++j) {
       const int k = thin[i], l = thin[j];
       cross[i][j] = gradient[k]->cross(*gradient[l]);
-      const double cross_norm = cross[i][j].norm();
+      // (within one tet the tet's own: the norm of g_l × g_k = −(g_k × g_l) is the same)
+      const double cross_norm = k / 4 == l / 4
+                                    ? metrics.of[k / 4]->cross_norm[kFacePair[k % 4][l % 4]]
+                                    : cross[i][j].norm();
       if (!(cross_norm > 0.0)) continue;
       const double section = mu[k] * mu[l] / cross_norm;
       const double perimeter = 2.0 * (mu[k] * norm[j] + mu[l] * norm[i]) / cross_norm;
@@ -195,7 +211,8 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty
   double mu[8], reach[8];
   const double thinnest = slab_depths(frame, mu);
   narrow_slab_depths(frame, mu, reach);
-  PairForceBound bound = pair_force_bound(frame, reach, penalty);
+  const FrameMetrics metrics(frame);
+  PairForceBound bound = pair_force_bound(frame, metrics.pair(), reach, penalty);
   bound.thinnest = thinnest;
   return bound;
 }
@@ -210,16 +227,16 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty
 // term it cancelled (<= Phi_T S on T's nodes; potential_contact.cpp adds it, so the forces stay
 // the gradient of the kept energy).  A tet whose every piece is sure to exceed `above` (or that
 // has no slab thinner than kPrismSlab) gets infinity, uncomputed.
-inline void piece_force_bounds(const TetPairFrame& frame, const double (&mu)[8],
+inline void piece_force_bounds(const PairMetrics& metrics, const double (&mu)[8],
                                const PairForceBound& pair, double above, double (&bound)[8]) {
   for (int T = 0; T < 2; ++T) {
     for (int i = 0; i < 4; ++i) bound[4 * T + i] = std::numeric_limits<double>::infinity();
     const double* own = mu + 4 * T;
     const double thinnest_own = std::min(std::min(own[0], own[1]), std::min(own[2], own[3]));
     if (!(thinnest_own < kPrismSlab)) continue;
-    const Vec3* gradient = frame.map[T].gradient;
-    double norm[4], largest = 0.0;
-    for (int a = 0; a < 4; ++a) largest = std::max(largest, norm[a] = gradient[a].norm());
+    const GradientMetrics& tet = *metrics.of[T];
+    const double(&norm)[4] = tet.norm;
+    const double largest = tet.largest;
     // Every section below is at least m_T² / G_T² (|g_a × g_b| <= G_T²).
     const double least_volume =
         std::min(pair.volume, thinnest_own * thinnest_own * pair.length / (largest * largest));
@@ -230,9 +247,8 @@ inline void piece_force_bounds(const TetPairFrame& frame, const double (&mu)[8],
     for (int i = 0; i < 4; ++i) volume[i] = pair.volume, surface[i] = pair.surface;
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) {
-        const double cross = gradient[a].cross(gradient[b]).norm();
-        if (!(cross > 0.0)) continue;
-        const double inverse_cross = 1.0 / cross;  // one division for the three prisms
+        if (!(tet.cross_norm[kFacePair[a][b]] > 0.0)) continue;
+        const double inverse_cross = tet.inverse_cross_norm[kFacePair[a][b]];
         const double nu[3][2] = {{own[a], own[b]}, {thinnest_own, own[b]}, {own[a], thinnest_own}};
         double prism_volume[3], prism_surface[3];
         for (int q = 0; q < 3; ++q) {
@@ -264,7 +280,8 @@ inline void piece_force_bounds(const TetPairFrame& frame, const double (&mu)[8],
 constexpr double kPressedFaceShare = 1e-3;
 constexpr unsigned kEveryPiece = 0xFFu;
 
-inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
+inline unsigned negligible_parts(const TetPairFrame& frame, const PairMetrics& metrics,
+                                 double tolerance) {
   constexpr double kThinSlab = 1e-3;
   double mu[8];
   const double thinnest = slab_depths(frame, mu);  // the depth of the pressure: sets the limit
@@ -273,17 +290,23 @@ inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
   // The pair as a whole is tried on its slab depths, its pieces on the depths narrowed by the caps.
   // (Whole pairs skipped on the narrowed depths cost a block sliding over shifted meshes 2 % of
   // its friction work against mu·N·s; leaving their pieces out instead does not.)
-  const PairForceBound bound = pair_force_bound(frame, mu, 1.0, share);
+  const PairForceBound bound = pair_force_bound(frame, metrics, mu, 1.0, share);
   const double limit = share * bound.length * bound.length;
   if (bound.nodal_force <= limit) return kEveryPiece;  // (else the bound is whole)
   double reach[8], piece[8];
   if (narrow_slab_depths(frame, mu, reach))
-    piece_force_bounds(frame, reach, pair_force_bound(frame, reach, 1.0), limit, piece);
+    piece_force_bounds(metrics, reach, pair_force_bound(frame, metrics, reach, 1.0), limit, piece);
   else
-    piece_force_bounds(frame, mu, bound, limit, piece);
+    piece_force_bounds(metrics, mu, bound, limit, piece);
   unsigned skipped = 0;
   for (int k = 0; k < 8; ++k) skipped |= piece[k] <= limit ? 1u << k : 0u;
   return skipped;
+}
+
+// The same with the metrics computed from `frame` (a single pair).
+inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
+  const FrameMetrics metrics(frame);
+  return negligible_parts(frame, metrics.pair(), tolerance);
 }
 
 }  // namespace fdem

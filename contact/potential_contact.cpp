@@ -371,7 +371,9 @@ ContactPairResult potential_contact(const PreparedContactor& contactor, const Te
     }
     return zero_result();
   }
-  const unsigned left_out = sliver_tolerance > 0.0 ? negligible_parts(frame, sliver_tolerance) : 0u;
+  const PairMetrics metrics{{&contactor.metrics, &target.metrics}};
+  const unsigned left_out =
+      sliver_tolerance > 0.0 ? negligible_parts(frame, metrics, sliver_tolerance) : 0u;
   if (left_out == kEveryPiece) return zero_result();
   // Apart at the step before though the face planes passed it: an edge–edge axis, mostly.
   if (memo && memo->apart_before != ClipMemo::kNotApart &&

@@ -186,6 +186,31 @@ struct TetPairFrame {
   double lambda_other[2][4][4];  // [s][v][a]: lambda of tet 1-s, component a, at corner v of s
 };
 
+// The lengths the sliver bounds (pair_force_bound.hpp) take from a tet's barycentric map:
+// computed once per tet and step for all its pairs, with the arithmetic the bounds would use, so
+// the same values bit for bit.
+struct GradientMetrics {
+  double norm[4];        // |grad lambda_a| (1/m): 1 / the height over face a
+  double largest;        // max_a norm[a] (1/m)
+  double cross_norm[6];  // |grad lambda_a x grad lambda_b| (1/m^2), a < b at kFacePair[a][b]
+  double inverse_cross_norm[6];  // 1 / cross_norm (m^2), 0 where cross_norm is not > 0
+  double volume;                 // |edge_det| / 6 (m^3)
+};
+// The slot of the gradients' pair {a, b}, a != b, in GradientMetrics (-1 on the diagonal).
+constexpr int kFacePair[4][4] = {{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}};
+
+inline void gradient_metrics(const Vec3 (&gradient)[4], double edge_det, GradientMetrics& out) {
+  out.volume = std::abs(edge_det) / 6.0;
+  out.largest = 0.0;
+  for (int a = 0; a < 4; ++a) out.largest = std::max(out.largest, out.norm[a] = gradient[a].norm());
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) {
+      const int k = kFacePair[a][b];
+      out.cross_norm[k] = gradient[a].cross(gradient[b]).norm();
+      out.inverse_cross_norm[k] = out.cross_norm[k] > 0.0 ? 1.0 / out.cross_norm[k] : 0.0;
+    }
+}
+
 // What a tet brings to every pair it is in: its corners and the origin-free part of its
 // barycentric map.  The contact stage computes it once per tet and step for all the tet's pairs
 // (a surface tet of a dense pile is in ~14); pairs built from it equal those built from the
@@ -196,8 +221,9 @@ struct TetGeometry {
   // Of face a, unit: gradient[a] / |gradient[a]|, where has_normals (the contact stage's tets,
   // whose normals serve all their pairs; a single pair computes them only if it overlaps).
   Vec3 inward_normal[4];
-  double edge_det = 0.0;  // m^3
-  bool valid = false;     // false: degenerate (flat or non-finite), overlaps nothing
+  GradientMetrics metrics;  // of `gradient`
+  double edge_det = 0.0;    // m^3
+  bool valid = false;       // false: degenerate (flat or non-finite), overlaps nothing
   bool has_normals = false;
 };
 
@@ -209,9 +235,12 @@ inline void compute_tet_geometry(const TetCorners& corners, TetGeometry& out,
     for (Vec3& g : out.gradient) g.setZero();
     out.edge_det = 0.0;
   }
+  gradient_metrics(out.gradient, out.edge_det, out.metrics);
   out.has_normals = with_normals;
-  if (with_normals)
-    for (int a = 0; a < 4; ++a) out.inward_normal[a] = out.gradient[a].normalized();
+  if (with_normals)  // gradient / |gradient|, as Eigen's normalized() (zero stays zero)
+    for (int a = 0; a < 4; ++a)
+      out.inward_normal[a] =
+          out.metrics.norm[a] > 0.0 ? Vec3(out.gradient[a] / out.metrics.norm[a]) : out.gradient[a];
 }
 
 // The tet's map about `origin` (its gradients and the offsets for that origin): the map
@@ -229,7 +258,8 @@ struct PreparedContactor {
   Vec3 origin;    // the centroid (m)
   Vec3 local[4];  // corners - origin (m)
   BarycentricMap map{};
-  Vec3 inward_normal[4];  // as TetGeometry's
+  Vec3 inward_normal[4];    // as TetGeometry's
+  GradientMetrics metrics;  // as TetGeometry's
   bool has_normals = false;
   bool valid = false;  // false: degenerate, overlaps nothing
 };
@@ -239,6 +269,7 @@ inline void prepare_contactor(const TetGeometry& contactor, PreparedContactor& o
   for (int v = 0; v < 4; ++v) out.local[v] = contactor.corners.x[v] - out.origin;
   out.has_normals = contactor.has_normals;
   if (contactor.has_normals) std::copy_n(contactor.inward_normal, 4, out.inward_normal);
+  out.metrics = contactor.metrics;
   out.valid = barycentric_map_about(contactor, out.origin, out.map);
 }
 

@@ -22,7 +22,7 @@ CornerTet lone_tet(const TetCorners& x, GlobalId first_gid) {
   CornerTet c;
   c.faces = 0xFFFFu;  // surface faces and fold edges; no fold vertex: nothing near a vertex
   for (int k = 0; k < 4; ++k) c.node_gid[k] = first_gid + k;
-  Vec3 gradient[4];
+  Vec3 gradient[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   double det = 0.0;
   REQUIRE(barycentric_gradients(x, gradient, det));
   for (int f = 0; f < 4; ++f) {

@@ -54,7 +54,8 @@ void kernel_piece_bounds(const TetPairFrame& frame, double (&reach)[8], double (
   double mu[8];
   slab_depths(frame, mu);
   narrow_slab_depths(frame, mu, reach);
-  piece_force_bounds(frame, reach, pair_force_bound(frame, reach, 1.0),
+  const FrameMetrics metrics(frame);
+  piece_force_bounds(metrics.pair(), reach, pair_force_bound(frame, metrics.pair(), reach, 1.0),
                      std::numeric_limits<double>::infinity(), piece);
 }
 
