@@ -241,26 +241,21 @@ inline void piece_force_bounds(const PairMetrics& metrics, const double (&mu)[8]
     const double least_volume =
         std::min(pair.volume, thinnest_own * thinnest_own * pair.length / (largest * largest));
     if (!(4.0 * largest * least_volume <= above)) continue;
-    // The prism of slabs a, b for piece i: its slab of face i thinned to m_T.  Pieces other than
-    // a and b share one prism, so each slab pair has three: [0] neither thinned, [1] a, [2] b.
+    // The prism of slabs a, b for piece i: its slab of face i thinned to m_T.  The four pieces
+    // side by side (one vector lane each).
     double volume[4], surface[4];
     for (int i = 0; i < 4; ++i) volume[i] = pair.volume, surface[i] = pair.surface;
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) {
         if (!(tet.cross_norm[kFacePair[a][b]] > 0.0)) continue;
         const double inverse_cross = tet.inverse_cross_norm[kFacePair[a][b]];
-        const double nu[3][2] = {{own[a], own[b]}, {thinnest_own, own[b]}, {own[a], thinnest_own}};
-        double prism_volume[3], prism_surface[3];
-        for (int q = 0; q < 3; ++q) {
-          const double section = nu[q][0] * nu[q][1] * inverse_cross;
-          const double perimeter = 2.0 * (nu[q][0] * norm[b] + nu[q][1] * norm[a]) * inverse_cross;
-          prism_volume[q] = section * pair.length;
-          prism_surface[q] = 2.0 * section + perimeter * pair.length;
-        }
         for (int i = 0; i < 4; ++i) {
-          const int q = i == a ? 1 : i == b ? 2 : 0;
-          volume[i] = std::min(volume[i], prism_volume[q]);
-          surface[i] = std::min(surface[i], prism_surface[q]);
+          const double nu_a = i == a ? thinnest_own : own[a];
+          const double nu_b = i == b ? thinnest_own : own[b];
+          const double section = nu_a * nu_b * inverse_cross;
+          const double perimeter = 2.0 * (nu_a * norm[b] + nu_b * norm[a]) * inverse_cross;
+          volume[i] = std::min(volume[i], section * pair.length);
+          surface[i] = std::min(surface[i], 2.0 * section + perimeter * pair.length);
         }
       }
     for (int i = 0; i < 4; ++i)
