@@ -72,12 +72,25 @@ class PairClipRecords {
 
 namespace piece_clip {
 
-// The faces of a clipped piece, each walked counter-clockwise seen from outside.
+// The faces of a clipped piece, each walked counter-clockwise seen from outside, in the layout of
+// the piece's record: face after face [size][planes, 16 bits: those all its vertices lie on][its
+// vertices].  `bytes` points into the record of the step before (a replay: nothing is copied) or
+// at `walked` (a fresh clip, whose record then copies them).
 struct PieceFaces {
+  static constexpr int kMaxBytes = 7 * kMaxVertices;  // 3 per face, 1 per face vertex: <= 6 n
   int count = 0;
-  std::uint8_t size[kMaxVertices];
-  unsigned planes[kMaxVertices];          // the planes all of a face's vertices lie on
-  std::uint8_t vertex[3 * kMaxVertices];  // face after face (each vertex is on 3 faces)
+  const std::uint8_t* bytes = nullptr;
+  std::uint8_t walked[kMaxBytes];
+
+  static unsigned planes_of(const std::uint8_t* face) {
+    return face[1] | (static_cast<unsigned>(face[2]) << 8);
+  }
+  // The length of the faces' bytes.
+  int length() const {
+    const std::uint8_t* at = bytes;
+    for (int f = 0; f < count; ++f) at += 3 + at[0];
+    return static_cast<int>(at - bytes);
+  }
 };
 
 // The faces of the piece's vertex graph, faces of fewer than three vertices dropped.  False for a
@@ -87,11 +100,12 @@ inline bool walk_faces(const Piece& piece, PieceFaces& faces) {
   bool used[kMaxVertices][3];
   for (int v = 0; v < n; ++v) used[v][0] = used[v][1] = used[v][2] = false;
   faces.count = 0;
-  int entries = 0;
+  faces.bytes = faces.walked;
+  int entries = 0;  // bytes written
   for (int vs = 0; vs < n; ++vs) {
     for (int es = 0; es < 3; ++es) {
       if (used[vs][es]) continue;
-      std::uint8_t* face = faces.vertex + entries;
+      std::uint8_t* face = faces.walked + entries + 3;
       int nf = 0;
       unsigned face_planes = ~0u;
       int vc = vs, e = es;
@@ -107,10 +121,12 @@ inline bool walk_faces(const Piece& piece, PieceFaces& faces) {
         e = b == 2 ? 0 : b + 1;
       } while (vc != vs && nf < kMaxVertices);
       if (nf < 3) continue;
-      faces.size[faces.count] = static_cast<std::uint8_t>(nf);
-      faces.planes[faces.count] = face_planes;
+      std::uint8_t* head = faces.walked + entries;
+      head[0] = static_cast<std::uint8_t>(nf);
+      head[1] = static_cast<std::uint8_t>(face_planes & 0xFFu);
+      head[2] = static_cast<std::uint8_t>((face_planes >> 8) & 0xFFu);
       ++faces.count;
-      entries += nf;
+      entries += 3 + nf;
     }
   }
   return true;
@@ -118,17 +134,10 @@ inline bool walk_faces(const Piece& piece, PieceFaces& faces) {
 
 // Appends the faces to a piece's log (the log turns invalid where they do not fit).
 inline void log_faces(const PieceFaces& faces, ClipLog& log) {
-  int entries = 0;
-  for (int f = 0; f < faces.count; ++f) entries += faces.size[f];
-  if (!log.room(1 + 3 * faces.count + entries)) return;
+  const int length = faces.length();
+  if (!log.room(1 + length)) return;
   log.put(static_cast<unsigned>(faces.count));
-  const std::uint8_t* vertex = faces.vertex;
-  for (int f = 0; f < faces.count; ++f) {
-    log.put(faces.size[f]);
-    log.put(faces.planes[f] & 0xFFu);
-    log.put((faces.planes[f] >> 8) & 0xFFu);
-    for (int j = 0; j < faces.size[f]; ++j) log.put(*vertex++);
-  }
+  for (int j = 0; j < length; ++j) log.put(faces.bytes[j]);
 }
 
 enum class Replay { kept, clipped_away, side_changed };
@@ -176,14 +185,7 @@ inline Replay replay_piece(Piece& piece, const std::uint8_t* bytes, const std::u
   }
   if (end - bytes < 1) return Replay::side_changed;
   faces.count = *bytes++;
-  int entries = 0;
-  for (int f = 0; f < faces.count; ++f) {
-    const int size = bytes[0];
-    faces.size[f] = static_cast<std::uint8_t>(size);
-    faces.planes[f] = bytes[1] | (static_cast<unsigned>(bytes[2]) << 8);
-    bytes += 3;
-    for (int j = 0; j < size; ++j) faces.vertex[entries++] = *bytes++;
-  }
+  faces.bytes = bytes;
   for (int j = 0; j < n; ++j) vertex[j] = &piece.v[current[j]];
   n_vertices = n;
   return Replay::kept;

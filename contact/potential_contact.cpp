@@ -33,10 +33,11 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
   for (int v = 0; v < n; ++v) volume_weight[v] = 0.0;
   const double* apex = vertex[0]->lam;  // apex: the first vertex of the piece
   double piece_vol6 = 0.0;
-  const std::uint8_t* face = faces.vertex;
-  for (int f = 0; f < faces.count; face += faces.size[f], ++f) {
-    const int nf = faces.size[f];
-    const unsigned face_planes = faces.planes[f];
+  const std::uint8_t* at = faces.bytes;
+  for (int f = 0; f < faces.count; at += 3 + at[0], ++f) {
+    const int nf = at[0];
+    const unsigned face_planes = PieceFaces::planes_of(at);
+    const std::uint8_t* face = at + 3;
     int other_face = -1;
     if (face_planes & kOtherFaceBits) {
       const unsigned bits = (face_planes & kOtherFaceBits) >> kOtherFaceShift;
