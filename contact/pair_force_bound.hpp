@@ -35,7 +35,6 @@ struct PairForceBound {
   double volume = 0.0;       // m^3: the overlap's volume is below it
   double surface = 0.0;      // m^2: the area of the overlap's boundary is below it
   double length = 0.0;       // m: the shorter of the two tets' longest edges
-  double thinnest = 1.0;     // the thinnest slab mu (barycentric): ~ depth / size when pressed
 };
 
 inline double longest_edge_squared(const Vec3 (&x)[4]) {
@@ -114,7 +113,7 @@ struct FrameMetrics {
 
 // The bound from the slab depths of slab_depths (or narrowed by narrow_slab_depths); penalty in
 // Pa; `metrics` of frame's gradients.  With `enough_share` >= 0 it returns as soon as its nodal
-// force is at most enough_share · length² (then only nodal_force, length and thinnest hold): each
+// force is at most enough_share · length² (then only nodal_force and length hold): each
 // further prism only lowers it, so whether the whole bound is that low is decided alike, for less.
 inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetrics& metrics,
                                        const double (&mu)[8], double penalty,
@@ -144,7 +143,6 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetr
   bound.length = std::sqrt(
       std::min(longest_edge_squared(frame.local[0]), longest_edge_squared(frame.local[1])));
   const double length = bound.length;
-  bound.thinnest = *std::min_element(mu, mu + 8);
 
   // Whole tets: face a's area is 3V |grad lambda_a| <= 3V G_T.
   double volume_bound = std::min(volume[0], volume[1]);
@@ -157,7 +155,8 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetr
                     4.0 * gradient_max[1] * volume_bound + potential_bound[0] * surface_bound);
   };
   const double enough = enough_share * length * length;
-  const auto early = [&] {
+  const auto early = [&] {  // (a whole bound is asked for: its force once, at the end)
+    if (!(enough_share >= 0.0)) return false;
     bound.nodal_force = nodal_force();
     return bound.nodal_force <= enough;
   };
@@ -206,15 +205,13 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetr
 }
 
 // `frame` as filled by prepare_tet_pair (the pair passed the face-plane test); penalty in Pa.  The
-// slab depths narrowed by caps; `thinnest` is the smallest slab depth as slab_depths gives it.
+// slab depths narrowed by caps.
 inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty) {
   double mu[8], reach[8];
-  const double thinnest = slab_depths(frame, mu);
+  slab_depths(frame, mu);
   narrow_slab_depths(frame, mu, reach);
   const FrameMetrics metrics(frame);
-  PairForceBound bound = pair_force_bound(frame, metrics.pair(), reach, penalty);
-  bound.thinnest = thinnest;
-  return bound;
+  return pair_force_bound(frame, metrics.pair(), reach, penalty);
 }
 
 // Per piece of a pair (sub-tet i of tet T clipped by the other tet: index 4T + i), an upper bound
