@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "contact/clip_topologies.hpp"
 #include "contact/piece_clipper.hpp"
 
 namespace fdem {
@@ -30,8 +31,11 @@ struct ClipMemo {
   const std::uint8_t* previous = nullptr;
   const std::uint8_t* previous_end = nullptr;
   std::vector<std::uint8_t>* record = nullptr;  // this evaluation's record is appended here
-  std::uint32_t replayed = 0;                   // pieces replayed from the record
-  std::uint32_t clipped = 0;                    // pieces clipped afresh
+  // The clips met before, where a piece's record no longer fits (clip_topologies.hpp); or null.
+  piece_clip::ClipTopologies* topologies = nullptr;
+  std::uint32_t replayed = 0;  // pieces replayed from the record or from the clips met before
+  std::uint32_t found = 0;     // of those, the pieces whose record did not fit
+  std::uint32_t clipped = 0;   // pieces clipped afresh
   // How the pair came out at the step before (kNotApart: overlapping, skipped or not evaluated;
   // kClippedEmpty: it passed the face planes and the bound but clipped to nothing;
   // kApartAtAxis + k: edge–edge axis k separated it; kApartAtPlane + j: face plane j did) and,
@@ -62,11 +66,13 @@ class PairClipRecords {
     memo.previous = read.empty() ? nullptr : read.data();
     memo.previous_end = read.data() + read.size();
     memo.record = &written;
+    memo.topologies = &topologies_;
     return memo;
   }
 
  private:
   std::vector<std::uint8_t> records_[2];
+  piece_clip::ClipTopologies topologies_;
   int parity_ = 0;
 };
 
@@ -188,6 +194,62 @@ inline Replay replay_piece(Piece& piece, const std::uint8_t* bytes, const std::u
   faces.bytes = bytes;
   for (int j = 0; j < n; ++j) vertex[j] = &piece.v[current[j]];
   n_vertices = n;
+  return Replay::kept;
+}
+
+// replay_piece along the clips met before: from the root of `sub_tet`, each plane's record is the
+// child reached by the outside mask.  side_changed where no clip met before fits; `terminal`
+// gets the node the clip ends at.
+inline Replay walk_topologies(Piece& piece, int sub_tet, const ClipTopologies& topologies,
+                              std::uint32_t& terminal, const PieceVertex** vertex, int& n_vertices,
+                              PieceFaces& faces) {
+  int slots[2][kMaxVertices];
+  int* current = slots[0];
+  int* next = slots[1];
+  for (int j = 0; j < 4; ++j) current[j] = j;
+  int n = 4, made = 4;
+  std::uint32_t at = topologies.root(sub_tet);
+  for (int b = 0; b < 4; ++b) {
+    const int k = 4 + b;
+    double dist[ClipLog::kMaxStageVertices];
+    unsigned mask = 0;
+    for (int j = 0; j < n; ++j) {
+      dist[j] = piece.v[current[j]].lam[k];
+      mask |= static_cast<unsigned>(dist[j] < 0.0) << j;
+    }
+    at = topologies.child(at, mask);
+    if (at == ClipTopologies::kNone) return Replay::side_changed;
+    if (mask == 0) continue;
+    if (mask == (1u << n) - 1u) {
+      terminal = at;
+      return Replay::clipped_away;
+    }
+    const ClipTopologies::Node& node = topologies.node(at);
+    const int n_new = node.n_new;
+    if (made + n_new > kMaxVertices) return Replay::side_changed;
+    const std::uint8_t* edges = topologies.bytes() + node.edges;
+    int kept = 0;
+    for (int j = 0; j < n; ++j)
+      if (!((mask >> j) & 1u)) next[kept++] = current[j];
+    const unsigned plane_bit = 1u << (kOtherFaceShift + b);
+    for (int q = 0; q < n_new; ++q, edges += 2) {
+      const int a = edges[0], c = edges[1];
+      cut_edge(piece.v[current[a]], piece.v[current[c]], dist[a], dist[c], k, plane_bit,
+               piece.v[made]);
+      next[kept++] = made++;
+    }
+    if (kept > ClipLog::kMaxStageVertices && b < 3) return Replay::side_changed;
+    std::swap(current, next);
+    n = kept;
+  }
+  const ClipTopologies::Node& node = topologies.node(at);
+  if (node.faces == ClipTopologies::kNone) return Replay::side_changed;
+  const std::uint8_t* bytes = topologies.bytes() + node.faces;
+  faces.count = *bytes++;
+  faces.bytes = bytes;
+  for (int j = 0; j < n; ++j) vertex[j] = &piece.v[current[j]];
+  n_vertices = n;
+  terminal = at;
   return Replay::kept;
 }
 

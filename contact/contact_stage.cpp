@@ -295,6 +295,7 @@ void ContactStage::release_until_rebind() {
   apart_pairs_.release();
   release(clip_records_[0]);
   release(clip_records_[1]);
+  clip_topologies_.clear();
   release(pair_tets_);
   release(pair_slots_);
   release(corner_tets_);
@@ -428,6 +429,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       record_start = clip_written.size();
       clip_written.resize(record_start + 2);  // the pair's length, once known
       memo.record = &clip_written;
+      memo.topologies = &clip_topologies_;
     }
     const ContactPairResult r =
         corners_ ? corner_contact(geometry_a, corner_tets_[slot_a], geometry_b,
@@ -444,6 +446,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         clip_record_at_[index] = static_cast<std::uint32_t>(record_start);
       }
       pieces_replayed_ += memo.replayed;
+      pieces_found_ += memo.found;
       pieces_clipped_ += memo.clipped;
       apart_at_[index] = memo.apart_now;
       apart_pairs_.found(index, pairs_.size(), slot_a, slot_b, memo.apart_gap);

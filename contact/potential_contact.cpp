@@ -115,12 +115,20 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
   }
 }
 
-// The record of piece `key` in the pair's record from the step before ([key][length][bytes]), or
+// The entry of piece `key` in the pair's record from the step before ([key][length][bytes]), or
 // null.  Pieces are looked up in the kernel's order, so the search resumes where it stopped.
 const std::uint8_t* find_recorded_piece(ClipMemo& memo, unsigned key) {
   const std::uint8_t*& at = memo.previous;
   while (at && memo.previous_end - at >= 2 && at[0] < key) at += 2 + at[1];
   return at && memo.previous_end - at >= 2 && at[0] == key ? at : nullptr;
+}
+
+// Appends a piece's clip record ([key][length][bytes]) to this step's record of the pair.
+void record_piece(std::vector<std::uint8_t>& record, unsigned key, const std::uint8_t* bytes,
+                  int length) {
+  record.push_back(static_cast<std::uint8_t>(key));
+  record.push_back(static_cast<std::uint8_t>(length));
+  record.insert(record.end(), bytes, bytes + length);
 }
 
 // The inward unit normals of the pair's faces: [0] contactor, [1] target (as TetGeometry's).
@@ -211,22 +219,31 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
       const double* other = (s == i) ? other_at_centroid : other_at_corner[s];
       for (int b = 0; b < 4; ++b) v.lam[4 + b] = other[b];
     }
-    // The piece's clip: replayed from the step before where every vertex kept its side of every
-    // plane (clip_replay.hpp), else clipped afresh (and recorded for the next step).
+    // The piece's clip: replayed where every vertex kept its side of every plane, from the pair's
+    // record of the step before (clip_replay.hpp) or else from a clip met before by any pair
+    // (clip_topologies.hpp); clipped afresh (and kept for the next time) where none fits.
     const unsigned key = 4u * static_cast<unsigned>(own) + static_cast<unsigned>(i);
     const PieceVertex* vertex[kMaxVertices];
     int n_vertices = 0;
     PieceFaces faces;
     const std::uint8_t* recorded = memo ? find_recorded_piece(*memo, key) : nullptr;
-    const Replay replay = recorded ? replay_piece(piece, recorded + 2, recorded + 2 + recorded[1],
-                                                  vertex, n_vertices, faces)
-                                   : Replay::side_changed;
+    Replay replay = recorded ? replay_piece(piece, recorded + 2, recorded + 2 + recorded[1], vertex,
+                                            n_vertices, faces)
+                             : Replay::side_changed;
+    ClipTopologies* const topologies = memo ? memo->topologies : nullptr;
+    if (replay == Replay::side_changed && topologies) {
+      std::uint32_t terminal = ClipTopologies::kNone;
+      replay = walk_topologies(piece, i, *topologies, terminal, vertex, n_vertices, faces);
+      if (replay != Replay::side_changed) {
+        ++memo->found;
+        recorded = topologies->bytes() + topologies->node(terminal).record - 1;  // [.][length]
+      }
+    }
     bool alive = replay == Replay::kept;
     bool walked = alive;
     if (replay != Replay::side_changed) {
       ++memo->replayed;
-      if (memo->record)
-        memo->record->insert(memo->record->end(), recorded, recorded + 2 + recorded[1]);
+      if (memo->record) record_piece(*memo->record, key, recorded + 2, recorded[1]);
     } else {
       ClipLog log;
       ClipLog* const logged = memo && memo->record ? &log : nullptr;
@@ -242,9 +259,8 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
       if (logged && alive == walked) {
         if (walked) log_faces(faces, log);
         if (log.valid) {
-          memo->record->push_back(static_cast<std::uint8_t>(key));
-          memo->record->push_back(static_cast<std::uint8_t>(log.size));
-          memo->record->insert(memo->record->end(), log.bytes, log.bytes + log.size);
+          record_piece(*memo->record, key, log.bytes, log.size);
+          if (topologies) topologies->add(i, log.bytes, log.size);
         }
       }
     }

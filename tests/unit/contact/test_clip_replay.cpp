@@ -160,3 +160,108 @@ TEST_CASE("a clip log replays the clipper's own vertices", "[contact][clip_repla
   for (int s = 0; s < 4; ++s)
     CHECK(std::memcmp(moved.v[s].lam, before.v[s].lam, sizeof(before.v[s].lam)) == 0);
 }
+
+TEST_CASE("a piece whose record no longer fits finds a clip met before, bit for bit",
+          "[contact][clip_replay]") {
+  // Aligned meshes: the upper tet's corners hover over the lower tet's side planes, so a piece's
+  // clip swings between a few graphs.  Each pair here is evaluated at two positions in turn: after
+  // the first two evaluations every clip has been met, and none is clipped afresh again.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  long mismatches = 0;
+  std::uint64_t found = 0, clipped_later = 0;
+  for (int p = 0; p < 100; ++p) {
+    TetCorners lower, upper;
+    face_on_face(rng, 1e-4, lower, upper);
+    TetCorners shifted = upper;  // every corner moved across some plane and back
+    for (int v = 0; v < 4; ++v) shifted.x[v] += 0.05 * Vec3(u(rng), u(rng), 0.0);
+    PairClipRecords records;
+    for (int step = 0; step < 6; ++step) {
+      const TetCorners& now = step % 2 ? shifted : upper;
+      PreparedContactor prepared;
+      prepare_contactor(now, prepared);
+      TetGeometry geometry;
+      compute_tet_geometry(lower, geometry);
+      const ContactPairResult fresh = potential_contact(prepared, geometry, 1e9, 1e-6);
+      ClipMemo memo = records.next();
+      const ContactPairResult replayed = potential_contact(prepared, geometry, 1e9, 1e-6, &memo);
+      mismatches += same_bits(fresh, replayed) ? 0 : 1;
+      if (step >= 2) {
+        found += memo.found;
+        clipped_later += memo.clipped;
+      }
+    }
+  }
+  INFO(found << " found, " << clipped_later << " clipped afresh after the first two steps");
+  CHECK(mismatches == 0);
+  CHECK(found > 100);
+  CHECK(clipped_later == 0);
+}
+
+TEST_CASE("the clips met before keep one node per graph and find each by its masks",
+          "[contact][clip_replay]") {
+  using namespace piece_clip;
+  // A sub-tet's corners with the other tet's barycentrics; clipped and added, then walked.
+  const auto piece_with = [](const double(&other)[4][4]) {
+    Piece piece;
+    piece.count = 4;
+    for (int s = 0; s < 4; ++s) {
+      for (int a = 0; a < 4; ++a) piece.v[s].lam[a] = a == s ? 1.0 : 0.0;
+      for (int b = 0; b < 4; ++b) piece.v[s].lam[4 + b] = other[s][b];
+      for (int e = 0; e < 3; ++e) piece.v[s].next[e] = kTetNeighbours[s][e];
+      piece.v[s].planes = 0;
+    }
+    return piece;
+  };
+  const double cut[4][4] = {
+      {0.6, 0.2, -0.3, 0.5}, {-0.2, 0.7, 0.4, 0.1}, {0.3, -0.4, 0.6, 0.5}, {0.4, 0.5, 0.3, -0.2}};
+  const double away[4][4] = {
+      {-0.6, 0.2, 0.3, 0.5}, {-0.2, 0.7, 0.4, 0.1}, {-0.3, 0.4, 0.6, 0.5}, {-0.4, 0.5, 0.3, 0.2}};
+  ClipTopologies topologies;
+  const PieceVertex* vertex[kMaxVertices];
+  int n = 0;
+  PieceFaces faces;
+  std::uint32_t terminal = ClipTopologies::kNone;
+  Piece unknown = piece_with(cut);
+  CHECK(walk_topologies(unknown, 2, topologies, terminal, vertex, n, faces) ==
+        Replay::side_changed);
+
+  Piece fresh = piece_with(cut);
+  ClipLog log;
+  for (int b = 0; b < 4; ++b) REQUIRE(clip_piece(fresh, 4 + b, 1u << (kOtherFaceShift + b), &log));
+  PieceFaces fresh_faces;
+  REQUIRE(walk_faces(fresh, fresh_faces));
+  log_faces(fresh_faces, log);
+  REQUIRE(log.valid);
+  const std::uint32_t added = topologies.add(2, log.bytes, log.size);
+  REQUIRE(added != ClipTopologies::kNone);
+  const std::size_t nodes = topologies.size();
+  CHECK(topologies.add(2, log.bytes, log.size) == added);  // the same graph: no new node
+  CHECK(topologies.size() == nodes);
+  CHECK(topologies.node(added).depth == 4);
+
+  Piece again = piece_with(cut);
+  REQUIRE(walk_topologies(again, 2, topologies, terminal, vertex, n, faces) == Replay::kept);
+  CHECK(terminal == added);
+  REQUIRE(n == fresh.count);
+  for (int v = 0; v < n; ++v)
+    CHECK(std::memcmp(vertex[v]->lam, fresh.v[v].lam, sizeof(fresh.v[v].lam)) == 0);
+  REQUIRE(faces.length() == fresh_faces.length());
+  CHECK(std::memcmp(faces.bytes, fresh_faces.bytes, static_cast<std::size_t>(faces.length())) == 0);
+  // Another sub-tet has its own root: the same masks do not lead there.
+  Piece other_root = piece_with(cut);
+  CHECK(walk_topologies(other_root, 1, topologies, terminal, vertex, n, faces) ==
+        Replay::side_changed);
+
+  // A piece every corner of which lies outside plane 0: cut off whole, found as such once added.
+  Piece gone = piece_with(away);
+  ClipLog gone_log;
+  REQUIRE_FALSE(clip_piece(gone, 4, 1u << kOtherFaceShift, &gone_log));
+  REQUIRE(gone_log.valid);
+  const std::uint32_t cut_off = topologies.add(2, gone_log.bytes, gone_log.size);
+  REQUIRE(cut_off != ClipTopologies::kNone);
+  Piece gone_again = piece_with(away);
+  CHECK(walk_topologies(gone_again, 2, topologies, terminal, vertex, n, faces) ==
+        Replay::clipped_away);
+  CHECK(terminal == cut_off);
+}
