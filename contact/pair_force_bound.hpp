@@ -224,10 +224,13 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, double penalty
 // term it cancelled (<= Phi_T S on T's nodes; potential_contact.cpp adds it, so the forces stay
 // the gradient of the kept energy).  A tet whose every piece is sure to exceed `above` (or that
 // has no slab thinner than kPrismSlab) gets infinity, uncomputed.
+// Only the tets in `tets` (bit T) are bounded; the others' pieces get infinity.
 inline void piece_force_bounds(const PairMetrics& metrics, const double (&mu)[8],
-                               const PairForceBound& pair, double above, double (&bound)[8]) {
+                               const PairForceBound& pair, double above, double (&bound)[8],
+                               unsigned tets = 3u) {
   for (int T = 0; T < 2; ++T) {
     for (int i = 0; i < 4; ++i) bound[4 * T + i] = std::numeric_limits<double>::infinity();
+    if (!((tets >> T) & 1u)) continue;
     const double* own = mu + 4 * T;
     const double thinnest_own = std::min(std::min(own[0], own[1]), std::min(own[2], own[3]));
     if (!(thinnest_own < kPrismSlab)) continue;
@@ -286,11 +289,26 @@ inline unsigned negligible_parts(const TetPairFrame& frame, const PairMetrics& m
   const double limit = share * bound.length * bound.length;
   if (bound.nodal_force <= limit) return kEveryPiece;  // (else the bound is whole)
   double reach[8], piece[8];
-  if (narrow_slab_depths(frame, mu, reach))
-    piece_force_bounds(metrics, reach, pair_force_bound(frame, metrics, reach, 1.0), limit, piece);
-  else
-    piece_force_bounds(metrics, mu, bound, limit, piece);
-  unsigned skipped = 0;
+  const bool narrowed = narrow_slab_depths(frame, mu, reach);
+  const double(&depth)[8] = narrowed ? reach : mu;
+  const PairForceBound caps = narrowed ? pair_force_bound(frame, metrics, reach, 1.0) : bound;
+  // A tet whose pieces are all below the limit on the pair's caps alone: each piece's bound is
+  // the same sum of the same products of numbers no larger (rounding keeps the order), so the
+  // same pieces are left out without their prisms.  (In the dry-stone wall every pair all of
+  // whose pieces are left out is decided so.)
+  unsigned skipped = 0, tets = 0;
+  for (int T = 0; T < 2; ++T) {
+    const double* own = depth + 4 * T;
+    const double thinnest_own = std::min(std::min(own[0], own[1]), std::min(own[2], own[3]));
+    const double largest = metrics.of[T]->largest;
+    if (thinnest_own < kPrismSlab &&
+        4.0 * largest * caps.volume + 4.0 * thinnest_own * caps.surface <= limit)
+      skipped |= 0xFu << (4 * T);
+    else
+      tets |= 1u << T;
+  }
+  if (tets == 0) return skipped;
+  piece_force_bounds(metrics, depth, caps, limit, piece, tets);
   for (int k = 0; k < 8; ++k) skipped |= piece[k] <= limit ? 1u << k : 0u;
   return skipped;
 }

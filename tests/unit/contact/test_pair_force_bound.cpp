@@ -398,3 +398,60 @@ TEST_CASE("the bounds hold where a fine mesh presses on a coarse one, and its sl
   CHECK(skipped_pairs > 100);
   CHECK(pressed_skipped == 0);
 }
+
+namespace {
+// negligible_parts as it was before the caps alone could decide a tet: every tet's pieces bounded
+// with their prisms.
+unsigned negligible_parts_with_every_prism(const TetPairFrame& frame, double tolerance) {
+  double mu[8];
+  const double thinnest = slab_depths(frame, mu);
+  if (!(thinnest < 1e-3)) return 0;
+  const double share = std::min(tolerance, kPressedFaceShare * thinnest);
+  const FrameMetrics metrics(frame);
+  const PairForceBound bound = pair_force_bound(frame, metrics.pair(), mu, 1.0, share);
+  const double limit = share * bound.length * bound.length;
+  if (bound.nodal_force <= limit) return kEveryPiece;
+  double reach[8], piece[8];
+  if (narrow_slab_depths(frame, mu, reach))
+    piece_force_bounds(metrics.pair(), reach, pair_force_bound(frame, metrics.pair(), reach, 1.0),
+                       limit, piece);
+  else
+    piece_force_bounds(metrics.pair(), mu, bound, limit, piece);
+  unsigned skipped = 0;
+  for (int k = 0; k < 8; ++k) skipped |= piece[k] <= limit ? 1u << k : 0u;
+  return skipped;
+}
+}  // namespace
+
+TEST_CASE("the caps alone leave out the same pieces as every piece's prisms", "[contact]") {
+  // Pressed interfaces of matched and shifted meshes from 1e-9 to 1e-3 deep, and random pairs.
+  int pairs = 0, differ = 0, all_left_out = 0, some_kept = 0;
+  const auto compare = [&](const TetCorners& c, const TetCorners& t, double tolerance) {
+    TetPairFrame frame;
+    if (!prepare_tet_pair(c, t, frame)) return;
+    const unsigned now = negligible_parts(frame, tolerance);
+    const unsigned before = negligible_parts_with_every_prism(frame, tolerance);
+    ++pairs;
+    differ += now != before;
+    all_left_out += now == kEveryPiece;
+    some_kept += now != 0 && now != kEveryPiece;
+  };
+  for (const double depth : {1e-9, 1e-7, 1e-5, 1e-3})
+    for_pressed_interfaces(
+        depth, [&](const std::vector<TetCorners>& upper, const std::vector<TetCorners>& lower) {
+          for (const TetCorners& c : upper)
+            for (const TetCorners& t : lower)
+              for (const double tolerance : {1e-9, 1e-6, 1e-3}) compare(c, t, tolerance);
+        });
+  std::mt19937_64 rng(5);
+  for (int p = 0; p < 2000; ++p) {
+    TetCorners c, t;
+    random_overlapping_pair(rng, Vec3::Zero(), c, t);
+    compare(c, t, 1e-6);
+  }
+  INFO(pairs << " pairs: " << all_left_out << " left out whole, " << some_kept
+             << " with some pieces kept");
+  CHECK(differ == 0);
+  CHECK(all_left_out > 100);
+  CHECK(some_kept > 100);
+}
