@@ -276,7 +276,7 @@ constexpr double kPressedFaceShare = 1e-3;
 constexpr unsigned kEveryPiece = 0xFFu;
 
 inline unsigned negligible_parts(const TetPairFrame& frame, const PairMetrics& metrics,
-                                 double tolerance) {
+                                 double tolerance, bool kept_before = false) {
   constexpr double kThinSlab = 1e-3;
   double mu[8];
   const double thinnest = slab_depths(frame, mu);  // the depth of the pressure: sets the limit
@@ -285,13 +285,34 @@ inline unsigned negligible_parts(const TetPairFrame& frame, const PairMetrics& m
   // The pair as a whole is tried on its slab depths, its pieces on the depths narrowed by the caps.
   // (Whole pairs skipped on the narrowed depths cost a block sliding over shifted meshes 2 % of
   // its friction work against mu·N·s; leaving their pieces out instead does not.)
-  const PairForceBound bound = pair_force_bound(frame, metrics, mu, 1.0, share);
-  const double limit = share * bound.length * bound.length;
-  if (bound.nodal_force <= limit) return kEveryPiece;  // (else the bound is whole)
   double reach[8], piece[8];
-  const bool narrowed = narrow_slab_depths(frame, mu, reach);
+  bool narrowed = false;
+  // With at most two slabs under kPrismSlab on the narrowed depths (a pressed face: one per tet),
+  // the bound on them has every term of the bound on the slab depths (thin there means thin
+  // here), each from no larger depths, with the same roundings: above the limit, it proves the
+  // pair's own bound above it too, which then need not be computed.  Tried first for a pair that
+  // kept pieces at the step before (`kept_before`: a hint, the decisions are the same without);
+  // most others are left out whole on the slab depths alone.
+  PairForceBound caps;
+  bool caps_known = false;
+  if (kept_before) {
+    narrowed = narrow_slab_depths(frame, mu, reach);
+    int thin_narrowed = 0;
+    for (int k = 0; k < 8; ++k) thin_narrowed += reach[k] < kPrismSlab;
+    if (narrowed && thin_narrowed <= 2) {
+      caps = pair_force_bound(frame, metrics, reach, 1.0);
+      caps_known = true;
+    }
+  }
+  double limit = share * caps.length * caps.length;
+  if (!caps_known || !(caps.nodal_force > limit)) {
+    const PairForceBound bound = pair_force_bound(frame, metrics, mu, 1.0, share);
+    limit = share * bound.length * bound.length;
+    if (bound.nodal_force <= limit) return kEveryPiece;  // (else the bound is whole)
+    if (!kept_before) narrowed = narrow_slab_depths(frame, mu, reach);
+    if (!caps_known) caps = narrowed ? pair_force_bound(frame, metrics, reach, 1.0) : bound;
+  }
   const double(&depth)[8] = narrowed ? reach : mu;
-  const PairForceBound caps = narrowed ? pair_force_bound(frame, metrics, reach, 1.0) : bound;
   // A tet whose pieces are all below the limit on the pair's caps alone: each piece's bound is
   // the same sum of the same products of numbers no larger (rounding keeps the order), so the
   // same pieces are left out without their prisms.  (In the dry-stone wall every pair all of
@@ -314,9 +335,10 @@ inline unsigned negligible_parts(const TetPairFrame& frame, const PairMetrics& m
 }
 
 // The same with the metrics computed from `frame` (a single pair).
-inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance) {
+inline unsigned negligible_parts(const TetPairFrame& frame, double tolerance,
+                                 bool kept_before = false) {
   const FrameMetrics metrics(frame);
-  return negligible_parts(frame, metrics.pair(), tolerance);
+  return negligible_parts(frame, metrics.pair(), tolerance, kept_before);
 }
 
 }  // namespace fdem

@@ -302,8 +302,9 @@ PairNormals unit_normals(const TetPairFrame& frame, Vec3 (&normals)[2][4]) {
 
 // The sliver bounds, built alike.
 FDEM_CONTACT_CLONES unsigned negligible_parts_of(const TetPairFrame& frame,
-                                                 const PairMetrics& metrics, double tolerance) {
-  return negligible_parts(frame, metrics, tolerance);
+                                                 const PairMetrics& metrics, double tolerance,
+                                                 bool kept_before) {
+  return negligible_parts(frame, metrics, tolerance, kept_before);
 }
 
 FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
@@ -396,7 +397,9 @@ ContactPairResult potential_contact(const PreparedContactor& contactor, const Te
   }
   const PairMetrics metrics{{&contactor.metrics, &target.metrics}};
   const unsigned left_out =
-      sliver_tolerance > 0.0 ? negligible_parts_of(frame, metrics, sliver_tolerance) : 0u;
+      sliver_tolerance > 0.0
+          ? negligible_parts_of(frame, metrics, sliver_tolerance, memo && memo->previous)
+          : 0u;
   if (left_out == kEveryPiece) return zero_result();
   // Apart at the step before though the face planes passed it: an edge–edge axis, mostly.
   if (memo && memo->apart_before != ClipMemo::kNotApart &&
