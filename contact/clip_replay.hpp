@@ -148,52 +148,85 @@ inline void log_faces(const PieceFaces& faces, ClipLog& log) {
 
 enum class Replay { kept, clipped_away, side_changed };
 
+// The vertices alive while a recorded clip is redone plane after plane (replay_piece,
+// walk_topologies): slots of piece.v, the sub-tet's four first and the new ones appended.
+class ReplayedVertices {
+ public:
+  ReplayedVertices() {
+    for (int j = 0; j < 4; ++j) current_[j] = j;
+  }
+  ReplayedVertices(const ReplayedVertices&) = delete;
+  ReplayedVertices& operator=(const ReplayedVertices&) = delete;
+
+  // Bit j: alive vertex j lies outside plane k (lam[k] < 0).
+  unsigned outside(const Piece& piece, int k) {
+    unsigned mask = 0;
+    for (int j = 0; j < n_; ++j) {
+      dist_[j] = piece.v[current_[j]].lam[k];
+      mask |= static_cast<unsigned>(dist_[j] < 0.0) << j;
+    }
+    return mask;
+  }
+  bool all(unsigned mask) const { return mask == (1u << n_) - 1u; }
+  // Plane b (index k = 4 + b) with outside mask `mask`: keeps the vertices inside and makes one
+  // on each recorded edge (`edges`: n_new pairs of alive indices, kept end first).  False where
+  // they would not fit (cannot happen for the kernel's records: clip afresh).
+  bool cut(Piece& piece, int b, unsigned mask, const std::uint8_t* edges, int n_new) {
+    if (made_ + n_new > kMaxVertices) return false;
+    const int k = 4 + b;
+    int kept = 0;
+    for (int j = 0; j < n_; ++j)
+      if (!((mask >> j) & 1u)) next_[kept++] = current_[j];
+    const unsigned plane_bit = 1u << (kOtherFaceShift + b);
+    for (int q = 0; q < n_new; ++q, edges += 2) {
+      const int a = edges[0], c = edges[1];
+      cut_edge(piece.v[current_[a]], piece.v[current_[c]], dist_[a], dist_[c], k, plane_bit,
+               piece.v[made_]);
+      next_[kept++] = made_++;
+    }
+    if (kept > ClipLog::kMaxStageVertices && b < 3) return false;
+    std::swap(current_, next_);
+    n_ = kept;
+    return true;
+  }
+  // The piece's vertices, in the clipper's order.
+  void hand_out(const Piece& piece, const PieceVertex** vertex, int& n_vertices) const {
+    for (int j = 0; j < n_; ++j) vertex[j] = &piece.v[current_[j]];
+    n_vertices = n_;
+  }
+
+ private:
+  int slots_[2][kMaxVertices];
+  int* current_ = slots_[0];
+  int* next_ = slots_[1];
+  int n_ = 4, made_ = 4;
+  double dist_[ClipLog::kMaxStageVertices];
+};
+
 // Redoes the clip of `piece` (its sub-tet's four vertices in v[0..3], graph unused) from the
 // record `bytes`: new vertices are appended to piece.v from slot 4 on; `vertex` gets the kept
 // piece's vertices in the clipper's order and `faces` its faces.  side_changed: some vertex lies
 // on the other side of a plane than in the record (piece.v[0..3] are untouched: clip afresh).
 inline Replay replay_piece(Piece& piece, const std::uint8_t* bytes, const std::uint8_t* end,
                            const PieceVertex** vertex, int& n_vertices, PieceFaces& faces) {
-  int slots[2][kMaxVertices];  // the vertices alive before and after a plane, as pool slots
-  int* current = slots[0];
-  int* next = slots[1];
-  for (int j = 0; j < 4; ++j) current[j] = j;
-  int n = 4, made = 4;
+  ReplayedVertices alive;
   for (int b = 0; b < 4; ++b) {
     if (end - bytes < 2) return Replay::side_changed;  // cannot happen: records are the kernel's
     const unsigned recorded = bytes[0] | (static_cast<unsigned>(bytes[1]) << 8);
     bytes += 2;
-    const int k = 4 + b;
-    double dist[ClipLog::kMaxStageVertices];
-    unsigned mask = 0;
-    for (int j = 0; j < n; ++j) {
-      dist[j] = piece.v[current[j]].lam[k];
-      mask |= static_cast<unsigned>(dist[j] < 0.0) << j;
-    }
+    const unsigned mask = alive.outside(piece, 4 + b);
     if (mask != recorded) return Replay::side_changed;
     if (mask == 0) continue;
-    if (mask == (1u << n) - 1u) return Replay::clipped_away;
+    if (alive.all(mask)) return Replay::clipped_away;
     const int n_new = *bytes++;
-    if (end - bytes < 2 * n_new || made + n_new > kMaxVertices) return Replay::side_changed;
-    int kept = 0;
-    for (int j = 0; j < n; ++j)
-      if (!((mask >> j) & 1u)) next[kept++] = current[j];
-    const unsigned plane_bit = 1u << (kOtherFaceShift + b);
-    for (int q = 0; q < n_new; ++q, bytes += 2) {
-      const int a = bytes[0], c = bytes[1];
-      cut_edge(piece.v[current[a]], piece.v[current[c]], dist[a], dist[c], k, plane_bit,
-               piece.v[made]);
-      next[kept++] = made++;
-    }
-    if (kept > ClipLog::kMaxStageVertices && b < 3) return Replay::side_changed;
-    std::swap(current, next);
-    n = kept;
+    if (end - bytes < 2 * n_new || !alive.cut(piece, b, mask, bytes, n_new))
+      return Replay::side_changed;
+    bytes += 2 * n_new;
   }
   if (end - bytes < 1) return Replay::side_changed;
   faces.count = *bytes++;
   faces.bytes = bytes;
-  for (int j = 0; j < n; ++j) vertex[j] = &piece.v[current[j]];
-  n_vertices = n;
+  alive.hand_out(piece, vertex, n_vertices);
   return Replay::kept;
 }
 
@@ -203,52 +236,27 @@ inline Replay replay_piece(Piece& piece, const std::uint8_t* bytes, const std::u
 inline Replay walk_topologies(Piece& piece, int sub_tet, const ClipTopologies& topologies,
                               std::uint32_t& terminal, const PieceVertex** vertex, int& n_vertices,
                               PieceFaces& faces) {
-  int slots[2][kMaxVertices];
-  int* current = slots[0];
-  int* next = slots[1];
-  for (int j = 0; j < 4; ++j) current[j] = j;
-  int n = 4, made = 4;
+  ReplayedVertices alive;
   std::uint32_t at = topologies.root(sub_tet);
   for (int b = 0; b < 4; ++b) {
-    const int k = 4 + b;
-    double dist[ClipLog::kMaxStageVertices];
-    unsigned mask = 0;
-    for (int j = 0; j < n; ++j) {
-      dist[j] = piece.v[current[j]].lam[k];
-      mask |= static_cast<unsigned>(dist[j] < 0.0) << j;
-    }
+    const unsigned mask = alive.outside(piece, 4 + b);
     at = topologies.child(at, mask);
     if (at == ClipTopologies::kNone) return Replay::side_changed;
     if (mask == 0) continue;
-    if (mask == (1u << n) - 1u) {
+    if (alive.all(mask)) {
       terminal = at;
       return Replay::clipped_away;
     }
     const ClipTopologies::Node& node = topologies.node(at);
-    const int n_new = node.n_new;
-    if (made + n_new > kMaxVertices) return Replay::side_changed;
-    const std::uint8_t* edges = topologies.bytes() + node.edges;
-    int kept = 0;
-    for (int j = 0; j < n; ++j)
-      if (!((mask >> j) & 1u)) next[kept++] = current[j];
-    const unsigned plane_bit = 1u << (kOtherFaceShift + b);
-    for (int q = 0; q < n_new; ++q, edges += 2) {
-      const int a = edges[0], c = edges[1];
-      cut_edge(piece.v[current[a]], piece.v[current[c]], dist[a], dist[c], k, plane_bit,
-               piece.v[made]);
-      next[kept++] = made++;
-    }
-    if (kept > ClipLog::kMaxStageVertices && b < 3) return Replay::side_changed;
-    std::swap(current, next);
-    n = kept;
+    if (!alive.cut(piece, b, mask, topologies.bytes() + node.edges, node.n_new))
+      return Replay::side_changed;
   }
   const ClipTopologies::Node& node = topologies.node(at);
   if (node.faces == ClipTopologies::kNone) return Replay::side_changed;
   const std::uint8_t* bytes = topologies.bytes() + node.faces;
   faces.count = *bytes++;
   faces.bytes = bytes;
-  for (int j = 0; j < n; ++j) vertex[j] = &piece.v[current[j]];
-  n_vertices = n;
+  alive.hand_out(piece, vertex, n_vertices);
   terminal = at;
   return Replay::kept;
 }
