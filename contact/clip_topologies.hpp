@@ -20,7 +20,8 @@ namespace fdem::piece_clip {
 class ClipTopologies {
  public:
   static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
-  // Bounds on what one rank keeps (~20 MiB at most); past them new graphs are clipped afresh.
+  // Bounds on what one rank keeps (nodes, their hash and records: under 48 MiB with the vectors'
+  // slack; wall55 needs ~3 MiB); past them new graphs are clipped afresh.
   static constexpr std::size_t kMaxNodes = std::size_t{1} << 19;
   static constexpr std::size_t kMaxBytes = std::size_t{1} << 23;
 
