@@ -25,8 +25,8 @@ class ClipTopologies {
   static constexpr std::size_t kMaxNodes = std::size_t{1} << 19;
   static constexpr std::size_t kMaxBytes = std::size_t{1} << 23;
 
-  // A node: the clip of sub-tet `root` after `depth` planes, reached by the outside masks on the
-  // way.  A terminal (the four planes done, or everything cut off) holds the whole record.
+  // A node: the clip of a sub-tet after some planes, reached from its root by the outside masks on
+  // the way.  A terminal (the four planes done, or everything cut off) holds the whole record.
   struct Node {
     std::uint32_t parent = kNone;
     std::uint32_t edges = 0;       // offset in bytes(): the 2 n_new edges cut at the last plane
@@ -34,7 +34,6 @@ class ClipTopologies {
     std::uint32_t faces = kNone;   // terminal that keeps a volume: offset of [count][its faces]
     std::uint16_t mask = 0;        // outside mask at the last plane
     std::uint8_t n_new = 0;        // vertices it made
-    std::uint8_t depth = 0;        // planes done
   };
 
   ClipTopologies() { clear(); }
@@ -49,10 +48,17 @@ class ClipTopologies {
   const Node& node(std::uint32_t id) const { return nodes_[id]; }
   const std::uint8_t* bytes() const { return bytes_.data(); }
   std::size_t size() const { return nodes_.size(); }
-  std::size_t memory_bytes() const {
-    return nodes_.capacity() * sizeof(Node) + bytes_.capacity() +
-           children_.capacity() * sizeof(Child);
+  // The planes done at node `id` (0 at a root).
+  int depth(std::uint32_t id) const {
+    int planes = 0;
+    for (; nodes_[id].parent != kNone; id = nodes_[id].parent) ++planes;
+    return planes;
   }
+  // The record of terminal `id` (the bytes a fresh clip's log holds) and its length.
+  const std::uint8_t* record(std::uint32_t id) const {
+    return bytes_.data() + nodes_[id].record + 1;
+  }
+  int record_length(std::uint32_t id) const { return bytes_[nodes_[id].record]; }
 
   // The child of `parent` reached by outside mask `mask`, or kNone.
   std::uint32_t child(std::uint32_t parent, unsigned mask) const {
@@ -88,7 +94,6 @@ class ClipTopologies {
         Node made;
         made.mask = static_cast<std::uint16_t>(mask);
         made.n_new = static_cast<std::uint8_t>(n_new);
-        made.depth = static_cast<std::uint8_t>(b + 1);
         made.edges = static_cast<std::uint32_t>(bytes_.size());
         bytes_.insert(bytes_.end(), in, in + 2 * n_new);
         made.parent = at;

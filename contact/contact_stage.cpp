@@ -446,7 +446,6 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         clip_record_at_[index] = static_cast<std::uint32_t>(record_start);
       }
       pieces_replayed_ += memo.replayed;
-      pieces_found_ += memo.found;
       pieces_clipped_ += memo.clipped;
       apart_at_[index] = memo.apart_now;
       apart_pairs_.found(index, pairs_.size(), slot_a, slot_b, memo.apart_gap);

@@ -198,9 +198,6 @@ class ContactStage {
   // Pieces replayed from the step before and pieces clipped afresh, over the run (clip_replay).
   std::uint64_t pieces_replayed() const { return pieces_replayed_; }
   std::uint64_t pieces_clipped() const { return pieces_clipped_; }
-  // Of the pieces replayed, those whose pair's record did not fit and that found their clip among
-  // the clips met before (clip_topologies.hpp).
-  std::uint64_t pieces_found() const { return pieces_found_; }
   // Pairs apart at the step before that an edge-edge axis showed still apart (clip_replay.hpp).
   std::uint64_t pairs_apart_by_edge_axis() const { return pairs_apart_by_edge_axis_; }
   // Pair evaluations skipped over the run: apart by more than their tets had moved since.
@@ -317,8 +314,8 @@ class ContactStage {
   // Pairs found apart by a gap their tets have not yet travelled (with clip_replay), skipped.
   ApartPairs apart_pairs_;
   int clip_parity_ = 0;
-  std::uint64_t pieces_replayed_ = 0, pieces_found_ = 0, pieces_clipped_ = 0,
-                pairs_apart_by_edge_axis_ = 0, pair_steps_kept_apart_ = 0;
+  std::uint64_t pieces_replayed_ = 0, pieces_clipped_ = 0, pairs_apart_by_edge_axis_ = 0,
+                pair_steps_kept_apart_ = 0;
   std::vector<std::uint8_t> body_cracked_;  // per body: one of its joints broke
   std::vector<std::uint8_t> left_out_;      // per tet, at the last detection
   std::int64_t left_out_count_ = 0;

@@ -294,7 +294,8 @@ inline unsigned negligible_parts(const TetPairFrame& frame, const PairMetrics& m
   // kept pieces at the step before (`kept_before`: a hint, the decisions are the same without);
   // most others are left out whole on the slab depths alone.
   PairForceBound caps;
-  bool caps_known = false;
+  bool caps_known = false, pair_bound_above = false;
+  double limit = 0.0;
   if (kept_before) {
     narrowed = narrow_slab_depths(frame, mu, reach);
     int thin_narrowed = 0;
@@ -302,10 +303,11 @@ inline unsigned negligible_parts(const TetPairFrame& frame, const PairMetrics& m
     if (narrowed && thin_narrowed <= 2) {
       caps = pair_force_bound(frame, metrics, reach, 1.0);
       caps_known = true;
+      limit = share * caps.length * caps.length;
+      pair_bound_above = caps.nodal_force > limit;
     }
   }
-  double limit = share * caps.length * caps.length;
-  if (!caps_known || !(caps.nodal_force > limit)) {
+  if (!pair_bound_above) {
     const PairForceBound bound = pair_force_bound(frame, metrics, mu, 1.0, share);
     limit = share * bound.length * bound.length;
     if (bound.nodal_force <= limit) return kEveryPiece;  // (else the bound is whole)

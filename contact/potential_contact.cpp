@@ -226,24 +226,26 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
     const PieceVertex* vertex[kMaxVertices];
     int n_vertices = 0;
     PieceFaces faces;
-    const std::uint8_t* recorded = memo ? find_recorded_piece(*memo, key) : nullptr;
-    Replay replay = recorded ? replay_piece(piece, recorded + 2, recorded + 2 + recorded[1], vertex,
-                                            n_vertices, faces)
-                             : Replay::side_changed;
+    const std::uint8_t* entry = memo ? find_recorded_piece(*memo, key) : nullptr;
+    const std::uint8_t* clip = entry ? entry + 2 : nullptr;  // the clip replayed, and its length
+    int clip_length = entry ? entry[1] : 0;
+    Replay replay = clip ? replay_piece(piece, clip, clip + clip_length, vertex, n_vertices, faces)
+                         : Replay::side_changed;
     ClipTopologies* const topologies = memo ? memo->topologies : nullptr;
     if (replay == Replay::side_changed && topologies) {
       std::uint32_t terminal = ClipTopologies::kNone;
       replay = walk_topologies(piece, i, *topologies, terminal, vertex, n_vertices, faces);
       if (replay != Replay::side_changed) {
         ++memo->found;
-        recorded = topologies->bytes() + topologies->node(terminal).record - 1;  // [.][length]
+        clip = topologies->record(terminal);
+        clip_length = topologies->record_length(terminal);
       }
     }
     bool alive = replay == Replay::kept;
     bool walked = alive;
     if (replay != Replay::side_changed) {
       ++memo->replayed;
-      if (memo->record) record_piece(*memo->record, key, recorded + 2, recorded[1]);
+      if (memo->record) record_piece(*memo->record, key, clip, clip_length);
     } else {
       ClipLog log;
       ClipLog* const logged = memo && memo->record ? &log : nullptr;

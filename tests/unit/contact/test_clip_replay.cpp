@@ -238,7 +238,7 @@ TEST_CASE("the clips met before keep one node per graph and find each by its mas
   const std::size_t nodes = topologies.size();
   CHECK(topologies.add(2, log.bytes, log.size) == added);  // the same graph: no new node
   CHECK(topologies.size() == nodes);
-  CHECK(topologies.node(added).depth == 4);
+  CHECK(topologies.depth(added) == 4);
 
   Piece again = piece_with(cut);
   REQUIRE(walk_topologies(again, 2, topologies, terminal, vertex, n, faces) == Replay::kept);
