@@ -52,11 +52,7 @@ struct Pair {
   TetCorners a, b;
 };
 
-double thread_cpu_seconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+using bench::thread_cpu_seconds;
 
 // Runs `body` over the pairs repeatedly for about `seconds` of this thread's CPU time (robust on
 // a shared machine; also stops after 2 * seconds of wall time); returns evaluations per CPU

@@ -2,6 +2,7 @@
 // kernel of issue 12's start: the per-pair cost distribution of every candidate pair of one step.
 //
 //   bench_contact_scene_pairs SCENE.yaml TIME [out.csv] [--label NAME] [--set key=value ...]
+//       [--turns SECONDS]
 //
 // The scene runs (one rank, no output) to just before TIME.  The candidate pairs of the last
 // step and the positions before it (x0) and after it (x1) are kept; then each pair at x1 is timed
@@ -18,6 +19,9 @@
 // the stage integrates (not skipped under the tolerance: the pairs that carry load).  The stage's
 // results are checked against the exact kernel (tolerance 0, fresh clips): the largest nodal
 // force difference relative to the step's largest pair force.
+// With --turns, the integrated pairs are then evaluated in turn, one after the other as the stage
+// meets them, again and again for SECONDS of CPU time: their mean cost without a hot loop on one
+// pair (and a steady loop to profile).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -72,12 +76,15 @@ int main(int argc, char** argv) {
   const double until = std::stod(argv[2]);
   std::string csv_path = "bench_contact_scene_pairs.csv", label = scene_path;
   std::vector<std::string> overrides;
+  double turns_seconds = 0.0;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--set" && i + 1 < argc)
       overrides.push_back(argv[++i]);
     else if (a == "--label" && i + 1 < argc)
       label = argv[++i];
+    else if (a == "--turns" && i + 1 < argc)
+      turns_seconds = std::stod(argv[++i]);
     else
       csv_path = a;
   }
@@ -144,6 +151,7 @@ int main(int argc, char** argv) {
   };
 
   std::vector<double> cost[3][2];  // [all, overlapping, integrated][baseline, stage]
+  std::vector<std::size_t> integrated;
   std::size_t boxes_meet = 0, overlapping = 0, stage_overlapping = 0;
   double largest_pair_force = 0.0, worst_difference = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -167,6 +175,7 @@ int main(int argc, char** argv) {
       cost[1][1].push_back(s);
     }
     if (base.overlapping && now.overlapping) {
+      integrated.push_back(i);
       cost[2][0].push_back(b);
       cost[2][1].push_back(s);
     }
@@ -204,6 +213,26 @@ int main(int argc, char** argv) {
           << ',' << s.p50 << ',' << s.p90 << ',' << s.p99 << ',' << s.mean << ','
           << (path == 1 ? per_tet_per_pair : 0.0) << ',' << (path == 1 ? ratio : 1.0) << '\n';
     }
+  }
+  if (turns_seconds > 0.0 && !integrated.empty()) {
+    // ns per evaluation of `evaluate(i)` over the integrated pairs in turn (CPU time).
+    const auto in_turn = [&](auto evaluate) {
+      long long evaluations = 0;
+      const double start = bench::thread_cpu_seconds();
+      double elapsed = 0.0;
+      while ((elapsed = bench::thread_cpu_seconds() - start) < turns_seconds) {
+        for (std::size_t i : integrated) sink += evaluate(i);
+        evaluations += static_cast<long long>(integrated.size());
+      }
+      return 1e9 * elapsed / static_cast<double>(evaluations);
+    };
+    const double stage_ns = in_turn([&](std::size_t i) { return stage_pair(i).energy; });
+    const double base_ns = in_turn([&](std::size_t i) {
+      return potential_contact_baseline(x1[pairs[i].a], x1[pairs[i].b], penalty).energy;
+    });
+    std::printf(
+        "integrated pairs in turn: baseline %.0f ns, stage %.0f ns (+%.0f per-tet), %.2fx\n",
+        base_ns, stage_ns, per_tet_per_pair, base_ns / (stage_ns + per_tet_per_pair));
   }
   if (sink == 42.0) std::printf(" ");
   std::printf("appended to %s\n", csv_path.c_str());

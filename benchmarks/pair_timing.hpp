@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 
 namespace fdem::bench {
 
@@ -19,6 +20,13 @@ double best_of_batches_ns(Body body, double& sink) {
     best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count() / 8);
   }
   return 1e9 * best;
+}
+
+// This thread's CPU time (s).
+inline double thread_cpu_seconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 }  // namespace fdem::bench

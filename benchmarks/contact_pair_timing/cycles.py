@@ -135,9 +135,9 @@ def add_probes(tree):
          '    const unsigned long long t = __rdtsc(); sum[own] += t - stamp; stamp = t; };\n'
          '  struct Last { decltype(lap)& f; ~Last() { f(fdem_cycles::now.setup); } } last_{lap};\n'
          '  for (int i = 0; i < 4; ++i) {'),
-        ('    const std::uint8_t* recorded = memo ? find_recorded_piece',
+        ('    const std::uint8_t* entry = memo ? find_recorded_piece',
          '    lap(fdem_cycles::now.setup); ++fdem_cycles::now.pieces[own];\n'
-         '    const std::uint8_t* recorded = memo ? find_recorded_piece'),
+         '    const std::uint8_t* entry = memo ? find_recorded_piece'),
         ('    bool alive = replay == Replay::kept;\n',
          '    lap(fdem_cycles::now.clip);\n    bool alive = replay == Replay::kept;\n'),
         ('      ClipLog log;\n',
