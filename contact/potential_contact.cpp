@@ -89,8 +89,10 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
     }
   }
   volume_weight[0] += piece_vol6;  // the apex term: vol6 of the piece times the apex's values
-  out.vol6[own_sub] += piece_vol6;
+  out.vol6[own_sub] = piece_vol6;  // one piece per sub-tet
+  out.integrated |= 1u << own_sub;
   double* moment = out.moment[own_sub];
+  for (int c = 0; c < moments; ++c) moment[c] = 0.0;
   for (int v = 0; v < n; ++v) {
     const double wv = volume_weight[v];
     const double* lam = vertex[v]->lam;
@@ -107,6 +109,10 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
   for (int j = 0; j < 4; ++j) {
     if (!on_face[j]) continue;
     double* surface = out.surface[j];
+    if (!((out.surfaced >> j) & 1u)) {
+      out.surfaced |= 1u << j;
+      for (int b = 0; b < 4; ++b) surface[b] = 0.0;
+    }
     for (int v = 0; v < n; ++v) {
       const double sv = surface_weight[j][v];
       const double* lam = vertex[v]->lam + 4;
@@ -268,7 +274,7 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
     }
     if (alive) {
       out.nonempty |= 1u << i;
-      double side_weight[4][3] = {};
+      double side_weight[4][3];  // set for the slots in `slots`, read for those only
       const unsigned slots = flux_slots & ~(1u << i);
       for (int slot = 0; slot < 4; ++slot) {
         if (!((slots >> slot) & 1u)) continue;
@@ -327,6 +333,10 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
     const double jac = std::abs(frame.map[s].edge_det);
     const int carried = s == 0 ? 8 : 4;  // the target's side carries its own values only
     for (int i = 0; i < 4; ++i) {
+      if (!((side[s].integrated >> i) & 1u)) {  // no piece: zero, as jac * 0 would give
+        for (int c = 0; c < carried; ++c) vol_integral[s][i][c] = 0.0;
+        continue;
+      }
       for (int c = 0; c < carried; ++c)
         vol_integral[s][i][c] = jac * side[s].moment[i][c] * (1.0 / 24.0);
       volume[s] += jac * side[s].vol6[i] * (1.0 / 6.0);
@@ -350,7 +360,8 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
         // volume term: grad phi = 4 grad lambda_i on sub-tet i
         const double volume_term = 4.0 * vol_integral[s][i][a];
         // surface term on own face i: - ∫ phi_other lambda_a n dS, n = outward unit normal
-        const double surface_term = other_side.surface[i][a] * (1.0 / 24.0);
+        const double surface_term =
+            (other_side.surfaced >> i) & 1u ? other_side.surface[i][a] * (1.0 / 24.0) : 0.0;
         for (int k = 0; k < 3; ++k) {
           f[k][a] += volume_term * gradient[k];
           f[k][a] += surface_term * normal[k];

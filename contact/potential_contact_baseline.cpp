@@ -140,7 +140,7 @@ void integrate_side(const TetPairFrame& frame, int own, SideIntegrals& out) {
 ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   ContactPairResult r = zero_result();
 
-  SideIntegrals side[2];
+  SideIntegrals side[2]{};
   integrate_side(frame, 0, side[0]);
   integrate_side(frame, 1, side[1]);
 
