@@ -5,12 +5,15 @@ kernel of issue 12's start: bench_contact_scene_pairs at chosen instants of the 
 
   benchmarks/contact_slivers/pair_costs.py [--bench build/benchmarks/bench_contact_scene_pairs]
       [--points tower@0.01,tower@0.04,...] [--csv docs/data/bench_contact_scene_pairs.csv]
+      [--turns SECONDS]
 
 A point is CASE@TIME (s), CASE one of run.py's cases (tower_full is tower).  Each point prints and
 appends one block of rows to the CSV (the file is started afresh): the per-pair cost percentiles
 and means of every candidate pair and of the overlapping ones, for the baseline kernel and the
 stage's path, and their ratio of means with the stage's per-tet work added.  Run it on an idle
-core: each pair is timed alone (best of 3 batches of 8 evaluations).
+core: each pair is timed alone (best of 3 batches of 8 evaluations).  With --turns, each point
+also times the pairs the stage integrates evaluated in turn (bench_contact_scene_pairs --turns):
+rows of class integrated_in_turn.
 """
 import argparse, importlib.util, os, subprocess, sys, tempfile
 
@@ -31,6 +34,8 @@ def main():
     ap.add_argument("--points", default=DEFAULT_POINTS)
     ap.add_argument("--csv", default=os.path.join(root, "docs", "data",
                                                   "bench_contact_scene_pairs.csv"))
+    ap.add_argument("--turns", type=float, default=0.0,
+                    help="CPU seconds per point for the integrated pairs in turn (0: not timed)")
     a = ap.parse_args()
     if os.path.exists(a.csv):
         os.remove(a.csv)
@@ -40,6 +45,8 @@ def main():
             scene, overrides = slivers.case_scene("tower" if case == "tower_full" else case,
                                                   workdir)
             command = [a.bench, scene, at, a.csv, "--label", f"{case}@{at}"]
+            if a.turns > 0:
+                command += ["--turns", str(a.turns)]
             for o in overrides:
                 if not o.startswith("time.end="):  # the benchmark steps to its instant itself
                     command += ["--set", o]
