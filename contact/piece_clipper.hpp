@@ -164,13 +164,14 @@ inline bool clip_piece(Piece& piece, int k, unsigned plane_bit, ClipLog* log = n
 // Value-initialise it (`SideIntegrals s{}`) to start from zero everywhere; potential_contact.cpp
 // writes a row on first use instead and keeps which in `integrated` and `surfaced`.
 struct SideIntegrals {
-  double vol6[4];           // per sub-tet i: 6 * volume in barycentric space
-  double moment[4][8];      // per sub-tet i: sum vol6_tet * (sum of its 4 vertex values)
-  double surface[4][4];     // [other face j][other node b]: ∫ 4 lambda_i^own lambda_b^other dS
-                            // * 24 (physical area), over the pieces' faces on face j
-  unsigned nonempty = 0;    // bit i: piece i was clipped to a non-empty polyhedron
-  unsigned integrated = 0;  // bit i: vol6[i] and moment[i] hold piece i (else read them as 0)
-  unsigned surfaced = 0;    // bit j: surface[j] holds the faces on face j (else read it as 0)
+  double vol6[4];        // per sub-tet i: 6 * volume in barycentric space
+  double moment[4][8];   // per sub-tet i: sum vol6_tet * (sum of its 4 vertex values)
+  double surface[4][4];  // [other face j][other node b]: ∫ 4 lambda_i^own lambda_b^other dS
+                         // * 24 (physical area), over the pieces' faces on face j
+  // bit i: piece i was clipped to a non-empty polyhedron and integrated: vol6[i], moment[i] and
+  // flux[i] hold it (else read vol6[i] and moment[i] as 0; an empty piece has no flux)
+  unsigned integrated = 0;
+  unsigned surfaced = 0;  // bit j: surface[j] holds the faces on face j (else read it as 0)
   // [sub-tet k][slot s][own node a]: ∫ 4 lambda_k lambda_a dS * 24 (physical area) over piece k's
   // face on the plane it shares with sub-tet s (lambda_k = lambda_s), for left-out pieces s only
   double flux[4][4][4];

@@ -272,8 +272,7 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
         }
       }
     }
-    if (alive) {
-      out.nonempty |= 1u << i;
+    if (walked) {  // (alive but not walked: a corrupted graph, cannot happen; nothing to add)
       double side_weight[4][3];  // set for the slots in `slots`, read for those only
       const unsigned slots = flux_slots & ~(1u << i);
       for (int slot = 0; slot < 4; ++slot) {
@@ -283,9 +282,9 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
         for (int k = 0; k < 3; ++k)
           side_weight[slot][k] = std::abs(own_map.edge_det) * own_map.gradient[k + 1].dot(normal);
       }
-      if (walked && moments == 8)
+      if (moments == 8)
         integrate_piece<8>(vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);
-      else if (walked)
+      else
         integrate_piece<4>(vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);
     }
   }
@@ -377,7 +376,7 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
     for (int i = 0; i < 4; ++i) {
       if (!((left_out >> (4 * s + i)) & 1u)) continue;
       for (int k = 0; k < 4; ++k) {
-        if (k == i || !((side[s].nonempty >> k) & 1u)) continue;  // an empty piece shares nothing
+        if (k == i || !((side[s].integrated >> k) & 1u)) continue;  // an empty piece shares nothing
         const Vec3& normal = side[s].flux_normal[k][i];
         for (int a = 0; a < 4; ++a)
           force[s][a] -= (penalty * side[s].flux[k][i][a] * (1.0 / 24.0)) * normal;
