@@ -352,15 +352,20 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
     const Vec3* inward_normal = normals.of[s];  // of own face i: grad lambda_i / |grad lambda_i|
     // The four nodes side by side (one vector lane each), each summed in the same order as alone.
     double f[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // [component][node a]
+    // A sub-tet with neither a piece nor a surface on its face adds only zeros (f never holds -0:
+    // it starts at +0 and a sum that cancels rounds to +0), so it is passed over.
+    const unsigned terms = side[s].integrated | other_side.surfaced;
     for (int i = 0; i < 4; ++i) {
+      if (!((terms >> i) & 1u)) continue;
       const Vec3& gradient = own.gradient[i];
       const Vec3& normal = inward_normal[i];
+      const bool has_volume = (side[s].integrated >> i) & 1u;
+      const bool has_surface = (other_side.surfaced >> i) & 1u;
       for (int a = 0; a < 4; ++a) {
         // volume term: grad phi = 4 grad lambda_i on sub-tet i
-        const double volume_term = 4.0 * vol_integral[s][i][a];
+        const double volume_term = has_volume ? 4.0 * vol_integral[s][i][a] : 0.0;
         // surface term on own face i: - ∫ phi_other lambda_a n dS, n = outward unit normal
-        const double surface_term =
-            (other_side.surfaced >> i) & 1u ? other_side.surface[i][a] * (1.0 / 24.0) : 0.0;
+        const double surface_term = has_surface ? other_side.surface[i][a] * (1.0 / 24.0) : 0.0;
         for (int k = 0; k < 3; ++k) {
           f[k][a] += volume_term * gradient[k];
           f[k][a] += surface_term * normal[k];
