@@ -2,7 +2,7 @@
 // kernel of issue 12's start: the per-pair cost distribution of every candidate pair of one step.
 //
 //   bench_contact_scene_pairs SCENE.yaml TIME [out.csv] [--label NAME] [--set key=value ...]
-//       [--turns SECONDS]
+//       [--turns SECONDS] [--count PASSES]
 //
 // The scene runs (one rank, no output) to just before TIME.  The candidate pairs of the last
 // step and the positions before it (x0) and after it (x1) are kept; then each pair at x1 is timed
@@ -23,6 +23,10 @@
 // meets them, again and again, the baseline and the stage alternating in three rounds for SECONDS
 // of CPU time in all: their mean cost without a hot loop on one pair (least of the rounds; CSV
 // class integrated_in_turn, percentiles empty), and a steady loop to profile.
+// With --count PASSES, nothing is timed: the integrated pairs are evaluated in turn PASSES times
+// by the stage's path inside count_in_turn, for counting its instructions under callgrind
+// (valgrind --tool=callgrind --toggle-collect='*count_in_turn*'): a figure that does not move
+// with the machine's load, for comparing two builds of the kernel.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -64,6 +68,16 @@ Stats stats_of(std::vector<double> v) {
   return s;
 }
 
+// `evaluate(i)` for every pair in `pairs`, `passes` times (not inlined: callgrind's toggle).
+template <class Evaluate>
+__attribute__((noinline)) double count_in_turn(const std::vector<std::size_t>& pairs, int passes,
+                                               Evaluate&& evaluate) {
+  double sink = 0.0;
+  for (int pass = 0; pass < passes; ++pass)
+    for (std::size_t i : pairs) sink += evaluate(i);
+  return sink;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -78,6 +92,7 @@ int main(int argc, char** argv) {
   std::string csv_path = "bench_contact_scene_pairs.csv", label = scene_path;
   std::vector<std::string> overrides;
   double turns_seconds = 0.0;
+  int count_passes = 0;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--set" && i + 1 < argc)
@@ -86,6 +101,8 @@ int main(int argc, char** argv) {
       label = argv[++i];
     else if (a == "--turns" && i + 1 < argc)
       turns_seconds = std::stod(argv[++i]);
+    else if (a == "--count" && i + 1 < argc)
+      count_passes = std::stoi(argv[++i]);
     else
       csv_path = a;
   }
@@ -166,6 +183,10 @@ int main(int argc, char** argv) {
     stage_overlapping += now.overlapping;
     largest_pair_force = std::max(largest_pair_force, largest_nodal_force(exact));
     worst_difference = std::max(worst_difference, largest_nodal_force_difference(now, exact));
+    if (count_passes > 0) {  // nothing timed
+      if (base.overlapping && now.overlapping) integrated.push_back(i);
+      continue;
+    }
     const double b = bench::best_of_batches_ns(
         [&] { return potential_contact_baseline(x1[p.a], x1[p.b], penalty).energy; }, sink);
     const double s = bench::best_of_batches_ns([&] { return stage_pair(i).energy; }, sink);
@@ -180,6 +201,15 @@ int main(int argc, char** argv) {
       cost[2][0].push_back(b);
       cost[2][1].push_back(s);
     }
+  }
+  if (count_passes > 0) {
+    sink += count_in_turn(integrated, count_passes,
+                          [&](std::size_t i) { return stage_pair(i).energy; });
+    std::printf(
+        "bench_contact_scene_pairs: %s at t = %.6g s: %zu integrated pairs evaluated in "
+        "turn %d times (count_in_turn)%s\n",
+        label.c_str(), sim->time(), integrated.size(), count_passes, sink == 42.0 ? " " : "");
+    return 0;
   }
   const double per_tet_per_pair = n > 0 ? per_tet_ns / static_cast<double>(n) : 0.0;
 

@@ -37,13 +37,6 @@ struct PairForceBound {
   double length = 0.0;       // m: the shorter of the two tets' longest edges
 };
 
-inline double longest_edge_squared(const Vec3 (&x)[4]) {
-  double longest = 0.0;
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (x[a] - x[b]).squaredNorm());
-  return longest;
-}
-
 // Prisms are formed from slabs thinner than this (barycentric units) only: a thicker slab's prism
 // is rarely the smallest, and each costs a cross product and a square root.
 constexpr double kPrismSlab = 1e-2;
@@ -106,7 +99,7 @@ struct FrameMetrics {
   GradientMetrics metrics[2];
   explicit FrameMetrics(const TetPairFrame& frame) {
     for (int T = 0; T < 2; ++T)
-      gradient_metrics(frame.map[T].gradient, frame.map[T].edge_det, metrics[T]);
+      gradient_metrics(frame.map[T].gradient, frame.map[T].edge_det, frame.local[T], metrics[T]);
   }
   PairMetrics pair() const { return PairMetrics{{&metrics[0], &metrics[1]}}; }
 };
@@ -140,8 +133,7 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetr
     for (int j = i; j > 0 && mu[thin[j]] < mu[thin[j - 1]]; --j) std::swap(thin[j], thin[j - 1]);
   thin_count = std::min(thin_count, kMaxThinSlabs);
   PairForceBound bound;
-  bound.length = std::sqrt(
-      std::min(longest_edge_squared(frame.local[0]), longest_edge_squared(frame.local[1])));
+  bound.length = std::min(metrics.of[0]->longest_edge, metrics.of[1]->longest_edge);
   const double length = bound.length;
 
   // Whole tets: face a's area is 3V |grad lambda_a| <= 3V G_T.

@@ -21,6 +21,16 @@ using namespace piece_clip;
 // end.  `moments`: how many carried values need their moment (4: own only, 8: own and other).
 // area_weight[j]: maps a barycentric-space doubled area vector to the doubled physical area
 // projected on face j's outward unit normal.
+// Zeroes w[0, n) in blocks of four (w holds kMaxVertices, a multiple of 4): a few vector stores
+// where a loop would become a call to memset.
+inline void zero_weights(double* w, int n) {
+  static_assert(kMaxVertices % 4 == 0);
+  for (int v = 0; v < n; v += 4) {
+    __asm__("" : "+r"(w));  // (no memset)
+    w[v] = 0.0, w[v + 1] = 0.0, w[v + 2] = 0.0, w[v + 3] = 0.0;
+  }
+}
+
 template <int moments>
 void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& faces, int own_sub,
                      const double (&area_weight)[4][3], const double (&side_weight)[4][3],
@@ -30,7 +40,7 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
   bool on_face[4] = {false, false, false, false};
   double flux_weight[4][kMaxVertices];  // per side slot s in flux_slots: as surface_weight
   bool on_side[4] = {false, false, false, false};
-  for (int v = 0; v < n; ++v) volume_weight[v] = 0.0;
+  zero_weights(volume_weight, n);
   const double* apex = vertex[0]->lam;  // apex: the first vertex of the piece
   double piece_vol6 = 0.0;
   const std::uint8_t* at = faces.bytes;
@@ -44,7 +54,7 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
       other_face = (bits & 1u) ? 0 : (bits & 2u) ? 1 : (bits & 4u) ? 2 : 3;
       if (!on_face[other_face]) {
         on_face[other_face] = true;
-        for (int v = 0; v < n; ++v) surface_weight[other_face][v] = 0.0;
+        zero_weights(surface_weight[other_face], n);
       }
     }
     int side_slot = -1;  // a face on the plane shared with a left-out piece's sub-tet
@@ -52,7 +62,7 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
       side_slot = (side & 1u) ? 0 : (side & 2u) ? 1 : (side & 4u) ? 2 : 3;
       if (!on_side[side_slot]) {
         on_side[side_slot] = true;
-        for (int v = 0; v < n; ++v) flux_weight[side_slot][v] = 0.0;
+        zero_weights(flux_weight[side_slot], n);
       }
     }
     // Fan from the face's first vertex.
@@ -91,33 +101,37 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
   volume_weight[0] += piece_vol6;  // the apex term: vol6 of the piece times the apex's values
   out.vol6[own_sub] = piece_vol6;  // one piece per sub-tet
   out.integrated |= 1u << own_sub;
-  double* moment = out.moment[own_sub];
-  for (int c = 0; c < moments; ++c) moment[c] = 0.0;
+  double moment[moments] = {};
   for (int v = 0; v < n; ++v) {
     const double wv = volume_weight[v];
     const double* lam = vertex[v]->lam;
     for (int c = 0; c < moments; ++c) moment[c] += wv * lam[c];
   }
+  for (int c = 0; c < moments; ++c) out.moment[own_sub][c] = moment[c];
+  // (the sums run in local lanes, four side by side, and are stored once)
   for (int slot = 0; slot < 4; ++slot) {
-    double* flux = out.flux[own_sub][slot];
-    if ((flux_slots >> slot) & 1u)
-      for (int a = 0; a < 4; ++a) flux[a] = 0.0;
-    if (!on_side[slot]) continue;
-    for (int v = 0; v < n; ++v)
-      for (int a = 0; a < 4; ++a) flux[a] += flux_weight[slot][v] * vertex[v]->lam[a];
+    if (!((flux_slots >> slot) & 1u)) continue;
+    double sum[4] = {0.0, 0.0, 0.0, 0.0};
+    if (on_side[slot])
+      for (int v = 0; v < n; ++v) {
+        const double fv = flux_weight[slot][v];
+        const double* lam = vertex[v]->lam;
+        for (int a = 0; a < 4; ++a) sum[a] += fv * lam[a];
+      }
+    for (int a = 0; a < 4; ++a) out.flux[own_sub][slot][a] = sum[a];
   }
   for (int j = 0; j < 4; ++j) {
     if (!on_face[j]) continue;
-    double* surface = out.surface[j];
-    if (!((out.surfaced >> j) & 1u)) {
-      out.surfaced |= 1u << j;
-      for (int b = 0; b < 4; ++b) surface[b] = 0.0;
-    }
+    double sum[4] = {0.0, 0.0, 0.0, 0.0};
+    if ((out.surfaced >> j) & 1u)
+      for (int b = 0; b < 4; ++b) sum[b] = out.surface[j][b];
+    out.surfaced |= 1u << j;
     for (int v = 0; v < n; ++v) {
       const double sv = surface_weight[j][v];
       const double* lam = vertex[v]->lam + 4;
-      for (int b = 0; b < 4; ++b) surface[b] += sv * lam[b];
+      for (int b = 0; b < 4; ++b) sum[b] += sv * lam[b];
     }
+    for (int b = 0; b < 4; ++b) out.surface[j][b] = sum[b];
   }
 }
 
@@ -352,24 +366,21 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
     const Vec3* inward_normal = normals.of[s];  // of own face i: grad lambda_i / |grad lambda_i|
     // The four nodes side by side (one vector lane each), each summed in the same order as alone.
     double f[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // [component][node a]
-    // A sub-tet with neither a piece nor a surface on its face adds only zeros (f never holds -0:
-    // it starts at +0 and a sum that cancels rounds to +0), so it is passed over.
-    const unsigned terms = side[s].integrated | other_side.surfaced;
+    // A term a sub-tet does not have (no piece; no surface on its face) adds only zeros and is
+    // passed over: f never holds -0 (it starts at +0, and a sum that cancels rounds to +0).
     for (int i = 0; i < 4; ++i) {
-      if (!((terms >> i) & 1u)) continue;
-      const Vec3& gradient = own.gradient[i];
-      const Vec3& normal = inward_normal[i];
-      const bool has_volume = (side[s].integrated >> i) & 1u;
-      const bool has_surface = (other_side.surfaced >> i) & 1u;
-      for (int a = 0; a < 4; ++a) {
-        // volume term: grad phi = 4 grad lambda_i on sub-tet i
-        const double volume_term = has_volume ? 4.0 * vol_integral[s][i][a] : 0.0;
-        // surface term on own face i: - ∫ phi_other lambda_a n dS, n = outward unit normal
-        const double surface_term = has_surface ? other_side.surface[i][a] * (1.0 / 24.0) : 0.0;
-        for (int k = 0; k < 3; ++k) {
-          f[k][a] += volume_term * gradient[k];
-          f[k][a] += surface_term * normal[k];
-        }
+      double term[4];
+      if ((side[s].integrated >> i) & 1u) {  // volume term: grad phi = 4 grad lambda_i on piece i
+        const Vec3& gradient = own.gradient[i];
+        for (int a = 0; a < 4; ++a) term[a] = 4.0 * vol_integral[s][i][a];
+        for (int k = 0; k < 3; ++k)
+          for (int a = 0; a < 4; ++a) f[k][a] += term[a] * gradient[k];
+      }
+      if ((other_side.surfaced >> i) & 1u) {    // on own face i: - ∫ phi_other lambda_a n dS
+        const Vec3& normal = inward_normal[i];  // n: the outward unit normal is -normal
+        for (int a = 0; a < 4; ++a) term[a] = other_side.surface[i][a] * (1.0 / 24.0);
+        for (int k = 0; k < 3; ++k)
+          for (int a = 0; a < 4; ++a) f[k][a] += term[a] * normal[k];
       }
     }
     for (int a = 0; a < 4; ++a)
@@ -378,10 +389,11 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
     // -p ∫ phi lambda_a n dS on the face two sub-tets share cancels between their pieces.  A
     // left-out piece i leaves it to each kept neighbour k, over k's face on their plane (normal
     // out of k, phi = 4 lambda_k there): the forces stay the exact gradient of the kept energy.
-    for (int i = 0; i < 4; ++i) {
-      if (!((left_out >> (4 * s + i)) & 1u)) continue;
-      for (int k = 0; k < 4; ++k) {
-        if (k == i || !((side[s].integrated >> k) & 1u)) continue;  // an empty piece shares nothing
+    for (unsigned out = (left_out >> (4 * s)) & 0xFu; out; out &= out - 1) {
+      const int i = __builtin_ctz(out);
+      // (an empty piece shares nothing; a left-out one is not integrated)
+      for (unsigned kept = side[s].integrated & ~(1u << i); kept; kept &= kept - 1) {
+        const int k = __builtin_ctz(kept);
         const Vec3& normal = side[s].flux_normal[k][i];
         for (int a = 0; a < 4; ++a)
           force[s][a] -= (penalty * side[s].flux[k][i][a] * (1.0 / 24.0)) * normal;

@@ -195,12 +195,23 @@ struct GradientMetrics {
   double cross_norm[6];  // |grad lambda_a x grad lambda_b| (1/m^2), a < b at kFacePair[a][b]
   double inverse_cross_norm[6];  // 1 / cross_norm (m^2), 0 where cross_norm is not > 0
   double volume;                 // |edge_det| / 6 (m^3)
+  double longest_edge;           // m
 };
+
+inline double longest_edge_squared(const Vec3 (&x)[4]) {
+  double longest = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (x[a] - x[b]).squaredNorm());
+  return longest;
+}
 // The slot of the gradients' pair {a, b}, a != b, in GradientMetrics (-1 on the diagonal).
 constexpr int kFacePair[4][4] = {{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}};
 
-inline void gradient_metrics(const Vec3 (&gradient)[4], double edge_det, GradientMetrics& out) {
+// `corners`: the tet's corners in any frame (for the longest edge).
+inline void gradient_metrics(const Vec3 (&gradient)[4], double edge_det, const Vec3 (&corners)[4],
+                             GradientMetrics& out) {
   out.volume = std::abs(edge_det) / 6.0;
+  out.longest_edge = std::sqrt(longest_edge_squared(corners));
   out.largest = 0.0;
   for (int a = 0; a < 4; ++a) out.largest = std::max(out.largest, out.norm[a] = gradient[a].norm());
   for (int a = 0; a < 4; ++a)
@@ -235,7 +246,7 @@ inline void compute_tet_geometry(const TetCorners& corners, TetGeometry& out,
     for (Vec3& g : out.gradient) g.setZero();
     out.edge_det = 0.0;
   }
-  gradient_metrics(out.gradient, out.edge_det, out.metrics);
+  gradient_metrics(out.gradient, out.edge_det, corners.x, out.metrics);
   out.has_normals = with_normals;
   if (with_normals)  // gradient / |gradient|, as Eigen's normalized() (zero stays zero)
     for (int a = 0; a < 4; ++a)
