@@ -241,11 +241,13 @@ inline void piece_force_bounds(const PairMetrics& metrics, const double (&mu)[8]
       for (int b = a + 1; b < 4; ++b) {
         if (!(tet.cross_norm[kFacePair[a][b]] > 0.0)) continue;
         const double inverse_cross = tet.inverse_cross_norm[kFacePair[a][b]];
+        double nu_a[4], nu_b[4];  // per piece i: the slabs a and b, face i's thinned to m_T
+        for (int i = 0; i < 4; ++i) nu_a[i] = own[a], nu_b[i] = own[b];
+        nu_a[a] = thinnest_own;
+        nu_b[b] = thinnest_own;
         for (int i = 0; i < 4; ++i) {
-          const double nu_a = i == a ? thinnest_own : own[a];
-          const double nu_b = i == b ? thinnest_own : own[b];
-          const double section = nu_a * nu_b * inverse_cross;
-          const double perimeter = 2.0 * (nu_a * norm[b] + nu_b * norm[a]) * inverse_cross;
+          const double section = nu_a[i] * nu_b[i] * inverse_cross;
+          const double perimeter = 2.0 * (nu_a[i] * norm[b] + nu_b[i] * norm[a]) * inverse_cross;
           volume[i] = std::min(volume[i], section * pair.length);
           surface[i] = std::min(surface[i], 2.0 * section + perimeter * pair.length);
         }

@@ -21,14 +21,12 @@ using namespace piece_clip;
 // end.  `moments`: how many carried values need their moment (4: own only, 8: own and other).
 // area_weight[j]: maps a barycentric-space doubled area vector to the doubled physical area
 // projected on face j's outward unit normal.
-// Zeroes w[0, n) in blocks of four (w holds kMaxVertices, a multiple of 4): a few vector stores
-// where a loop would become a call to memset.
-inline void zero_weights(double* w, int n) {
-  static_assert(kMaxVertices % 4 == 0);
-  for (int v = 0; v < n; v += 4) {
-    __asm__("" : "+r"(w));  // (no memset)
-    w[v] = 0.0, w[v + 1] = 0.0, w[v + 2] = 0.0, w[v + 3] = 0.0;
-  }
+// Zeroes w[0, n): the first 16 (a piece has ~8 vertices) by a fixed-size store the compiler
+// writes out inline, where a loop to n would become a call to memset.
+inline void zero_weights(double (&w)[kMaxVertices], int n) {
+  static_assert(kMaxVertices >= 16);
+  std::fill_n(w, 16, 0.0);
+  for (int v = 16; v < n; ++v) w[v] = 0.0;
 }
 
 template <int moments>
@@ -51,7 +49,7 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
     int other_face = -1;
     if (face_planes & kOtherFaceBits) {
       const unsigned bits = (face_planes & kOtherFaceBits) >> kOtherFaceShift;
-      other_face = (bits & 1u) ? 0 : (bits & 2u) ? 1 : (bits & 4u) ? 2 : 3;
+      other_face = __builtin_ctz(bits);  // (the lowest face: bits is not 0)
       if (!on_face[other_face]) {
         on_face[other_face] = true;
         zero_weights(surface_weight[other_face], n);
@@ -59,7 +57,7 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
     }
     int side_slot = -1;  // a face on the plane shared with a left-out piece's sub-tet
     if (const unsigned side = (face_planes >> 1) & flux_slots & 0xFu) {
-      side_slot = (side & 1u) ? 0 : (side & 2u) ? 1 : (side & 4u) ? 2 : 3;
+      side_slot = __builtin_ctz(side);
       if (!on_side[side_slot]) {
         on_side[side_slot] = true;
         zero_weights(flux_weight[side_slot], n);
