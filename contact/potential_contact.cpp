@@ -319,6 +319,13 @@ PairNormals unit_normals(const TetPairFrame& frame, Vec3 (&normals)[2][4]) {
 #define FDEM_CONTACT_CLONES
 #endif
 
+// The pair's frame and its face-plane test, built alike: every candidate pair the boxes pass
+// comes here.
+FDEM_CONTACT_CLONES bool prepare_pair(const PreparedContactor& contactor, const TetGeometry& target,
+                                      TetPairFrame& frame, int first_plane, int* separating_plane) {
+  return prepare_tet_pair(contactor, target, frame, first_plane, separating_plane);
+}
+
 // The sliver bounds, built alike.
 FDEM_CONTACT_CLONES unsigned negligible_parts_of(const TetPairFrame& frame,
                                                  const PairMetrics& metrics, double tolerance,
@@ -413,9 +420,9 @@ ContactPairResult potential_contact(const PreparedContactor& contactor, const Te
                                     double penalty, double sliver_tolerance, ClipMemo* memo) {
   TetPairFrame frame;
   int plane = -1;
-  if (!prepare_tet_pair(contactor, target, frame,
-                        memo ? memo->apart_before - ClipMemo::kApartAtPlane : -1,
-                        memo ? &plane : nullptr)) {
+  if (!prepare_pair(contactor, target, frame,
+                    memo ? memo->apart_before - ClipMemo::kApartAtPlane : -1,
+                    memo ? &plane : nullptr)) {
     if (plane >= 0) {
       memo->apart_now = static_cast<std::uint8_t>(ClipMemo::kApartAtPlane + plane);
       memo->apart_gap = face_plane_gap(contactor, target, plane / 4, plane % 4);
