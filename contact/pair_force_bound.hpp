@@ -26,6 +26,7 @@
 #include <limits>
 
 #include "contact/tet_overlap.hpp"
+#include "core/lanes.hpp"
 
 namespace fdem {
 
@@ -234,23 +235,22 @@ inline void piece_force_bounds(const PairMetrics& metrics, const double (&mu)[8]
         std::min(pair.volume, thinnest_own * thinnest_own * pair.length / (largest * largest));
     if (!(4.0 * largest * least_volume <= above)) continue;
     // The prism of slabs a, b for piece i: its slab of face i thinned to m_T.  The four pieces
-    // side by side (one vector lane each).
-    double volume[4], surface[4];
-    for (int i = 0; i < 4; ++i) volume[i] = pair.volume, surface[i] = pair.surface;
+    // side by side (one vector lane each, each lane rounding as alone).
+    const double length = pair.length;
+    Lanes volume = Lanes{} + pair.volume, surface = Lanes{} + pair.surface;
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) {
         if (!(tet.cross_norm[kFacePair[a][b]] > 0.0)) continue;
         const double inverse_cross = tet.inverse_cross_norm[kFacePair[a][b]];
-        double nu_a[4], nu_b[4];  // per piece i: the slabs a and b, face i's thinned to m_T
-        for (int i = 0; i < 4; ++i) nu_a[i] = own[a], nu_b[i] = own[b];
+        Lanes nu_a = Lanes{} + own[a], nu_b = Lanes{} + own[b];  // lane i: face i's thinned
         nu_a[a] = thinnest_own;
         nu_b[b] = thinnest_own;
-        for (int i = 0; i < 4; ++i) {
-          const double section = nu_a[i] * nu_b[i] * inverse_cross;
-          const double perimeter = 2.0 * (nu_a[i] * norm[b] + nu_b[i] * norm[a]) * inverse_cross;
-          volume[i] = std::min(volume[i], section * pair.length);
-          surface[i] = std::min(surface[i], 2.0 * section + perimeter * pair.length);
-        }
+        const Lanes section = nu_a * nu_b * inverse_cross;
+        const Lanes perimeter = 2.0 * (nu_a * norm[b] + nu_b * norm[a]) * inverse_cross;
+        const Lanes prism_volume = section * length;
+        const Lanes prism_surface = 2.0 * section + perimeter * length;
+        volume = prism_volume < volume ? prism_volume : volume;  // std::min(volume, ...)
+        surface = prism_surface < surface ? prism_surface : surface;
       }
     for (int i = 0; i < 4; ++i)
       bound[4 * T + i] = 4.0 * largest * volume[i] + 4.0 * thinnest_own * surface[i];
