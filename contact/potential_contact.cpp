@@ -6,6 +6,7 @@
 #include "contact/pair_force_bound.hpp"
 #include "contact/piece_clipper.hpp"
 #include "contact/potential_contact_kernels.hpp"
+#include "core/lanes.hpp"
 
 namespace fdem {
 namespace {
@@ -99,37 +100,27 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
   volume_weight[0] += piece_vol6;  // the apex term: vol6 of the piece times the apex's values
   out.vol6[own_sub] = piece_vol6;  // one piece per sub-tet
   out.integrated |= 1u << own_sub;
-  double moment[moments] = {};
+  // The sums below run over the vertices four values side by side (one vector lane each, each
+  // lane rounding as alone).
+  Lanes moment[moments / 4] = {};
   for (int v = 0; v < n; ++v) {
-    const double wv = volume_weight[v];
-    const double* lam = vertex[v]->lam;
-    for (int c = 0; c < moments; ++c) moment[c] += wv * lam[c];
+    const Lanes wv = Lanes{} + volume_weight[v];
+    for (int h = 0; h < moments / 4; ++h) moment[h] += wv * load_lanes(vertex[v]->lam + 4 * h);
   }
-  for (int c = 0; c < moments; ++c) out.moment[own_sub][c] = moment[c];
-  // (the sums run in local lanes, four side by side, and are stored once)
+  for (int h = 0; h < moments / 4; ++h) store_lanes(moment[h], out.moment[own_sub] + 4 * h);
   for (int slot = 0; slot < 4; ++slot) {
     if (!((flux_slots >> slot) & 1u)) continue;
-    double sum[4] = {0.0, 0.0, 0.0, 0.0};
+    Lanes sum = {};
     if (on_side[slot])
-      for (int v = 0; v < n; ++v) {
-        const double fv = flux_weight[slot][v];
-        const double* lam = vertex[v]->lam;
-        for (int a = 0; a < 4; ++a) sum[a] += fv * lam[a];
-      }
-    for (int a = 0; a < 4; ++a) out.flux[own_sub][slot][a] = sum[a];
+      for (int v = 0; v < n; ++v) sum += flux_weight[slot][v] * load_lanes(vertex[v]->lam);
+    store_lanes(sum, out.flux[own_sub][slot]);
   }
   for (int j = 0; j < 4; ++j) {
     if (!on_face[j]) continue;
-    double sum[4] = {0.0, 0.0, 0.0, 0.0};
-    if ((out.surfaced >> j) & 1u)
-      for (int b = 0; b < 4; ++b) sum[b] = out.surface[j][b];
+    Lanes sum = (out.surfaced >> j) & 1u ? load_lanes(out.surface[j]) : Lanes{};
     out.surfaced |= 1u << j;
-    for (int v = 0; v < n; ++v) {
-      const double sv = surface_weight[j][v];
-      const double* lam = vertex[v]->lam + 4;
-      for (int b = 0; b < 4; ++b) sum[b] += sv * lam[b];
-    }
-    for (int b = 0; b < 4; ++b) out.surface[j][b] = sum[b];
+    for (int v = 0; v < n; ++v) sum += surface_weight[j][v] * load_lanes(vertex[v]->lam + 4);
+    store_lanes(sum, out.surface[j]);
   }
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstring>
 
 namespace fdem {
 
@@ -21,6 +22,15 @@ inline double select(bool take_first, double a, double b) {
 template <class Mask>
 inline Lanes select(Mask take_first, Lanes a, Lanes b) {
   return take_first ? a : b;
+}
+// Four doubles from memory and back (any alignment).
+inline Lanes load_lanes(const double* from) {
+  Lanes out;
+  std::memcpy(&out, from, sizeof out);
+  return out;
+}
+inline void store_lanes(const Lanes& value, double* to) {
+  std::memcpy(to, &value, sizeof value);
 }
 inline double log_of(double x) {
   return std::log(x);
