@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/lanes.hpp"
 #include "core/types.hpp"
 
 namespace fdem {
@@ -94,13 +95,18 @@ inline bool tet_boxes_intersect(const TetCorners& a, const TetCorners& b) {
 }
 
 // lambda[v][a]: barycentric coordinate a of `map`'s tet at corner v of `other` (local coords).
+// The four coordinates side by side (one vector lane each), each summed as value() sums it:
+// (g_x y_x + g_y y_y) + g_z y_z, then the offset.
 inline void barycentric_at_corners(const BarycentricMap& map, const Vec3 (&other_local)[4],
                                    double (&lambda)[4][4]) {
+  const Vec3(&g)[4] = map.gradient;
+  const Lanes gx = {g[0].x(), g[1].x(), g[2].x(), g[3].x()};
+  const Lanes gy = {g[0].y(), g[1].y(), g[2].y(), g[3].y()};
+  const Lanes gz = {g[0].z(), g[1].z(), g[2].z(), g[3].z()};
+  const Lanes offset = load_lanes(map.offset);
   for (int v = 0; v < 4; ++v) {
-    lambda[v][1] = map.value(1, other_local[v]);
-    lambda[v][2] = map.value(2, other_local[v]);
-    lambda[v][3] = map.value(3, other_local[v]);
-    lambda[v][0] = map.value(0, other_local[v]);
+    const Vec3& y = other_local[v];
+    store_lanes(gx * y.x() + gy * y.y() + gz * y.z() + offset, lambda[v]);
   }
 }
 

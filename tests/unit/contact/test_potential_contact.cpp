@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 #include "contact/potential_contact_kernels.hpp"
@@ -271,6 +272,33 @@ TEST_CASE("separated and touching tets give zero, and contact starts continuousl
       previous_f = r.normal_force;
     }
   }
+}
+
+TEST_CASE("barycentric values at the other corners, four lanes, equal value() bit for bit",
+          "[potential_contact]") {
+  // plane_values_at_other uses BarycentricMap::value() and prepare_tet_pair the lanes: the same
+  // bits, or a pair apart at its remembered plane could be decided otherwise than by the frame.
+  std::mt19937_64 rng(4711);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  int compared = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double scale = std::pow(10.0, u(rng));  // tets of 1 mm to 1 km
+    const TetCorners a = random_tet(rng, scale, Vec3(u(rng), u(rng), u(rng)) * scale, 0.3);
+    const TetCorners b = random_tet(rng, scale, Vec3(u(rng), u(rng), u(rng)) * scale, 0.3);
+    BarycentricMap map;
+    if (!make_barycentric_map(a, tet_centroid(a), map)) continue;
+    Vec3 local[4];
+    for (int v = 0; v < 4; ++v) local[v] = b.x[v] - tet_centroid(a);
+    double lambda[4][4];
+    barycentric_at_corners(map, local, lambda);
+    for (int v = 0; v < 4; ++v)
+      for (int k = 0; k < 4; ++k) {
+        const double expected = map.value(k, local[v]);
+        CHECK(std::memcmp(&lambda[v][k], &expected, sizeof expected) == 0);
+        ++compared;
+      }
+  }
+  CHECK(compared > 30000);
 }
 
 TEST_CASE("tets_may_overlap never rejects an overlapping pair", "[potential_contact]") {
