@@ -198,27 +198,26 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
   const unsigned flux_slots = (left_out >> (4 * own)) & 0xFu;
   // Quick rejection of a piece: its four vertices strictly outside one plane of the other tet, or
   // the other tet's four corners strictly outside one side plane of the sub-tet (lambda_i <=
-  // lambda_k inside it).  Either way the piece has no volume.  corner_outside[b]: bit s where own
-  // corner s lies outside the other tet's plane b; sub-tet i's vertices are the corners s != i
-  // and the centroid.
-  unsigned corner_outside[4], centroid_outside = 0;
-  for (int b = 0; b < 4; ++b) {
-    corner_outside[b] = 0;
-    for (int s = 0; s < 4; ++s)
-      corner_outside[b] |= static_cast<unsigned>(other_at_corner[s][b] < 0.0) << s;
-    centroid_outside |= static_cast<unsigned>(other_at_centroid[b] < 0.0) << b;
-  }
+  // lambda_k inside it).  Either way the piece has no volume.  Sub-tet i's vertices are the
+  // corners s != i and the centroid.  The planes side by side (one vector lane each): lane b of
+  // outside[s], whether own corner s (s = 4: the centroid) lies outside the other tet's plane b.
+  LaneMask outside[5];
+  for (int s = 0; s < 4; ++s) outside[s] = load_lanes(other_at_corner[s]) < 0.0;
+  outside[4] = load_lanes(other_at_centroid) < 0.0;
   Piece piece;
   for (int i = 0; i < 4; ++i) {
     if ((left_out >> (4 * own + i)) & 1u) continue;
-    bool empty = false;
-    for (int b = 0; b < 4; ++b)
-      empty |= ((corner_outside[b] | (1u << i)) == 0xFu) & ((centroid_outside >> b) & 1u);
-    for (int k = 0; k < 4; ++k)
-      empty |= (k != i) & (own_at_other_corner[0][i] > own_at_other_corner[0][k]) &
-               (own_at_other_corner[1][i] > own_at_other_corner[1][k]) &
-               (own_at_other_corner[2][i] > own_at_other_corner[2][k]) &
-               (own_at_other_corner[3][i] > own_at_other_corner[3][k]);
+    // Lane b: the sub-tet's four vertices outside plane b.  Lane k: the other tet's four corners
+    // where lambda_i > lambda_k, outside sub-tet i's side k.
+    LaneMask all_outside = outside[4];
+    for (int s = 0; s < 4; ++s)
+      if (s != i) all_outside &= outside[s];
+    LaneMask all_beyond = load_lanes(own_at_other_corner[0]) < own_at_other_corner[0][i];
+    for (int v = 1; v < 4; ++v)
+      all_beyond &= load_lanes(own_at_other_corner[v]) < own_at_other_corner[v][i];
+    all_beyond[i] = 0;  // (not a side of its own)
+    const LaneMask either = all_outside | all_beyond;
+    const bool empty = (either[0] | either[1] | either[2] | either[3]) != 0;
     if (empty) continue;
     // Sub-tet i = own corners k != i plus the centroid in slot i (kSubTetVertices).
     piece.count = 4;

@@ -119,9 +119,10 @@ inline bool outside_face_plane(const double (&lambda)[4][4], int a) {
 // True when some face plane of the map's tet has all four corners of the other tet strictly
 // outside.  Bitwise, as boxes_intersect.
 inline bool separated_by_face_plane(const double (&lambda)[4][4]) {
-  bool separated = false;
-  for (int a = 0; a < 4; ++a) separated |= outside_face_plane(lambda, a);
-  return separated;
+  // The four planes side by side (one vector lane each): the comparisons outside_face_plane makes.
+  const LaneMask outside = (load_lanes(lambda[0]) < 0.0) & (load_lanes(lambda[1]) < 0.0) &
+                           (load_lanes(lambda[2]) < 0.0) & (load_lanes(lambda[3]) < 0.0);
+  return (outside[0] | outside[1] | outside[2] | outside[3]) != 0;
 }
 
 // The interval [lo, hi] that the four corners project to on `axis`.
