@@ -47,16 +47,18 @@ constexpr int kMaxThinSlabs = 4;
 // pair that passed the face-plane test (`frame` as filled by prepare_tet_pair); returns the
 // smallest.
 inline double slab_depths(const TetPairFrame& frame, double (&mu)[8]) {
-  double thinnest = 1.0;
+  // The four faces side by side (one vector lane each), with std::max's and std::clamp's choices.
+  const auto larger = [](Lanes x, Lanes y) { return x < y ? y : x; };
   for (int T = 0; T < 2; ++T) {
     const double(&at_other_corners)[4][4] = frame.lambda_other[1 - T];
-    for (int a = 0; a < 4; ++a) {
-      const double peak = std::max(std::max(at_other_corners[0][a], at_other_corners[1][a]),
-                                   std::max(at_other_corners[2][a], at_other_corners[3][a]));
-      mu[4 * T + a] = std::clamp(peak, 0.0, 1.0);
-      thinnest = std::min(thinnest, mu[4 * T + a]);
-    }
+    const Lanes peak =
+        larger(larger(load_lanes(at_other_corners[0]), load_lanes(at_other_corners[1])),
+               larger(load_lanes(at_other_corners[2]), load_lanes(at_other_corners[3])));
+    const Lanes zero = Lanes{}, one = zero + 1.0;
+    store_lanes(peak < zero ? zero : (one < peak ? one : peak), mu + 4 * T);
   }
+  double thinnest = 1.0;
+  for (int k = 0; k < 8; ++k) thinnest = std::min(thinnest, mu[k]);
   return thinnest;
 }
 

@@ -360,26 +360,22 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
     for (int i = 0; i < 4; ++i) energy += vol_integral[s][i][i];
     const Vec3* inward_normal = normals.of[s];  // of own face i: grad lambda_i / |grad lambda_i|
     // The four nodes side by side (one vector lane each), each summed in the same order as alone.
-    double f[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // [component][node a]
+    Lanes f[3] = {};  // [component], lane a: node a
     // A term a sub-tet does not have (no piece; no surface on its face) adds only zeros and is
     // passed over: f never holds -0 (it starts at +0, and a sum that cancels rounds to +0).
     for (int i = 0; i < 4; ++i) {
-      double term[4];
       if ((side[s].integrated >> i) & 1u) {  // volume term: grad phi = 4 grad lambda_i on piece i
         const Vec3& gradient = own.gradient[i];
-        for (int a = 0; a < 4; ++a) term[a] = 4.0 * vol_integral[s][i][a];
-        for (int k = 0; k < 3; ++k)
-          for (int a = 0; a < 4; ++a) f[k][a] += term[a] * gradient[k];
+        const Lanes term = 4.0 * load_lanes(vol_integral[s][i]);
+        for (int k = 0; k < 3; ++k) f[k] += term * gradient[k];
       }
       if ((other_side.surfaced >> i) & 1u) {    // on own face i: - ∫ phi_other lambda_a n dS
         const Vec3& normal = inward_normal[i];  // n: the outward unit normal is -normal
-        for (int a = 0; a < 4; ++a) term[a] = other_side.surface[i][a] * (1.0 / 24.0);
-        for (int k = 0; k < 3; ++k)
-          for (int a = 0; a < 4; ++a) f[k][a] += term[a] * normal[k];
+        const Lanes term = load_lanes(other_side.surface[i]) * (1.0 / 24.0);
+        for (int k = 0; k < 3; ++k) f[k] += term * normal[k];
       }
     }
-    for (int a = 0; a < 4; ++a)
-      force[s][a] = Vec3(penalty * f[0][a], penalty * f[1][a], penalty * f[2][a]);
+    for (int k = 0; k < 3; ++k) f[k] = penalty * f[k];
     // The pieces' forces sum to the gradient of the energy because the boundary term
     // -p ∫ phi lambda_a n dS on the face two sub-tets share cancels between their pieces.  A
     // left-out piece i leaves it to each kept neighbour k, over k's face on their plane (normal
@@ -390,10 +386,11 @@ FDEM_CONTACT_CLONES ContactPairResult assemble(const TetPairFrame& frame,
       for (unsigned kept = side[s].integrated & ~(1u << i); kept; kept &= kept - 1) {
         const int k = __builtin_ctz(kept);
         const Vec3& normal = side[s].flux_normal[k][i];
-        for (int a = 0; a < 4; ++a)
-          force[s][a] -= (penalty * side[s].flux[k][i][a] * (1.0 / 24.0)) * normal;
+        const Lanes flux = penalty * load_lanes(side[s].flux[k][i]) * (1.0 / 24.0);
+        for (int c = 0; c < 3; ++c) f[c] -= flux * normal[c];
       }
     }
+    for (int a = 0; a < 4; ++a) force[s][a] = Vec3(f[0][a], f[1][a], f[2][a]);
   }
   energy *= 4.0 * penalty;
 
