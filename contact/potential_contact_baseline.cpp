@@ -183,12 +183,36 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
   return r;
 }
 
+// The pair's frame as the start built it, scalar, from the corners alone: the shared
+// prepare_tet_pair has since taken per-tet work for the bounds (gradient metrics, longest edges)
+// and vector lanes, which would change what the baseline costs.  The same values bit for bit.
+bool start_frame(const TetCorners& contactor, const TetCorners& target, TetPairFrame& frame) {
+  if (!tet_boxes_intersect(contactor, target)) return false;
+  frame.origin = tet_centroid(contactor);
+  for (int v = 0; v < 4; ++v) {
+    frame.local[0][v] = contactor.x[v] - frame.origin;
+    frame.local[1][v] = target.x[v] - frame.origin;
+  }
+  if (!make_barycentric_map(contactor, frame.origin, frame.map[0]) ||
+      !make_barycentric_map(target, frame.origin, frame.map[1]))
+    return false;
+  for (int T : {1, 0}) {  // the other tet's corners in tet T's map, then its planes
+    double(&lambda)[4][4] = frame.lambda_other[1 - T];
+    for (int v = 0; v < 4; ++v)
+      for (int a : {1, 2, 3, 0}) lambda[v][a] = frame.map[T].value(a, frame.local[1 - T][v]);
+    bool separated = false;
+    for (int a = 0; a < 4; ++a) separated |= outside_face_plane(lambda, a);
+    if (separated) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 ContactPairResult potential_contact_baseline(const TetCorners& contactor, const TetCorners& target,
                                              double penalty) {
   TetPairFrame frame;
-  if (!prepare_tet_pair(contactor, target, frame)) return zero_result();
+  if (!start_frame(contactor, target, frame)) return zero_result();
   return assemble(frame, penalty);
 }
 
