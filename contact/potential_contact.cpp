@@ -464,14 +464,7 @@ ContactPairResult potential_contact_without(const TetCorners& contactor, const T
 ContactPairResult potential_contact_unculled(const TetCorners& contactor, const TetCorners& target,
                                              double penalty) {
   TetPairFrame frame;
-  frame.origin = tet_centroid(contactor);
-  for (int v = 0; v < 4; ++v) {
-    frame.local[0][v] = contactor.x[v] - frame.origin;
-    frame.local[1][v] = target.x[v] - frame.origin;
-  }
-  if (!make_barycentric_map(contactor, frame.origin, frame.map[0]) ||
-      !make_barycentric_map(target, frame.origin, frame.map[1]))
-    return zero_result();
+  if (!frame_maps_from_corners(contactor, target, frame)) return zero_result();
   barycentric_at_corners(frame.map[1], frame.local[0], frame.lambda_other[0]);
   barycentric_at_corners(frame.map[0], frame.local[1], frame.lambda_other[1]);
   Vec3 normals[2][4];

@@ -187,14 +187,7 @@ ContactPairResult assemble(const TetPairFrame& frame, double penalty) {
 // prepare_tet_pair has since taken per-tet work for the bounds (gradient metrics, longest edges)
 // and vector lanes, which would change what the baseline costs.  The same values bit for bit.
 bool start_frame(const TetCorners& contactor, const TetCorners& target, TetPairFrame& frame) {
-  if (!tet_boxes_intersect(contactor, target)) return false;
-  frame.origin = tet_centroid(contactor);
-  for (int v = 0; v < 4; ++v) {
-    frame.local[0][v] = contactor.x[v] - frame.origin;
-    frame.local[1][v] = target.x[v] - frame.origin;
-  }
-  if (!make_barycentric_map(contactor, frame.origin, frame.map[0]) ||
-      !make_barycentric_map(target, frame.origin, frame.map[1]))
+  if (!tet_boxes_intersect(contactor, target) || !frame_maps_from_corners(contactor, target, frame))
     return false;
   for (int T : {1, 0}) {  // the other tet's corners in tet T's map, then its planes
     double(&lambda)[4][4] = frame.lambda_other[1 - T];

@@ -334,6 +334,19 @@ inline double face_plane_gap(const PreparedContactor& contactor, const TetGeomet
   return peak < -kMargin ? (-peak - kMargin) / gradient.norm() : 0.0;
 }
 
+// A pair's frame from the corners alone: the origin (the contactor's centroid), the corners about
+// it and both maps, without the corner values; false for a degenerate tet.
+inline bool frame_maps_from_corners(const TetCorners& contactor, const TetCorners& target,
+                                    TetPairFrame& frame) {
+  frame.origin = tet_centroid(contactor);
+  for (int v = 0; v < 4; ++v) {
+    frame.local[0][v] = contactor.x[v] - frame.origin;
+    frame.local[1][v] = target.x[v] - frame.origin;
+  }
+  return make_barycentric_map(contactor, frame.origin, frame.map[0]) &&
+         make_barycentric_map(target, frame.origin, frame.map[1]);
+}
+
 // The 4+4 face planes (the caller has tested the boxes: a pair whose boxes are apart ends the same,
 // only later).  False when the pair certainly does not overlap (or a tet is degenerate); true
 // means "may overlap" and fills `frame`.
