@@ -54,7 +54,7 @@ inline double slab_depths(const TetPairFrame& frame, double (&mu)[8]) {
     const Lanes peak =
         larger(larger(load_lanes(at_other_corners[0]), load_lanes(at_other_corners[1])),
                larger(load_lanes(at_other_corners[2]), load_lanes(at_other_corners[3])));
-    const Lanes zero = Lanes{}, one = zero + 1.0;
+    const Lanes zero = splat(0.0), one = splat(1.0);
     store_lanes(peak < zero ? zero : (one < peak ? one : peak), mu + 4 * T);
   }
   double thinnest = 1.0;
@@ -239,12 +239,12 @@ inline void piece_force_bounds(const PairMetrics& metrics, const double (&mu)[8]
     // The prism of slabs a, b for piece i: its slab of face i thinned to m_T.  The four pieces
     // side by side (one vector lane each, each lane rounding as alone).
     const double length = pair.length;
-    Lanes volume = Lanes{} + pair.volume, surface = Lanes{} + pair.surface;
+    Lanes volume = splat(pair.volume), surface = splat(pair.surface);
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) {
         if (!(tet.cross_norm[kFacePair[a][b]] > 0.0)) continue;
         const double inverse_cross = tet.inverse_cross_norm[kFacePair[a][b]];
-        Lanes nu_a = Lanes{} + own[a], nu_b = Lanes{} + own[b];  // lane i: face i's thinned
+        Lanes nu_a = splat(own[a]), nu_b = splat(own[b]);  // lane i: face i's thinned
         nu_a[a] = thinnest_own;
         nu_b[b] = thinnest_own;
         const Lanes section = nu_a * nu_b * inverse_cross;

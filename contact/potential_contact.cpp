@@ -13,6 +13,14 @@ namespace {
 
 using namespace piece_clip;
 
+// Zeroes w[0, n): the first 16 (a piece has ~8 vertices) by a fixed-size store the compiler
+// writes out inline, where a loop to n would become a call to memset.
+inline void zero_weights(double (&w)[kMaxVertices], int n) {
+  static_assert(kMaxVertices >= 16);
+  std::fill_n(w, 16, 0.0);
+  for (int v = 16; v < n; ++v) w[v] = 0.0;
+}
+
 // Accumulates one piece (sub-tet `own_sub` clipped; its n vertices in the clipper's order and its
 // faces, from a fresh clip or its replay): cone sums over all faces from an apex at the piece's
 // first vertex (a point of the piece: no cancellation between remote cones, so slivers
@@ -22,14 +30,6 @@ using namespace piece_clip;
 // end.  `moments`: how many carried values need their moment (4: own only, 8: own and other).
 // area_weight[j]: maps a barycentric-space doubled area vector to the doubled physical area
 // projected on face j's outward unit normal.
-// Zeroes w[0, n): the first 16 (a piece has ~8 vertices) by a fixed-size store the compiler
-// writes out inline, where a loop to n would become a call to memset.
-inline void zero_weights(double (&w)[kMaxVertices], int n) {
-  static_assert(kMaxVertices >= 16);
-  std::fill_n(w, 16, 0.0);
-  for (int v = 16; v < n; ++v) w[v] = 0.0;
-}
-
 template <int moments>
 void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& faces, int own_sub,
                      const double (&area_weight)[4][3], const double (&side_weight)[4][3],
@@ -104,7 +104,7 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
   // lane rounding as alone).
   Lanes moment[moments / 4] = {};
   for (int v = 0; v < n; ++v) {
-    const Lanes wv = Lanes{} + volume_weight[v];
+    const Lanes wv = splat(volume_weight[v]);
     for (int h = 0; h < moments / 4; ++h) moment[h] += wv * load_lanes(vertex[v]->lam + 4 * h);
   }
   for (int h = 0; h < moments / 4; ++h) store_lanes(moment[h], out.moment[own_sub] + 4 * h);

@@ -193,9 +193,17 @@ struct TetPairFrame {
   double lambda_other[2][4][4];  // [s][v][a]: lambda of tet 1-s, component a, at corner v of s
 };
 
-// The lengths the sliver bounds (pair_force_bound.hpp) take from a tet's barycentric map:
-// computed once per tet and step for all its pairs, with the arithmetic the bounds would use, so
-// the same values bit for bit.
+// The square of the longest of the six edges of the tet with corners x (m²).
+inline double longest_edge_squared(const Vec3 (&x)[4]) {
+  double longest = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (x[a] - x[b]).squaredNorm());
+  return longest;
+}
+
+// The lengths the sliver bounds (pair_force_bound.hpp) take from a tet (its barycentric map and
+// its longest edge): computed once per tet and step for all its pairs, with the arithmetic the
+// bounds would use, so the same values bit for bit.
 struct GradientMetrics {
   double norm[4];        // |grad lambda_a| (1/m): 1 / the height over face a
   double largest;        // max_a norm[a] (1/m)
@@ -205,12 +213,6 @@ struct GradientMetrics {
   double longest_edge;           // m
 };
 
-inline double longest_edge_squared(const Vec3 (&x)[4]) {
-  double longest = 0.0;
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) longest = std::max(longest, (x[a] - x[b]).squaredNorm());
-  return longest;
-}
 // The slot of the gradients' pair {a, b}, a != b, in GradientMetrics (-1 on the diagonal).
 constexpr int kFacePair[4][4] = {{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}};
 

@@ -1,7 +1,6 @@
 #include "core/dynamics.hpp"
 
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 #include "core/tet_force_kernel.hpp"
@@ -313,10 +312,8 @@ inline void integrate_four_free_nodes(double dt, NodeArrays& nodes, LocalIndex n
   const double* f = nodes.f.data() + 3 * static_cast<std::size_t>(n);
   double dx[12];
   for (int j = 0; j < 3; ++j) {
-    Lanes v_old, force, position;
-    std::memcpy(&v_old, v + 4 * j, sizeof v_old);
-    std::memcpy(&force, f + 4 * j, sizeof force);
-    std::memcpy(&position, x + 4 * j, sizeof position);
+    const Lanes v_old = load_lanes(v + 4 * j), force = load_lanes(f + 4 * j);
+    Lanes position = load_lanes(x + 4 * j);
     const Lanes v_new = v_old + dt * force / mass[j];
     sum.kinetic2_lanes[j] += mass[j] * v_old * v_new;
     sum.kinetic_half2_lanes[j] += mass[j] * v_new * v_new;
@@ -326,9 +323,9 @@ inline void integrate_four_free_nodes(double dt, NodeArrays& nodes, LocalIndex n
     position += step;
     const Lanes magnitude = position < 0.0 ? -position : position;
     sum.max_abs_x_lanes = sum.max_abs_x_lanes < magnitude ? magnitude : sum.max_abs_x_lanes;
-    std::memcpy(v + 4 * j, &v_new, sizeof v_new);
-    std::memcpy(x + 4 * j, &position, sizeof position);
-    std::memcpy(dx + 4 * j, &step, sizeof step);
+    store_lanes(v_new, v + 4 * j);
+    store_lanes(position, x + 4 * j);
+    store_lanes(step, dx + 4 * j);
   }
   for (int node = 0; node < 4; ++node) {
     const double* d = dx + 3 * node;

@@ -23,6 +23,10 @@ template <class Mask>
 inline Lanes select(Mask take_first, Lanes a, Lanes b) {
   return take_first ? a : b;
 }
+// One value in every lane.
+inline Lanes splat(double x) {
+  return Lanes{x, x, x, x};
+}
 // Four doubles from memory and back (any alignment).
 inline Lanes load_lanes(const double* from) {
   Lanes out;
