@@ -64,6 +64,11 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
         zero_weights(flux_weight[side_slot], n);
       }
     }
+    // A face through the apex starts at it (walk_faces walks the apex's three faces first, from
+    // the apex): its cones are flat, vol6 = 0 · area = ±0, which adds nothing to sums that start
+    // at +0.  Such a face is integrated only where it carries a surface or flux term.
+    const bool through_apex = face[0] == 0;
+    if (through_apex && other_face < 0 && side_slot < 0) continue;
     // Fan from the face's first vertex.
     const double* x0 = vertex[face[0]]->lam;
     const double h0[3] = {x0[1] - apex[1], x0[2] - apex[2], x0[3] - apex[3]};
@@ -74,11 +79,13 @@ void integrate_piece(const PieceVertex* const* vertex, int n, const PieceFaces& 
       const double w[3] = {x2[1] - x0[1], x2[2] - x0[2], x2[3] - x0[3]};
       const double area2[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
                                u[0] * w[1] - u[1] * w[0]};
-      const double vol6 = h0[0] * area2[0] + h0[1] * area2[1] + h0[2] * area2[2];
-      piece_vol6 += vol6;
-      volume_weight[face[0]] += vol6;
-      volume_weight[face[k]] += vol6;
-      volume_weight[face[k + 1]] += vol6;
+      if (!through_apex) {
+        const double vol6 = h0[0] * area2[0] + h0[1] * area2[1] + h0[2] * area2[2];
+        piece_vol6 += vol6;
+        volume_weight[face[0]] += vol6;
+        volume_weight[face[k]] += vol6;
+        volume_weight[face[k + 1]] += vol6;
+      }
       // ∫_tri f g dS = A/12 (sum f_k g_k + (sum f)(sum g)), f = 4 lambda_own, g any carried
       // value: vertex k carries A (f_k + sum f), A the triangle's area on the plane that
       // `weight` projects onto.
