@@ -376,7 +376,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
   std::vector<std::uint8_t>& clip_written = clip_records_[clip_parity_ ^ 1];
   clip_written.clear();
   clip_parity_ ^= 1;
-  for (std::size_t index = 0; index < pairs_.size(); ++index) {
+  const std::size_t pair_count = pairs_.size();
+  for (std::size_t index = 0; index < pair_count; ++index) {
     const std::int32_t slot_a = pair_slots_[2 * index], slot_b = pair_slots_[2 * index + 1];
     // Apart by more than its tets have moved since (apart_pairs.hpp): as it was, with no record.
     if (apart_pairs_.still_apart(index, slot_a, slot_b)) {
@@ -399,7 +400,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     // (a corner may hold just outside its face's tet, beside a fold: corners_ tests every pair)
     if (!corners_ && !boxes_intersect(tet_boxes_[slot_a], tet_boxes_[slot_b])) {
       if (clip_replay_)
-        apart_pairs_.found(index, pairs_.size(), slot_a, slot_b,
+        apart_pairs_.found(index, pair_count, slot_a, slot_b,
                            box_gap(tet_boxes_[slot_a], tet_boxes_[slot_b]));
       lost();
       continue;
@@ -417,9 +418,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     memo.apart_before = apart_before;
     std::size_t record_start = 0;
     if (clip_replay_) {
-      if (clip_record_at_.size() != pairs_.size()) {
-        clip_record_at_.assign(pairs_.size(), kNoClipRecord);
-        apart_at_.assign(pairs_.size(), ClipMemo::kNotApart);
+      if (clip_record_at_.size() != pair_count) {
+        clip_record_at_.assign(pair_count, kNoClipRecord);
+        apart_at_.assign(pair_count, ClipMemo::kNotApart);
       }
       if (clip_read_at != kNoClipRecord) {
         memo.previous = clip_read.data() + clip_read_at + 2;
@@ -427,7 +428,10 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
             memo.previous + (clip_read[clip_read_at] | (clip_read[clip_read_at + 1] << 8));
       }
       record_start = clip_written.size();
-      clip_written.resize(record_start + 2);  // the pair's length, once known
+      // Two bytes for the pair's length, once known (push_back: a resize made a call and a memset
+      // per pair).
+      clip_written.push_back(0);
+      clip_written.push_back(0);
       memo.record = &clip_written;
       memo.topologies = &clip_topologies_;
     }
@@ -448,14 +452,14 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       pieces_replayed_ += memo.replayed;
       pieces_clipped_ += memo.clipped;
       apart_at_[index] = memo.apart_now;
-      apart_pairs_.found(index, pairs_.size(), slot_a, slot_b, memo.apart_gap);
+      apart_pairs_.found(index, pair_count, slot_a, slot_b, memo.apart_gap);
       pairs_apart_by_edge_axis_ +=
           memo.apart_now >= ClipMemo::kApartAtAxis && memo.apart_now < ClipMemo::kApartAtPlane;
     }
     // Every rank that holds a pair computes it; the owner of its first tet reports its energies.
     const double share = tets.is_owned(pair.a) ? 1.0 : 0.0;
     if (corners_)  // a pair without contact may stay so for a known travel (corner_contact.hpp)
-      apart_pairs_.found(index, pairs_.size(), slot_a, slot_b,
+      apart_pairs_.found(index, pair_count, slot_a, slot_b,
                          r.overlapping
                              ? 0.0
                              : corner_pair_apart_travel(geometry_a, corner_tets_[slot_a],
@@ -528,7 +532,7 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     if (mu > 0.0) {
       // Stick spring k_t = p·s (N/m) with s the pair's size: as stiff as the normal contact.
       // (set once per contact: the pair's reference volumes do not change)
-      if (friction_of_pair_.empty()) friction_of_pair_.assign(pairs_.size(), nullptr);
+      if (friction_of_pair_.empty()) friction_of_pair_.assign(pair_count, nullptr);
       PairFriction*& entry = friction_of_pair_[index];
       if (!entry) entry = &friction_[PairId{tets.gid[pair.a], tets.gid[pair.b]}];
       PairFriction& pair_friction = *entry;
