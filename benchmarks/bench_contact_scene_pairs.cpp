@@ -145,12 +145,16 @@ int main(int argc, char** argv) {
       },
       sink);
 
-  // The evaluation at x0 leaves each pair its clip record and apart memo, as in the stage.
+  // The evaluation at x0 leaves each pair its clip record and apart memo, as in the stage, and
+  // every clip it made in the clips met before, which the stage's path then walks where a pair's
+  // record no longer fits (as the stage's own, shared by all pairs of a rank).
+  piece_clip::ClipTopologies topologies;
   std::vector<PairClipRecords> records(n);
   std::vector<std::vector<std::uint8_t>> record0(n);
   std::vector<std::uint8_t> apart0(n, ClipMemo::kNotApart);
   for (std::size_t i = 0; i < n; ++i) {
     ClipMemo memo = records[i].next();
+    memo.topologies = &topologies;
     potential_contact(prepared0[pairs[i].a], geometry0[pairs[i].b], penalty, tolerance, &memo);
     record0[i].assign(memo.record->begin(), memo.record->end());
     apart0[i] = memo.apart_now;
@@ -165,6 +169,7 @@ int main(int argc, char** argv) {
     scratch.clear();
     memo.record = &scratch;
     memo.apart_before = apart0[i];
+    memo.topologies = &topologies;
     return potential_contact(prepared1[p.a], geometry1[p.b], penalty, tolerance, &memo);
   };
 

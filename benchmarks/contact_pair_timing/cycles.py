@@ -146,8 +146,8 @@ def add_probes(tree):
          '      if (memo) ++memo->clipped;\n      ++fdem_cycles::now.fresh[own];\n'
          '      { const unsigned long long t = __rdtsc(); fdem_cycles::now.clip[own] += t - clip_from;\n'
          '        fdem_cycles::now.record[own] -= t - clip_from; }\n'),
-        ('    if (alive) {\n      out.nonempty |= 1u << i;',
-         '    lap(fdem_cycles::now.record);\n    if (alive) {\n      out.nonempty |= 1u << i;'),
+        ('    if (walked) {  // (alive but not walked',
+         '    lap(fdem_cycles::now.record);\n    if (walked) {  // (alive but not walked'),
         ('        integrate_piece<4>(vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);\n    }\n',
          '        integrate_piece<4>(vertex, n_vertices, faces, i, area_weight, side_weight, slots, out);\n'
          '    }\n    lap(fdem_cycles::now.integrate);\n'),
