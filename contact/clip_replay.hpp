@@ -169,19 +169,19 @@ class ReplayedVertices {
   }
   bool all(unsigned mask) const { return mask == (1u << n_) - 1u; }
   // Plane b (index k = 4 + b) with outside mask `mask`: keeps the vertices inside and makes one
-  // on each recorded edge (`edges`: n_new pairs of alive indices, kept end first).  False where
-  // they would not fit (cannot happen for the kernel's records: clip afresh).
+  // on each recorded edge (`edges`: n_new pairs of alive indices, kept end first), its
+  // coordinates only (the record holds the faces and their planes).  False where they would not
+  // fit (cannot happen for the kernel's records: clip afresh).
   bool cut(Piece& piece, int b, unsigned mask, const std::uint8_t* edges, int n_new) {
     if (made_ + n_new > kMaxVertices) return false;
     const int k = 4 + b;
     int kept = 0;
     for (int j = 0; j < n_; ++j)
       if (!((mask >> j) & 1u)) next_[kept++] = current_[j];
-    const unsigned plane_bit = 1u << (kOtherFaceShift + b);
     for (int q = 0; q < n_new; ++q, edges += 2) {
       const int a = edges[0], c = edges[1];
-      cut_edge(piece.v[current_[a]], piece.v[current_[c]], dist_[a], dist_[c], k, plane_bit,
-               piece.v[made_]);
+      cut_edge_values(piece.v[current_[a]], piece.v[current_[c]], dist_[a], dist_[c], k,
+                      piece.v[made_]);
       next_[kept++] = made_++;
     }
     if (kept > ClipLog::kMaxStageVertices && b < 3) return false;

@@ -240,13 +240,15 @@ inline void piece_force_bounds(const PairMetrics& metrics, const double (&mu)[8]
     // side by side (one vector lane each, each lane rounding as alone).
     const double length = pair.length;
     Lanes volume = splat(pair.volume), surface = splat(pair.surface);
+    const Lanes thinned = splat(thinnest_own);
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) {
         if (!(tet.cross_norm[kFacePair[a][b]] > 0.0)) continue;
         const double inverse_cross = tet.inverse_cross_norm[kFacePair[a][b]];
-        Lanes nu_a = splat(own[a]), nu_b = splat(own[b]);  // lane i: face i's thinned
-        nu_a[a] = thinnest_own;
-        nu_b[b] = thinnest_own;
+        // Lane i: face i's thinned (lane_index(): a blend, where a lane written at a variable
+        // index went through memory).
+        const Lanes nu_a = select(lane_index() == a, thinned, splat(own[a]));
+        const Lanes nu_b = select(lane_index() == b, thinned, splat(own[b]));
         const Lanes section = nu_a * nu_b * inverse_cross;
         const Lanes perimeter = 2.0 * (nu_a * norm[b] + nu_b * norm[a]) * inverse_cross;
         const Lanes prism_volume = section * length;

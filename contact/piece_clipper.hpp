@@ -40,11 +40,16 @@ constexpr int kTetNeighbours[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}
 // dist_b = b.lam[k]): interpolated from the kept end a, so that a shared edge gives the same point
 // in every piece that holds it.  One function for the clip and its replay (clip_replay.hpp): the
 // same operations, bit for bit.
-inline void cut_edge(const PieceVertex& a, const PieceVertex& b, double dist_a, double dist_b,
-                     int k, unsigned plane_bit, PieceVertex& w) {
+// The replay needs the coordinates only (its faces come with the record): cut_edge_values.
+inline void cut_edge_values(const PieceVertex& a, const PieceVertex& b, double dist_a,
+                            double dist_b, int k, PieceVertex& w) {
   const double t = dist_a / (dist_a - dist_b);  // in [0, 1)
   for (int c = 0; c < 8; ++c) w.lam[c] = a.lam[c] + t * (b.lam[c] - a.lam[c]);
   w.lam[k] = 0.0;
+}
+inline void cut_edge(const PieceVertex& a, const PieceVertex& b, double dist_a, double dist_b,
+                     int k, unsigned plane_bit, PieceVertex& w) {
+  cut_edge_values(a, b, dist_a, dist_b, k, w);
   w.planes = (a.planes & b.planes) | plane_bit;
 }
 

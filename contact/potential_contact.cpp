@@ -222,7 +222,7 @@ void integrate_side(const TetPairFrame& frame, const PairNormals& normals, int o
     LaneMask all_beyond = load_lanes(own_at_other_corner[0]) < own_at_other_corner[0][i];
     for (int v = 1; v < 4; ++v)
       all_beyond &= load_lanes(own_at_other_corner[v]) < own_at_other_corner[v][i];
-    all_beyond[i] = 0;  // (not a side of its own)
+    all_beyond &= lane_index() != i;  // (not a side of its own)
     const LaneMask either = all_outside | all_beyond;
     const bool empty = (either[0] | either[1] | either[2] | either[3]) != 0;
     if (empty) continue;

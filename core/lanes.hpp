@@ -23,6 +23,12 @@ template <class Mask>
 inline Lanes select(Mask take_first, Lanes a, Lanes b) {
   return take_first ? a : b;
 }
+// Lane i holds i: `lane_index() == k` is the mask of lane k alone.  (A lane chosen by such a mask
+// stays in registers; writing one lane at a variable index sends the vector through memory, and
+// the load after the store stalls.)
+inline LaneMask lane_index() {
+  return LaneMask{0, 1, 2, 3};
+}
 // One value in every lane.
 inline Lanes splat(double x) {
   return Lanes{x, x, x, x};

@@ -141,10 +141,10 @@ TEST_CASE("a clip log replays the clipper's own vertices", "[contact][clip_repla
   REQUIRE(replay_piece(pool, log.bytes, log.bytes + log.size, vertex, n, replayed_faces) ==
           Replay::kept);
   REQUIRE(n == fresh.count);
-  for (int v = 0; v < n; ++v) {
+  // The same coordinates bit for bit.  (The replay leaves the vertices' plane tags unset: the
+  // faces it hands out carry their planes, compared below.)
+  for (int v = 0; v < n; ++v)
     CHECK(std::memcmp(vertex[v]->lam, fresh.v[v].lam, sizeof(fresh.v[v].lam)) == 0);
-    CHECK(vertex[v]->planes == fresh.v[v].planes);
-  }
   REQUIRE(replayed_faces.count == faces.count);
   REQUIRE(replayed_faces.length() == faces.length());
   CHECK(replayed_faces.bytes != replayed_faces.walked);  // read in place from the record
