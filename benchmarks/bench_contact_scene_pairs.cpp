@@ -11,7 +11,8 @@
 //             no sliver skip, every clip afresh (it includes its own box test);
 //   stage     what the contact stage does for the pair: the tets' boxes, then potential_contact
 //             on the prepared contactor and the target's geometry, with the scene's sliver
-//             tolerance and the clip record and apart memo of the pair's evaluation at x0.
+//             tolerance, the clip record and apart memo of the pair's evaluation at x0, and the
+//             clips met before (one store for all pairs, as the stage keeps one per rank).
 // The per-tet work the stage shares between a tet's pairs (geometry, box, prepared contactor) is
 // timed once for all tets and reported per pair.  Pairs the stage would not evaluate at all
 // (kept apart by their gap) are timed like the others: the figures are an upper bound for it.
