@@ -5,6 +5,7 @@ running stage").
 
   /usr/bin/python3 benchmarks/contact_pair_timing/plot.py
       [--csv docs/data/contact_pair_timing_histograms.csv] [--png docs/contact_pair_costs.png]
+      [--now-label d206238]
 
 Each curve is the share of the class's pairs per bin of cost (80 bins per decade, from 1 ns),
 smoothed over 5 bins; the legend gives the class's mean.
@@ -27,6 +28,7 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--csv", default="docs/data/contact_pair_timing_histograms.csv")
     p.add_argument("--png", default="docs/contact_pair_costs.png")
+    p.add_argument("--now-label", default="d206238", help="the commit run.py measured as now")
     a = p.parse_args()
     counts = collections.defaultdict(lambda: collections.Counter())  # (case, code, class) -> bins
     for r in csv.DictReader(open(a.csv)):
@@ -65,7 +67,7 @@ def main():
             if row == 1:
                 ax.set_xlabel("ns per pair (in the running stage)", fontsize=8)
     fig.suptitle("One contact pair's cost, friction and dashpot included: issue 12's start "
-                 "(f37b868) and now (d206238)", fontsize=10)
+                 f"(f37b868) and now ({a.now_label})", fontsize=10)
     fig.tight_layout()
     fig.savefig(a.png, dpi=110)
     print(f"wrote {a.png}")
