@@ -39,8 +39,8 @@ constexpr int kTetNeighbours[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}
 // The new vertex on edge a–b where the plane lam[k] = 0 cuts it (dist_a = a.lam[k] >= 0 >
 // dist_b = b.lam[k]): interpolated from the kept end a, so that a shared edge gives the same point
 // in every piece that holds it.  One function for the clip and its replay (clip_replay.hpp): the
-// same operations, bit for bit.
-// The replay needs the coordinates only (its faces come with the record): cut_edge_values.
+// same operations, bit for bit.  The replay makes the coordinates only (its faces and their
+// planes come with the record); the clip tags the vertex's planes too (cut_edge).
 inline void cut_edge_values(const PieceVertex& a, const PieceVertex& b, double dist_a,
                             double dist_b, int k, PieceVertex& w) {
   const double t = dist_a / (dist_a - dist_b);  // in [0, 1)
