@@ -176,8 +176,10 @@ class ReplayedVertices {
     if (made_ + n_new > kMaxVertices) return false;
     const int k = 4 + b;
     int kept = 0;
-    for (int j = 0; j < n_; ++j)
-      if (!((mask >> j) & 1u)) next_[kept++] = current_[j];
+    for (int j = 0; j < n_; ++j) {  // (no branch: the mask varies from piece to piece)
+      next_[kept] = current_[j];
+      kept += !((mask >> j) & 1u);
+    }
     for (int q = 0; q < n_new; ++q, edges += 2) {
       const int a = edges[0], c = edges[1];
       cut_edge_values(piece.v[current_[a]], piece.v[current_[c]], dist_[a], dist_[c], k,

@@ -116,14 +116,17 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetr
                                        double enough_share = -1.0) {
   const Vec3* gradient[8];
   double potential_bound[2], gradient_max[2], volume[2];
-  int thin[8], thin_count = 0;  // slabs thin enough for their prisms to matter
+  int thin[8] = {}, thin_count = 0;  // slabs thin enough for their prisms to matter
+  double slab_norm[8];               // |g| of slab k
   for (int T = 0; T < 2; ++T) {
     double smallest_mu = 1.0;
     for (int a = 0; a < 4; ++a) {
       const int k = 4 * T + a;
       smallest_mu = std::min(smallest_mu, mu[k]);
       gradient[k] = &frame.map[T].gradient[a];
-      if (mu[k] < kPrismSlab) thin[thin_count++] = k;
+      slab_norm[k] = metrics.of[T]->norm[a];
+      thin[thin_count] = k;  // kept where thin (no branch: which slabs are thin varies by pair)
+      thin_count += mu[k] < kPrismSlab;
     }
     potential_bound[T] = 4.0 * smallest_mu;
     gradient_max[T] = metrics.of[T]->largest;
@@ -132,7 +135,13 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetr
   // The thinnest slabs first, and the prisms and parallelepipeds of the kMaxThinSlabs thinnest
   // only (their number grows as the cube of the slabs'; any of them bounds, so fewer leave the
   // bound rigorous).
-  for (int i = 1; i < thin_count; ++i)  // insertion sort: at most 8, stable
+  // Insertion sort (at most 8, stable), its first step without a branch: most pairs have two thin
+  // slabs (a pressed face: one per tet) in either order.
+  const bool swap_first = thin_count >= 2 && mu[thin[1]] < mu[thin[0]];
+  const int first = thin[0], second = thin[1];
+  thin[0] = swap_first ? second : first;
+  thin[1] = swap_first ? first : second;
+  for (int i = 2; i < thin_count; ++i)
     for (int j = i; j > 0 && mu[thin[j]] < mu[thin[j - 1]]; --j) std::swap(thin[j], thin[j - 1]);
   thin_count = std::min(thin_count, kMaxThinSlabs);
   PairForceBound bound;
@@ -156,8 +165,8 @@ inline PairForceBound pair_force_bound(const TetPairFrame& frame, const PairMetr
     return bound.nodal_force <= enough;
   };
   if (early()) return bound;
-  double norm[8];
-  for (int i = 0; i < thin_count; ++i) norm[i] = metrics.of[thin[i] / 4]->norm[thin[i] % 4];
+  double norm[kMaxThinSlabs];  // (all four: a loop to thin_count is a branch that varies)
+  for (int i = 0; i < kMaxThinSlabs; ++i) norm[i] = slab_norm[thin[i]];
   Vec3 cross[8][8];  // [i][j], i < j: g_thin[i] × g_thin[j]
   for (int i = 0; i < thin_count; ++i)
     for (int j = i + 1; j < thin_count; ++j) {
