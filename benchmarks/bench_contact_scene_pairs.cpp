@@ -157,10 +157,10 @@ int main(int argc, char** argv) {
     ClipMemo memo = records[i].next();
     memo.topologies = &topologies;
     potential_contact(prepared0[pairs[i].a], geometry0[pairs[i].b], penalty, tolerance, &memo);
-    record0[i].assign(memo.record->begin(), memo.record->end());
+    record0[i].assign(memo.record->data(), memo.record->data() + memo.record->size());
     apart0[i] = memo.apart_now;
   }
-  std::vector<std::uint8_t> scratch;
+  RecordBytes scratch;
   const auto stage_pair = [&](std::size_t i) {
     const CandidatePair& p = pairs[i];
     if (!boxes_intersect(box1[p.a], box1[p.b])) return ContactPairResult{};

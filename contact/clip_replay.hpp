@@ -16,7 +16,10 @@
 // piece that keeps a volume, [faces] and per face [size][planes, 16 bits][its vertices].
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <cstring>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -25,12 +28,54 @@
 
 namespace fdem {
 
+// A pair's or a stage's clip records: a byte buffer whose appends are inlined (std::vector's
+// push_back of a byte was a call, a few per evaluated pair).  Capacity doubles as it grows and is
+// kept across clear(), so a lasting scene stops allocating after its first steps.
+class RecordBytes {
+ public:
+  RecordBytes() = default;
+  RecordBytes(RecordBytes&&) = default;
+  RecordBytes& operator=(RecordBytes&&) = default;
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  const std::uint8_t* data() const { return bytes_.get(); }
+  std::uint8_t* data() { return bytes_.get(); }
+  void clear() { size_ = 0; }
+  void shrink_to(std::size_t size) { size_ = size < size_ ? size : size_; }
+  void append(const std::uint8_t* bytes, std::size_t count) {
+    if (count > capacity_ - size_) grow(count);
+    std::memcpy(bytes_.get() + size_, bytes, count);
+    size_ += count;
+  }
+  void append_pair(std::uint8_t first, std::uint8_t second) {
+    if (2 > capacity_ - size_) grow(2);
+    bytes_[size_] = first;
+    bytes_[size_ + 1] = second;
+    size_ += 2;
+  }
+  void release() {
+    bytes_.reset();
+    size_ = capacity_ = 0;
+  }
+
+ private:
+  void grow(std::size_t count) {
+    const std::size_t capacity = std::max<std::size_t>({256, 2 * capacity_, size_ + count});
+    std::unique_ptr<std::uint8_t[]> bytes(new std::uint8_t[capacity]);
+    if (size_ > 0) std::memcpy(bytes.get(), bytes_.get(), size_);
+    bytes_ = std::move(bytes);
+    capacity_ = capacity;
+  }
+  std::unique_ptr<std::uint8_t[]> bytes_;
+  std::size_t size_ = 0, capacity_ = 0;
+};
+
 // What the contact stage hands the kernel for one pair.  Every part is optional.
 struct ClipMemo {
   // The pair's record from the step before, or null; the kernel reads it forward from here.
   const std::uint8_t* previous = nullptr;
   const std::uint8_t* previous_end = nullptr;
-  std::vector<std::uint8_t>* record = nullptr;  // this evaluation's record is appended here
+  RecordBytes* record = nullptr;  // this evaluation's record is appended here
   // The clips met before, where a piece's record no longer fits (clip_topologies.hpp); or null.
   piece_clip::ClipTopologies* topologies = nullptr;
   std::uint32_t replayed = 0;  // pieces replayed from the record or from the clips met before
@@ -58,8 +103,8 @@ class PairClipRecords {
   // A memo that reads the record of the evaluation before and writes this one's; valid until
   // the next call.
   ClipMemo next() {
-    const std::vector<std::uint8_t>& read = records_[parity_];
-    std::vector<std::uint8_t>& written = records_[parity_ ^ 1];
+    const RecordBytes& read = records_[parity_];
+    RecordBytes& written = records_[parity_ ^ 1];
     written.clear();
     parity_ ^= 1;
     ClipMemo memo;
@@ -71,7 +116,7 @@ class PairClipRecords {
   }
 
  private:
-  std::vector<std::uint8_t> records_[2];
+  RecordBytes records_[2];
   piece_clip::ClipTopologies topologies_;
   int parity_ = 0;
 };

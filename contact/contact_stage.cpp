@@ -293,8 +293,8 @@ void ContactStage::release_until_rebind() {
   release(clip_record_at_);
   release(apart_at_);
   apart_pairs_.release();
-  release(clip_records_[0]);
-  release(clip_records_[1]);
+  clip_records_[0].release();
+  clip_records_[1].release();
   clip_topologies_.clear();
   release(pair_tets_);
   release(pair_slots_);
@@ -372,8 +372,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
                     friction_coefficient_[tets.material[pair.b]]);
   };
   // This step's clip records go to the other buffer; every pair's offset is renewed or cleared.
-  const std::vector<std::uint8_t>& clip_read = clip_records_[clip_parity_];
-  std::vector<std::uint8_t>& clip_written = clip_records_[clip_parity_ ^ 1];
+  const RecordBytes& clip_read = clip_records_[clip_parity_];
+  RecordBytes& clip_written = clip_records_[clip_parity_ ^ 1];
   clip_written.clear();
   clip_parity_ ^= 1;
   const std::size_t pair_count = pairs_.size();
@@ -423,15 +423,12 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         apart_at_.assign(pair_count, ClipMemo::kNotApart);
       }
       if (clip_read_at != kNoClipRecord) {
-        memo.previous = clip_read.data() + clip_read_at + 2;
-        memo.previous_end =
-            memo.previous + (clip_read[clip_read_at] | (clip_read[clip_read_at + 1] << 8));
+        const std::uint8_t* const at = clip_read.data() + clip_read_at;
+        memo.previous = at + 2;
+        memo.previous_end = memo.previous + (at[0] | (at[1] << 8));
       }
       record_start = clip_written.size();
-      // Two bytes for the pair's length, once known (push_back: a resize made a call and a memset
-      // per pair).
-      clip_written.push_back(0);
-      clip_written.push_back(0);
+      clip_written.append_pair(0, 0);  // the pair's length, once known
       memo.record = &clip_written;
       memo.topologies = &clip_topologies_;
     }
@@ -443,10 +440,10 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     if (clip_replay_) {
       const std::size_t length = clip_written.size() - record_start - 2;
       if (length == 0 || length > 0xFFFFu || record_start >= kNoClipRecord) {
-        clip_written.resize(record_start);
+        clip_written.shrink_to(record_start);
       } else {
-        clip_written[record_start] = static_cast<std::uint8_t>(length & 0xFFu);
-        clip_written[record_start + 1] = static_cast<std::uint8_t>(length >> 8);
+        clip_written.data()[record_start] = static_cast<std::uint8_t>(length & 0xFFu);
+        clip_written.data()[record_start + 1] = static_cast<std::uint8_t>(length >> 8);
         clip_record_at_[index] = static_cast<std::uint32_t>(record_start);
       }
       pieces_replayed_ += memo.replayed;

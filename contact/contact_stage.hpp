@@ -11,6 +11,7 @@
 
 #include "contact/apart_pairs.hpp"
 #include "contact/broad_phase.hpp"
+#include "contact/clip_replay.hpp"
 #include "contact/clip_topologies.hpp"
 #include "contact/corner_contact.hpp"
 #include "contact/friction_kernels.hpp"
@@ -303,7 +304,7 @@ class ContactStage {
   // the pair's length in its first two bytes.  The offsets exist from the first pair whose boxes
   // meet, and go with the candidate list.
   static constexpr std::uint32_t kNoClipRecord = 0xFFFFFFFFu;
-  std::vector<std::uint8_t> clip_records_[2];
+  RecordBytes clip_records_[2];
   std::vector<std::uint32_t> clip_record_at_;
   // Every clip met on this rank, shared by all pairs: where a pair's record of the step before
   // no longer fits its piece.

@@ -140,11 +140,9 @@ const std::uint8_t* find_recorded_piece(ClipMemo& memo, unsigned key) {
 }
 
 // Appends a piece's clip record ([key][length][bytes]) to this step's record of the pair.
-void record_piece(std::vector<std::uint8_t>& record, unsigned key, const std::uint8_t* bytes,
-                  int length) {
-  record.push_back(static_cast<std::uint8_t>(key));
-  record.push_back(static_cast<std::uint8_t>(length));
-  record.insert(record.end(), bytes, bytes + length);
+void record_piece(RecordBytes& record, unsigned key, const std::uint8_t* bytes, int length) {
+  record.append_pair(static_cast<std::uint8_t>(key), static_cast<std::uint8_t>(length));
+  record.append(bytes, static_cast<std::size_t>(length));
 }
 
 // The inward unit normals of the pair's faces: [0] contactor, [1] target (as TetGeometry's).
