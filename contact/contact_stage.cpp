@@ -469,24 +469,25 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
     may_hold_friction_[index] = 1;
     out.active_pairs += share > 0.0 ? 1 : 0;
     out.energy += share * r.energy;
-    for (int c = 0; c < 4; ++c) {
-      vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += r.force_contactor[c];
-      vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += r.force_target[c];
-    }
+    const LocalIndex* const node_a = tets.nodes.data() + 4 * static_cast<std::size_t>(pair.a);
+    const LocalIndex* const node_b = tets.nodes.data() + 4 * static_cast<std::size_t>(pair.b);
     Vec3 va[4], vb[4];
     for (int c = 0; c < 4; ++c) va[c] = vb[c] = Vec3::Zero();
     const double xi = std::max(damping_ratio_[ma], damping_ratio_[mb]);
     if (mu > 0.0 || xi > 0.0)
       for (int c = 0; c < 4; ++c) {
-        va[c] = vec3_at(nodes.v.data(), tets.nodes[4 * pair.a + c]);
-        vb[c] = vec3_at(nodes.v.data(), tets.nodes[4 * pair.b + c]);
+        va[c] = vec3_at(nodes.v.data(), node_a[c]);
+        vb[c] = vec3_at(nodes.v.data(), node_b[c]);
       }
     // A round-off sliver (overlap below 1e-12 of the smaller tet, e.g. coplanar faces touching
     // at t = 0) has no meaningful secant stiffness F²/(2U) (seen 1.6e23 N/m from F = 6e-41 N,
     // U = 1e-104 J): no dashpot on it.
     const double sliver =
         1e-12 * std::min(std::abs(tets.volume0[pair.a]), std::abs(tets.volume0[pair.b]));
-    if (xi > 0.0 && r.energy > 0.0 && r.normal_force > 0.0 && r.overlap_volume > sliver) {
+    double f_n = 0.0;  // N: the dashpot's force on the contactor along r.normal
+    const bool damped =
+        xi > 0.0 && r.energy > 0.0 && r.normal_force > 0.0 && r.overlap_volume > sliver;
+    if (damped) {
       // Normal dashpot c = 2ξ√(k m): k = F²/(2U) is the pair's secant stiffness (exact for U ∝ d²),
       // m the reduced mass of the two pieces (contact.dashpot: bodies) or of the two tets (tets);
       // a fixed partner has infinite mass.  The dashpot never pulls harder than the elastic push,
@@ -503,8 +504,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         };
         double inverse_a[4], inverse_b[4];
         for (int q = 0; q < 4; ++q) {
-          inverse_a[q] = a_fixed ? 0.0 : 1.0 / nodes.mass[tets.nodes[4 * pair.a + q]];
-          inverse_b[q] = b_fixed ? 0.0 : 1.0 / nodes.mass[tets.nodes[4 * pair.b + q]];
+          inverse_a[q] = a_fixed ? 0.0 : 1.0 / nodes.mass[node_a[q]];
+          inverse_b[q] = b_fixed ? 0.0 : 1.0 / nodes.mass[node_b[q]];
         }
         coefficient = dashpot_coefficient(
             xi, k, reduced_mass(piece_mass(pair.a, m_a), a_fixed, piece_mass(pair.b, m_b), b_fixed),
@@ -513,19 +514,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
         coefficient = dashpot_coefficient(xi, k, reduced_mass(m_a, a_fixed, m_b, b_fixed), 0.0, dt);
       }
       const double v_n = relative_velocity_at_centroid(r, va, vb).dot(r.normal);
-      const double f_n =
-          std::max(-coefficient * v_n, -r.normal_force);  // on the contactor, along n
-      double* damping_force = writable(damping_force_, damping_written_);
-      for (int c = 0; c < 4; ++c) {
-        const Vec3 on_a = r.centroid_weights_contactor[c] * f_n * r.normal;
-        const Vec3 on_b = -r.centroid_weights_target[c] * f_n * r.normal;
-        vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += on_a;
-        vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += on_b;
-        vec3_at(damping_force, tets.nodes[4 * pair.a + c]) += on_a;
-        vec3_at(damping_force, tets.nodes[4 * pair.b + c]) += on_b;
-      }
+      f_n = std::max(-coefficient * v_n, -r.normal_force);
     }
-    Vec3 tangential = Vec3::Zero();
+    FrictionResult f;
     if (mu > 0.0) {
       // Stick spring k_t = p·s (N/m) with s the pair's size: as stiff as the normal contact.
       // (set once per contact: the pair's reference volumes do not change)
@@ -550,19 +541,37 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       }
       FrictionPoint point = centroid_point(r);
       if (history.attached()) spring_point(history, geometry_a, geometry_b, point);
-      const FrictionResult f =
-          coulomb_friction(law, r, point, relative_velocity_at(point, va, vb), dt, history);
+      f = coulomb_friction(law, r, point, relative_velocity_at(point, va, vb), dt, history);
       if (f.slipping && history.attached()) slide_anchors(history, geometry_a, geometry_b, f.slip);
-      double* friction_force = writable(friction_force_, friction_written_);
-      for (int c = 0; c < 4; ++c) {
-        vec3_at(nodes.f.data(), tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
-        vec3_at(nodes.f.data(), tets.nodes[4 * pair.b + c]) += f.force_target[c];
-        vec3_at(friction_force, tets.nodes[4 * pair.a + c]) += f.force_contactor[c];
-        vec3_at(friction_force, tets.nodes[4 * pair.b + c]) += f.force_target[c];
-      }
       out.friction_spring_energy += share * f.spring_energy;
-      tangential = f.tangential_force;
     }
+    // One pass over the pair's nodes: each node's force takes its contact, dashpot and friction
+    // parts in that order (as three passes would add them: a pair's tets share no node, pairs
+    // within one group are never candidates), the dashpot's and friction's arrays their own.
+    double* const force = nodes.f.data();
+    double* const damping_force = damped ? writable(damping_force_, damping_written_) : nullptr;
+    double* const friction_force =
+        mu > 0.0 ? writable(friction_force_, friction_written_) : nullptr;
+    const auto add_to_node = [&](LocalIndex node, const Vec3& contact, double centroid_weight,
+                                 const Vec3& friction) {
+      Vec3 total = vec3_at(force, node) + contact;
+      if (damped) {
+        const Vec3 damping = centroid_weight * f_n * r.normal;
+        total += damping;
+        vec3_at(damping_force, node) += damping;
+      }
+      if (mu > 0.0) {
+        total += friction;
+        vec3_at(friction_force, node) += friction;
+      }
+      vec3_at(force, node) = total;
+    };
+    for (int c = 0; c < 4; ++c)
+      add_to_node(node_a[c], r.force_contactor[c], r.centroid_weights_contactor[c],
+                  f.force_contactor[c]);
+    for (int c = 0; c < 4; ++c)
+      add_to_node(node_b[c], r.force_target[c], -r.centroid_weights_target[c], f.force_target[c]);
+    const Vec3 tangential = f.tangential_force;
     if (share > 0.0) records_.push_back({r.centroid, r.normal_force * r.normal, tangential});
   }
   // Owned nodes hold the whole force of every pair they take part in (the halo guarantees it).
