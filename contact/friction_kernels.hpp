@@ -112,13 +112,14 @@ inline bool spring_point(const FrictionHistory& history, const TetGeometry& cont
     anchor_t += history.anchor_target[a] * target.corners.x[a];
   }
   const Vec3 middle = 0.5 * (anchor_c + anchor_t);
-  BarycentricMap map_c, map_t;
-  if (!barycentric_map_about(contactor, middle, map_c) ||
-      !barycentric_map_about(target, middle, map_t))
+  double at_c[4], at_t[4];
+  if (!contactor.valid || !target.valid ||
+      !barycentric_values(contactor.gradient, contactor.corners.x[0], middle, at_c) ||
+      !barycentric_values(target.gradient, target.corners.x[0], middle, at_t))
     return false;
-  for (int a = 0; a < 4; ++a) {  // at y = middle - origin = 0 the map's value is its offset
-    point.contactor[a] = map_c.offset[a];
-    point.target[a] = map_t.offset[a];
+  for (int a = 0; a < 4; ++a) {
+    point.contactor[a] = at_c[a];
+    point.target[a] = at_t[a];
   }
   return true;
 }
@@ -179,12 +180,7 @@ inline FrictionResult coulomb_friction(const FrictionLaw& law, const ContactPair
                                        const FrictionPoint& point, const Vec3& relative_velocity,
                                        double dt, FrictionHistory& history,
                                        double normal_spin_rate = 0.0) {
-  FrictionResult out;
-  for (int a = 0; a < 4; ++a) {
-    out.force_contactor[a].setZero();
-    out.force_target[a].setZero();
-  }
-  out.tangential_force.setZero();
+  FrictionResult out;  // (zero forces)
   const double k = law.tangential_stiffness;
   Vec3& spring = history.tangential_spring;
   if (!pair.overlapping || !(pair.normal_force > 0.0)) {

@@ -48,14 +48,21 @@ inline bool barycentric_gradients(const TetCorners& tet, Vec3 (&gradient)[4], do
   return true;
 }
 
-// The offsets for the local origin `origin`, from corner 0 (`corner0`); false when not finite.
+// The barycentric coordinates at `point` of a tet with these gradients and corner 0 (`corner0`);
+// false when not finite.
+inline bool barycentric_values(const Vec3 (&gradient)[4], const Vec3& corner0, const Vec3& point,
+                               double (&value)[4]) {
+  const Vec3 y0 = corner0 - point;
+  value[1] = -gradient[1].dot(y0);
+  value[2] = -gradient[2].dot(y0);
+  value[3] = -gradient[3].dot(y0);
+  value[0] = 1.0 - value[1] - value[2] - value[3];
+  return std::isfinite(value[0]);
+}
+
+// The offsets for the local origin `origin` (the coordinates there); false when not finite.
 inline bool barycentric_offsets(const Vec3& corner0, const Vec3& origin, BarycentricMap& map) {
-  const Vec3 y0 = corner0 - origin;
-  map.offset[1] = -map.gradient[1].dot(y0);
-  map.offset[2] = -map.gradient[2].dot(y0);
-  map.offset[3] = -map.gradient[3].dot(y0);
-  map.offset[0] = 1.0 - map.offset[1] - map.offset[2] - map.offset[3];
-  return std::isfinite(map.offset[0]);
+  return barycentric_values(map.gradient, corner0, origin, map.offset);
 }
 
 // Builds the map; false for a degenerate (flat or non-finite) tet, which has no interior.
