@@ -265,8 +265,7 @@ inline void piece_force_bounds(const PairMetrics& metrics, const double (&mu)[8]
         volume = prism_volume < volume ? prism_volume : volume;  // std::min(volume, ...)
         surface = prism_surface < surface ? prism_surface : surface;
       }
-    for (int i = 0; i < 4; ++i)
-      bound[4 * T + i] = 4.0 * largest * volume[i] + 4.0 * thinnest_own * surface[i];
+    store_lanes(4.0 * largest * volume + 4.0 * thinnest_own * surface, bound + 4 * T);
   }
 }
 
