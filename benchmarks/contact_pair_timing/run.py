@@ -2,7 +2,7 @@
 """What one contact pair costs as the contact stage runs, friction and dashpot included, at
 issue 12's start and now (docs/benchmarks.md, "Each pair timed in the running stage").
 
-  benchmarks/contact_pair_timing/run.py [--start f37b868] [--now 9768513]
+  benchmarks/contact_pair_timing/run.py [--start f37b868] [--now decbb23]
       [--workdir /tmp/fdem_pair_timing] [--cases tower,dry_wall,pile,wall55,arch]
       [--repeats 1] [--cpu 0] [--without-friction-and-dashpot]
       [--csv docs/data/contact_pair_timing.csv]
@@ -129,7 +129,7 @@ def run_case(fdem, scene, overrides, cpu, outdir, histogram):
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--start", default="f37b868")
-    p.add_argument("--now", default="9768513")
+    p.add_argument("--now", default="decbb23")
     p.add_argument("--workdir", default="/tmp/fdem_pair_timing")
     p.add_argument("--cases", default="tower,dry_wall,pile,wall55,arch")
     p.add_argument("--repeats", type=int, default=1)
