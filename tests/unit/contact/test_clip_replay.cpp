@@ -265,3 +265,39 @@ TEST_CASE("the clips met before keep one node per graph and find each by its mas
         Replay::clipped_away);
   CHECK(terminal == cut_off);
 }
+
+TEST_CASE("clip records keep their bytes as the buffer grows, shrinks and is cleared",
+          "[contact][clip_replay]") {
+  RecordBytes record;
+  REQUIRE(record.empty());
+  std::vector<std::uint8_t> expected;
+  // Appends of every length from 0 to 40 bytes, well past the first capacity (256 B).
+  for (int length = 0; length <= 40; ++length) {
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(length));
+    for (int j = 0; j < length; ++j) bytes[static_cast<std::size_t>(j)] = std::uint8_t(length + j);
+    record.append_pair(std::uint8_t(length), std::uint8_t(255 - length));
+    expected.push_back(std::uint8_t(length));
+    expected.push_back(std::uint8_t(255 - length));
+    record.append(bytes.data(), bytes.size());
+    expected.insert(expected.end(), bytes.begin(), bytes.end());
+  }
+  REQUIRE(record.size() == expected.size());
+  REQUIRE(std::memcmp(record.data(), expected.data(), expected.size()) == 0);
+  // A pair's record dropped: back to where it started; shrinking never grows.
+  record.shrink_to(100);
+  REQUIRE(record.size() == 100);
+  record.shrink_to(200);
+  REQUIRE(record.size() == 100);
+  REQUIRE(std::memcmp(record.data(), expected.data(), 100) == 0);
+  // Cleared, it keeps its storage for the next step's records.
+  const std::uint8_t* storage = record.data();
+  record.clear();
+  REQUIRE(record.empty());
+  record.append_pair(7, 9);
+  REQUIRE(record.data() == storage);
+  REQUIRE(record.data()[0] == 7);
+  REQUIRE(record.data()[1] == 9);
+  record.release();
+  REQUIRE(record.empty());
+  REQUIRE(record.data() == nullptr);
+}
