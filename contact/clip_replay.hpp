@@ -43,6 +43,7 @@ class RecordBytes {
   void clear() { size_ = 0; }
   void shrink_to(std::size_t size) { size_ = size < size_ ? size : size_; }
   void append(const std::uint8_t* bytes, std::size_t count) {
+    if (count == 0) return;  // (bytes may then be null, which memcpy must not get)
     if (count > capacity_ - size_) grow(count);
     std::memcpy(bytes_.get() + size_, bytes, count);
     size_ += count;
