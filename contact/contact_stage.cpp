@@ -546,8 +546,9 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
       out.friction_spring_energy += share * f.spring_energy;
     }
     // One pass over the pair's nodes: each node's force takes its contact, dashpot and friction
-    // parts in that order (as three passes would add them: a pair's tets share no node, pairs
-    // within one group are never candidates), the dashpot's and friction's arrays their own.
+    // parts in that order, as three passes would add them (a pair's tets share no node: pairs
+    // within one group are never candidates; a shared node would only sum in another order), the
+    // dashpot's and friction's arrays their own.
     double* const force = nodes.f.data();
     double* const damping_force = damped ? writable(damping_force_, damping_written_) : nullptr;
     double* const friction_force =
