@@ -33,9 +33,6 @@ namespace fdem {
 // kept across clear(), so a lasting scene stops allocating after its first steps.
 class RecordBytes {
  public:
-  RecordBytes() = default;
-  RecordBytes(RecordBytes&&) = default;
-  RecordBytes& operator=(RecordBytes&&) = default;
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
   const std::uint8_t* data() const { return bytes_.get(); }

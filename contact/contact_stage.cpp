@@ -572,8 +572,8 @@ ContactForceSummary ContactStage::add_forces(Model& model, double dt) {
                   f.force_contactor[c]);
     for (int c = 0; c < 4; ++c)
       add_to_node(node_b[c], r.force_target[c], -r.centroid_weights_target[c], f.force_target[c]);
-    const Vec3 tangential = f.tangential_force;
-    if (share > 0.0) records_.push_back({r.centroid, r.normal_force * r.normal, tangential});
+    if (share > 0.0)
+      records_.push_back({r.centroid, r.normal_force * r.normal, f.tangential_force});
   }
   // Owned nodes hold the whole force of every pair they take part in (the halo guarantees it).
   out.work_before = work_against(model, dt);
